@@ -1,0 +1,189 @@
+//! The loaded scene as plain data: what every loader produces and what
+//! [`crate::Scene::new`] turns into something that answers ray queries.
+//!
+//! Everything here is in world space and in the units of the scene format
+//! (`../shared/design/scene-format.md`): lengths in scene units, angles in
+//! radians (the file says degrees; loaders convert), colours as linear Rec.709
+//! RGB in `Vec3`.
+
+use std::path::PathBuf;
+
+use glam::Vec3;
+
+/// Linear Rec.709 RGB triple.
+pub type Rgb = Vec3;
+
+/// A whole scene as loaded from a file, before acceleration structures exist.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneDescription {
+    /// The file the scene came from (used in error messages and reports).
+    pub source: PathBuf,
+    /// The camera.
+    pub camera: Camera,
+    /// The film resolution.
+    pub film: Film,
+    /// Every material; shapes refer to them by index.
+    pub materials: Vec<Material>,
+    /// Every triangle of every mesh and quad, already transformed to world space.
+    pub triangles: Vec<Triangle>,
+    /// Analytic spheres.
+    pub spheres: Vec<Sphere>,
+    /// Point, spot and directional lights (area emitters are emissive materials).
+    pub lights: Vec<Light>,
+    /// Optional render defaults from the `[render]` table; flags override them.
+    pub render: RenderDefaults,
+    /// What the loader skipped or had to guess, for `fppm info` and reports.
+    pub notes: LoadNotes,
+}
+
+/// Counters of what a loader dropped or inferred. Skipping is not an error.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct LoadNotes {
+    /// Triangles with zero area (or collinear vertices) that were skipped.
+    pub degenerate_triangles: usize,
+    /// Whether the camera was made up by framing the bounding box.
+    pub camera_framed: bool,
+    /// Free-form remarks ("material `light` uses Ka, not Ke: no emission").
+    pub warnings: Vec<String>,
+}
+
+/// Pinhole or thin-lens perspective camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub position: Vec3,
+    /// Point looked at.
+    pub look_at: Vec3,
+    /// Up vector (need not be orthogonal to the view direction).
+    pub up: Vec3,
+    /// Vertical field of view in radians, in (0, π).
+    pub fov_y: f32,
+    /// Lens radius; 0 is a pinhole.
+    pub aperture_radius: f32,
+    /// Distance to the plane in focus (> 0).
+    pub focus_distance: f32,
+}
+
+/// Image resolution in pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Film {
+    /// Width in pixels (> 0).
+    pub width: u32,
+    /// Height in pixels (> 0).
+    pub height: u32,
+}
+
+/// A named material: a scattering model plus optional emission from the front face.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name in the source file (TOML table key, MTL `newmtl`, glTF material name or index).
+    pub name: String,
+    /// How light scatters.
+    pub kind: MaterialKind,
+    /// Emitted radiance in W/(sr·m²) per channel, leaving the front face only. Zero if none.
+    pub emission: Rgb,
+}
+
+/// The scattering models of scene format version 1.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MaterialKind {
+    /// Lambertian reflector.
+    Diffuse {
+        /// Albedo in [0, 1] per channel.
+        albedo: Rgb,
+    },
+    /// Perfect specular reflection.
+    Mirror {
+        /// Reflectance per channel.
+        reflectance: Rgb,
+    },
+    /// Smooth dielectric with exact unpolarised Fresnel.
+    Dielectric {
+        /// Index of refraction relative to the outside medium.
+        ior: f32,
+    },
+    /// Rough conductor with a GGX (Trowbridge–Reitz) distribution and Smith shadowing,
+    /// optionally over a Lambertian base (the OBJ `Kd` + `Ks` mapping).
+    Glossy {
+        /// Specular reflectance per channel.
+        reflectance: Rgb,
+        /// GGX α (not squared), > 0.
+        roughness: f32,
+        /// Albedo of the Lambertian base; zero for a pure conductor (the TOML `glossy`).
+        diffuse: Rgb,
+    },
+}
+
+/// One world-space triangle. The front face is where v0, v1, v2 appear counter-clockwise.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    /// Vertex positions.
+    pub positions: [Vec3; 3],
+    /// Per-vertex shading normals (unit length), if the source had them.
+    pub normals: Option<[Vec3; 3]>,
+    /// Index into [`SceneDescription::materials`].
+    pub material: u32,
+}
+
+/// An analytic sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Centre.
+    pub center: Vec3,
+    /// Radius (> 0).
+    pub radius: f32,
+    /// Index into [`SceneDescription::materials`].
+    pub material: u32,
+}
+
+/// A delta light source.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    /// Isotropic point light.
+    Point {
+        /// Position.
+        position: Vec3,
+        /// Radiant intensity in W/sr per channel.
+        intensity: Rgb,
+    },
+    /// Spot light: full intensity inside `falloff_start`, smooth falloff to zero at `cone_angle`.
+    Spot {
+        /// Position.
+        position: Vec3,
+        /// Unit axis of the cone.
+        direction: Vec3,
+        /// Radiant intensity on the axis in W/sr per channel.
+        intensity: Rgb,
+        /// Half-angle of the cone in radians: no light outside it.
+        cone_angle: f32,
+        /// Half-angle in radians up to which the intensity is full (≤ `cone_angle`).
+        falloff_start: f32,
+    },
+    /// Infinitely distant light.
+    Directional {
+        /// Unit direction the light travels.
+        direction: Vec3,
+        /// Irradiance in W/m² on a surface facing the light.
+        irradiance: Rgb,
+    },
+}
+
+/// Optional render settings stored with a scene (`[render]` table). Every field is optional;
+/// the command line overrides them and the integrators validate them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RenderDefaults {
+    /// Integrator name, e.g. `"ppm"`, `"sppm"`, `"freq"`.
+    pub method: Option<String>,
+    /// Number of passes.
+    pub passes: Option<u32>,
+    /// Photons traced per pass.
+    pub photons_per_pass: Option<u64>,
+    /// Radius reduction parameter α.
+    pub alpha: Option<f64>,
+    /// Initial gather radius in scene units.
+    pub initial_radius: Option<f64>,
+    /// Maximum path depth.
+    pub max_depth: Option<u32>,
+    /// Random seed.
+    pub seed: Option<u64>,
+}

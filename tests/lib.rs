@@ -1,0 +1,1 @@
+//! Workspace integration tests; the test binary lives in `it/main.rs`.
