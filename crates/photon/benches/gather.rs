@@ -1,0 +1,2 @@
+//! Gather benchmark (placeholder).
+fn main() {}
