@@ -1,0 +1,259 @@
+//! The one error type of the scene loaders.
+
+use std::path::PathBuf;
+
+/// Why a scene could not be loaded.
+///
+/// Every variant carries the file the problem is in (the scene file, or the mesh file a
+/// scene refers to), and `Display` is one lowercase line that starts with that path,
+/// e.g. `scenes/a.toml: line 7, column 1: unknown key "colour" in [materials.white]
+/// (expected one of: type, albedo, emission)`.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum LoadError {
+    /// The file could not be opened or read.
+    #[error("{}: cannot read file: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the operating system said.
+        source: std::io::Error,
+    },
+    /// The file is not valid UTF-8 text.
+    #[error("{}: file is not valid utf-8 text", path.display())]
+    NotUtf8 {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The file name has an extension no loader handles.
+    #[error(
+        "{}: unsupported scene file extension {extension:?} (expected .toml, .obj, .gltf or .glb)",
+        path.display()
+    )]
+    UnsupportedExtension {
+        /// The file.
+        path: PathBuf,
+        /// The extension found (empty if none).
+        extension: String,
+    },
+    /// The TOML text is not well-formed TOML.
+    #[error("{}: {}invalid toml: {message}", path.display(), location(*line, *column))]
+    Toml {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line, if known.
+        line: Option<u32>,
+        /// 1-based column, if known.
+        column: Option<u32>,
+        /// The parser's description of the problem.
+        message: String,
+    },
+    /// A key that scene format version 1 does not define.
+    #[error(
+        "{}: {}unknown key {key:?} in {table} (expected one of: {expected})",
+        path.display(), location(*line, *column)
+    )]
+    UnknownKey {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line, if known.
+        line: Option<u32>,
+        /// 1-based column, if known.
+        column: Option<u32>,
+        /// The table, e.g. `[materials.white]` or `[[shapes]] #2`.
+        table: String,
+        /// The unknown key.
+        key: String,
+        /// The keys allowed there, comma separated.
+        expected: String,
+    },
+    /// A required key is absent.
+    #[error("{}: {}missing required key {key:?} in {table}", path.display(), location(*line, *column))]
+    MissingKey {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line of the table, if known.
+        line: Option<u32>,
+        /// 1-based column, if known.
+        column: Option<u32>,
+        /// The table the key belongs in.
+        table: String,
+        /// The missing key.
+        key: String,
+    },
+    /// A value has the wrong TOML type (a string where numbers belong, a 2-vector for a colour…).
+    #[error(
+        "{}: {}wrong type{} in {table}: {message}",
+        path.display(), location(*line, *column), for_key(key)
+    )]
+    WrongType {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line, if known.
+        line: Option<u32>,
+        /// 1-based column, if known.
+        column: Option<u32>,
+        /// The table the key is in.
+        table: String,
+        /// The key (empty if not known).
+        key: String,
+        /// What was found and what was expected.
+        message: String,
+    },
+    /// A material `type` (or shape/light `type`) that the format does not define.
+    #[error(
+        "{}: {}unknown type {found:?} in {table} (expected one of: {expected})",
+        path.display(), location(*line, *column)
+    )]
+    UnknownType {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line, if known.
+        line: Option<u32>,
+        /// 1-based column, if known.
+        column: Option<u32>,
+        /// The table, e.g. `[materials.glass]`.
+        table: String,
+        /// The type given.
+        found: String,
+        /// The types allowed, comma separated.
+        expected: String,
+    },
+    /// A shape refers to a material name that no `[materials.NAME]` table defines.
+    #[error("{}: {context} refers to unknown material {name:?} (defined: {defined})", path.display())]
+    UnknownMaterial {
+        /// The file.
+        path: PathBuf,
+        /// Where the reference is, e.g. `[[shapes]] #3`.
+        context: String,
+        /// The name referred to.
+        name: String,
+        /// The names that are defined, comma separated.
+        defined: String,
+    },
+    /// A value out of its allowed range: fov outside (0, 180), a non-positive radius or
+    /// resolution, a negative radiance or albedo, a zero direction, a non-finite number…
+    #[error("{}: {key} {message}", path.display())]
+    InvalidValue {
+        /// The file.
+        path: PathBuf,
+        /// Which value, e.g. `[camera] fov_y` or `material "lamp" emission`.
+        key: String,
+        /// What is wrong with it, e.g. `must be in (0, 180) degrees, got 180`.
+        message: String,
+    },
+    /// `format` is not 1.
+    #[error("{}: unsupported scene format version {found} (this loader reads format = 1)", path.display())]
+    UnsupportedVersion {
+        /// The file.
+        path: PathBuf,
+        /// The version given, as written.
+        found: String,
+    },
+    /// The OBJ text is malformed.
+    #[error("{}: {}{message}", path.display(), location(*line, None))]
+    Obj {
+        /// The OBJ file.
+        path: PathBuf,
+        /// 1-based line, if it could be found.
+        line: Option<u32>,
+        /// What is wrong.
+        message: String,
+    },
+    /// An MTL file exists but is malformed.
+    #[error("{}: {}{message}", path.display(), location(*line, None))]
+    Mtl {
+        /// The MTL file.
+        path: PathBuf,
+        /// 1-based line, if it could be found.
+        line: Option<u32>,
+        /// What is wrong.
+        message: String,
+    },
+    /// The glTF file (JSON, binary container or buffers) is malformed or unsupported.
+    #[error("{}: invalid gltf: {message}", path.display())]
+    Gltf {
+        /// The glTF file.
+        path: PathBuf,
+        /// What the glTF reader said.
+        message: String,
+    },
+    /// A vertex position is NaN or infinite.
+    #[error("{}: {}vertex has a {what} coordinate", path.display(), location(*line, None))]
+    NonFiniteVertex {
+        /// The mesh file.
+        path: PathBuf,
+        /// 1-based line of the vertex (OBJ only).
+        line: Option<u32>,
+        /// `"nan"` or `"infinite"`.
+        what: &'static str,
+    },
+    /// The scene has no geometry at all (no non-degenerate triangle and no sphere).
+    #[error("{}: empty scene: no triangles or spheres", path.display())]
+    EmptyScene {
+        /// The file.
+        path: PathBuf,
+    },
+    /// Nothing emits light: no emissive material is used and there is no delta light.
+    #[error(
+        "{}: scene has no emitter (no emissive material in use and no point, spot or directional light)",
+        path.display()
+    )]
+    NoEmitter {
+        /// The file.
+        path: PathBuf,
+    },
+    /// An emissive material is used only by degenerate (zero-area) triangles.
+    #[error("{}: emissive material {material:?} has zero area (all its triangles are degenerate)", path.display())]
+    ZeroAreaEmitter {
+        /// The file.
+        path: PathBuf,
+        /// The material's name.
+        material: String,
+    },
+}
+
+/// `" for \"albedo\""`, or nothing for an unknown key.
+fn for_key(key: &str) -> String {
+    if key.is_empty() {
+        String::new()
+    } else {
+        format!(" for {key:?}")
+    }
+}
+
+/// `"line 3, column 5: "`, `"line 3: "` or nothing.
+fn location(line: Option<u32>, column: Option<u32>) -> String {
+    match (line, column) {
+        (Some(l), Some(c)) => format!("line {l}, column {c}: "),
+        (Some(l), None) => format!("line {l}: "),
+        _ => String::new(),
+    }
+}
+
+impl LoadError {
+    /// The file the error is about.
+    #[must_use]
+    pub fn path(&self) -> &std::path::Path {
+        match self {
+            Self::Io { path, .. }
+            | Self::NotUtf8 { path }
+            | Self::UnsupportedExtension { path, .. }
+            | Self::Toml { path, .. }
+            | Self::UnknownKey { path, .. }
+            | Self::MissingKey { path, .. }
+            | Self::WrongType { path, .. }
+            | Self::UnknownType { path, .. }
+            | Self::UnknownMaterial { path, .. }
+            | Self::InvalidValue { path, .. }
+            | Self::UnsupportedVersion { path, .. }
+            | Self::Obj { path, .. }
+            | Self::Mtl { path, .. }
+            | Self::Gltf { path, .. }
+            | Self::NonFiniteVertex { path, .. }
+            | Self::EmptyScene { path }
+            | Self::NoEmitter { path }
+            | Self::ZeroAreaEmitter { path, .. } => path,
+        }
+    }
+}

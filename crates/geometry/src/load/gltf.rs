@@ -1,0 +1,335 @@
+//! glTF 2.0 (`.gltf` with `.bin` files or data URIs, and `.glb`) through the gltf crate.
+//!
+//! The default scene (or else scene 0) is walked from its root nodes, composing world matrices.
+//! Mapping (scene-format.md, "glTF 2.0 mapping"), with these decisions:
+//! - materials: transmission > 0 → dielectric (ior from `KHR_materials_ior`, default 1.5);
+//!   metallic ≥ 0.5 ([`METALLIC_THRESHOLD`]) with roughness < 0.01 → mirror with the base
+//!   colour; metallic ≥ 0.5 otherwise → glossy with α = roughness² and no diffuse base;
+//!   else diffuse with the base colour. Textures are ignored (factors only; one warning).
+//!   Emission = emissive factor × emissive strength. A primitive without a material gets
+//!   the glTF default material (white, metallic 1, roughness 1, so glossy with α = 1);
+//! - the camera is the perspective camera with the lowest index that a node of the scene
+//!   uses (its first such node); it looks down the node's −Z with the node's +Y up;
+//! - `KHR_lights_punctual` intensities are taken as radiometric (cd → W/sr, lux → W/m²) and
+//!   multiplied by the colour; spot outer cone → `cone_angle`, inner → `falloff_start`;
+//! - triangle strips and fans are converted to triangles; points and lines are skipped with
+//!   a warning; primitives without positions are skipped with a warning;
+//! - missing normals give flat shading; a node transform with negative determinant swaps
+//!   the winding so that front faces stay front faces.
+
+use std::path::Path;
+
+use glam::{Mat3, Mat4, Vec3};
+use gltf::khr_lights_punctual::Kind;
+use gltf::mesh::Mode;
+
+use super::{MeshData, read_bytes};
+use crate::description::{Camera, Light, Material, MaterialKind};
+use crate::error::LoadError;
+
+/// Metallic factor from which a glTF material counts as a conductor.
+pub const METALLIC_THRESHOLD: f32 = 0.5;
+
+/// Roughness below which a conductor is a perfect mirror.
+const MIRROR_ROUGHNESS: f32 = 0.01;
+
+/// Deepest node hierarchy accepted (guards against cyclic node graphs).
+const MAX_DEPTH: usize = 1024;
+
+fn gltf_error(path: &Path, message: impl std::fmt::Display) -> LoadError {
+    LoadError::Gltf {
+        path: path.to_path_buf(),
+        message: message.to_string().to_lowercase(),
+    }
+}
+
+/// Loads a glTF or GLB file.
+pub(crate) fn load_gltf(path: &Path) -> Result<MeshData, LoadError> {
+    let bytes = read_bytes(path)?;
+    let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| gltf_error(path, e))?;
+    let buffers = gltf::import_buffers(&gltf.document, path.parent(), gltf.blob.clone())
+        .map_err(|e| gltf_error(path, e))?;
+    let doc = &gltf.document;
+
+    let mut data = MeshData::default();
+    let mut textured = 0usize;
+    for (i, m) in doc.materials().enumerate() {
+        if m.pbr_metallic_roughness().base_color_texture().is_some()
+            || m.emissive_texture().is_some()
+        {
+            textured += 1;
+        }
+        data.materials.push(material(&m, i));
+    }
+    if textured > 0 {
+        data.warnings.push(format!(
+            "{textured} material(s) have textures, which are ignored (factors only)"
+        ));
+    }
+
+    let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
+        data.warnings.push("the file has no scene".to_owned());
+        return Ok(data);
+    };
+
+    let mut walker = Walker {
+        path,
+        buffers: &buffers,
+        data,
+        default_material: None,
+        camera: None,
+        skipped_primitives: 0,
+    };
+    let mut stack: Vec<(gltf::Node<'_>, Mat4, usize)> =
+        scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    stack.reverse();
+    while let Some((node, parent, depth)) = stack.pop() {
+        if depth > MAX_DEPTH {
+            return Err(gltf_error(
+                path,
+                format!("node hierarchy deeper than {MAX_DEPTH} levels (cyclic?)"),
+            ));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        walker.node(&node, world)?;
+        let children: Vec<_> = node.children().collect();
+        for child in children.into_iter().rev() {
+            stack.push((child, world, depth + 1));
+        }
+    }
+    let mut data = walker.data;
+    if walker.skipped_primitives > 0 {
+        data.warnings.push(format!(
+            "{} point/line or position-less primitive(s) skipped",
+            walker.skipped_primitives
+        ));
+    }
+    data.camera = walker.camera.map(|(_, camera, aspect)| (camera, aspect));
+    Ok(data)
+}
+
+struct Walker<'a> {
+    path: &'a Path,
+    buffers: &'a [gltf::buffer::Data],
+    data: MeshData,
+    default_material: Option<u32>,
+    /// (camera index, camera, aspect ratio).
+    camera: Option<(usize, Camera, Option<f32>)>,
+    skipped_primitives: usize,
+}
+
+impl Walker<'_> {
+    fn node(&mut self, node: &gltf::Node<'_>, world: Mat4) -> Result<(), LoadError> {
+        if !world.is_finite() {
+            return Err(gltf_error(
+                self.path,
+                format!("node {} has a non-finite transform", node.index()),
+            ));
+        }
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                self.primitive(&prim, world)?;
+            }
+        }
+        if let Some(cam) = node.camera()
+            && let gltf::camera::Projection::Perspective(p) = cam.projection()
+            && self
+                .camera
+                .as_ref()
+                .is_none_or(|(i, _, _)| cam.index() < *i)
+        {
+            let yfov = p.yfov();
+            if !(yfov.is_finite() && yfov > 0.0 && yfov < std::f32::consts::PI) {
+                return Err(gltf_error(
+                    self.path,
+                    format!("camera {} has yfov {yfov}, outside (0, pi)", cam.index()),
+                ));
+            }
+            let position = world.transform_point3(Vec3::ZERO);
+            let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+            let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
+            if forward == Vec3::ZERO || up == Vec3::ZERO {
+                return Err(gltf_error(
+                    self.path,
+                    format!("camera node {} has a degenerate transform", node.index()),
+                ));
+            }
+            let camera = Camera {
+                position,
+                look_at: position + forward,
+                up,
+                fov_y: yfov,
+                aperture_radius: 0.0,
+                focus_distance: 1.0,
+            };
+            self.camera = Some((cam.index(), camera, p.aspect_ratio()));
+        }
+        if let Some(light) = node.light() {
+            let colour = Vec3::from(light.color()) * light.intensity();
+            let position = world.transform_point3(Vec3::ZERO);
+            // `+ Vec3::ZERO` turns -0.0 into +0.0 (see crates.md, G1).
+            let direction = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero() + Vec3::ZERO;
+            let needs_direction = !matches!(light.kind(), Kind::Point);
+            if needs_direction && direction == Vec3::ZERO {
+                return Err(gltf_error(
+                    self.path,
+                    format!("light node {} has a degenerate transform", node.index()),
+                ));
+            }
+            self.data.lights.push(match light.kind() {
+                Kind::Point => Light::Point {
+                    position,
+                    intensity: colour,
+                },
+                Kind::Directional => Light::Directional {
+                    direction,
+                    irradiance: colour,
+                },
+                Kind::Spot {
+                    inner_cone_angle,
+                    outer_cone_angle,
+                } => Light::Spot {
+                    position,
+                    direction,
+                    intensity: colour,
+                    cone_angle: outer_cone_angle,
+                    falloff_start: inner_cone_angle.min(outer_cone_angle),
+                },
+            });
+        }
+        Ok(())
+    }
+
+    fn primitive(&mut self, prim: &gltf::Primitive<'_>, world: Mat4) -> Result<(), LoadError> {
+        let mode = prim.mode();
+        if !matches!(
+            mode,
+            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+        ) {
+            self.skipped_primitives += 1;
+            return Ok(());
+        }
+        let reader = prim.reader(|b| self.buffers.get(b.index()).map(|d| &d.0[..]));
+        let Some(positions) = reader.read_positions() else {
+            self.skipped_primitives += 1;
+            return Ok(());
+        };
+        let positions: Vec<Vec3> = positions.map(Vec3::from).collect();
+        if let Some(bad) = positions.iter().find(|p| !p.is_finite()) {
+            return Err(LoadError::NonFiniteVertex {
+                path: self.path.to_path_buf(),
+                line: None,
+                what: if bad.is_nan() { "nan" } else { "infinite" },
+            });
+        }
+        let normals: Option<Vec<Vec3>> = reader
+            .read_normals()
+            .map(|n| n.map(Vec3::from).collect())
+            .filter(|n: &Vec<Vec3>| n.len() == positions.len());
+        let indices: Vec<u32> = match reader.read_indices() {
+            Some(i) => i.into_u32().collect(),
+            None => (0..positions.len() as u32).collect(),
+        };
+        if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+            return Err(gltf_error(
+                self.path,
+                format!(
+                    "mesh primitive index {bad} is out of range ({} vertices)",
+                    positions.len()
+                ),
+            ));
+        }
+        let triangles: Vec<[u32; 3]> = match mode {
+            Mode::TriangleStrip => (2..indices.len())
+                .map(|i| {
+                    if i % 2 == 0 {
+                        [indices[i - 2], indices[i - 1], indices[i]]
+                    } else {
+                        [indices[i - 1], indices[i - 2], indices[i]]
+                    }
+                })
+                .collect(),
+            Mode::TriangleFan => (2..indices.len())
+                .map(|i| [indices[0], indices[i - 1], indices[i]])
+                .collect(),
+            _ => indices
+                .chunks_exact(3)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect(),
+        };
+        let material = match prim.material().index() {
+            Some(i) if i < self.data.materials.len() => i as u32,
+            _ => *self.default_material.get_or_insert_with(|| {
+                self.data.materials.push(default_material());
+                (self.data.materials.len() - 1) as u32
+            }),
+        };
+        let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
+        let flip = world.determinant() < 0.0;
+        let world_positions: Vec<Vec3> = positions
+            .iter()
+            .map(|&p| world.transform_point3(p))
+            .collect();
+        let world_normals: Option<Vec<Vec3>> = normals.map(|n| {
+            n.iter()
+                .map(|&v| (normal_matrix * v).normalize_or_zero())
+                .collect()
+        });
+        for mut t in triangles {
+            if flip {
+                t.swap(1, 2);
+            }
+            let p = t.map(|i| world_positions[i as usize]);
+            let n = world_normals.as_ref().map(|n| t.map(|i| n[i as usize]));
+            self.data.push_triangle(p, n, material);
+        }
+        Ok(())
+    }
+}
+
+/// The glTF default material: base colour 1, metallic 1, roughness 1.
+fn default_material() -> Material {
+    Material {
+        name: "default".to_owned(),
+        kind: MaterialKind::Glossy {
+            reflectance: Vec3::ONE,
+            roughness: 1.0,
+            diffuse: Vec3::ZERO,
+        },
+        emission: Vec3::ZERO,
+    }
+}
+
+fn material(m: &gltf::Material<'_>, index: usize) -> Material {
+    let pbr = m.pbr_metallic_roughness();
+    let [r, g, b, _] = pbr.base_color_factor();
+    let base = Vec3::new(r, g, b);
+    let metallic = pbr.metallic_factor();
+    let roughness = pbr.roughness_factor();
+    let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
+    let kind = if transmission > 0.0 {
+        MaterialKind::Dielectric {
+            ior: m.ior().unwrap_or(1.5),
+        }
+    } else if metallic >= METALLIC_THRESHOLD {
+        if roughness < MIRROR_ROUGHNESS {
+            MaterialKind::Mirror { reflectance: base }
+        } else {
+            MaterialKind::Glossy {
+                reflectance: base,
+                roughness: roughness * roughness,
+                diffuse: Vec3::ZERO,
+            }
+        }
+    } else {
+        MaterialKind::Diffuse { albedo: base }
+    };
+    let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
+    Material {
+        name: m
+            .name()
+            .map_or_else(|| format!("material {index}"), str::to_owned),
+        kind,
+        emission,
+    }
+}

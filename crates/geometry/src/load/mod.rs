@@ -1,0 +1,426 @@
+//! Scene loaders: TOML scene files (format version 1), lone OBJ/MTL files and glTF 2.0.
+//!
+//! Every loader produces a [`SceneDescription`] and goes through the same final checks
+//! ([`finish`]): all numbers finite, no negative radiance, at least one triangle or sphere,
+//! no emissive material whose triangles all have zero area, and (unless
+//! [`LoadOptions::require_emitter`] is off) at least one emitter.
+//!
+//! Decisions that the scene format leaves open:
+//! - A scene without a camera (a lone OBJ, a glTF without a perspective camera, a TOML file
+//!   without `[camera]`) gets one that frames the bounding box from +Z ([`frame_camera`]);
+//!   [`LoadNotes::camera_framed`] says so.
+//! - The film defaults to [`DEFAULT_FILM_WIDTH`] × [`DEFAULT_FILM_HEIGHT`]; a glTF camera with an
+//!   aspect ratio keeps the width and derives the height. Film sides are limited to
+//!   [`MAX_FILM_SIDE`].
+//! - Triangles with zero area are skipped and counted, never an error.
+
+mod frame;
+mod gltf;
+mod obj;
+mod polygon;
+mod toml;
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+use crate::description::{
+    Camera, Film, Light, LoadNotes, Material, RenderDefaults, SceneDescription, Sphere, Triangle,
+};
+use crate::error::LoadError;
+
+pub use frame::FRAMED_FOV_Y_DEGREES;
+pub(crate) use frame::{bounds, frame_camera};
+pub use gltf::METALLIC_THRESHOLD;
+pub use obj::DEFAULT_ALBEDO;
+
+/// Film width used when the scene file gives none.
+pub const DEFAULT_FILM_WIDTH: u32 = 512;
+/// Film height used when the scene file gives none (and no glTF camera aspect ratio).
+pub const DEFAULT_FILM_HEIGHT: u32 = 512;
+/// Largest film width or height accepted.
+pub const MAX_FILM_SIDE: u32 = 16384;
+
+/// Options of [`load_with`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct LoadOptions {
+    /// Fail with [`LoadError::NoEmitter`] when nothing emits light (the default, and what
+    /// [`load`] does). Turn it off to inspect a scene (`fppm info`) or to load a bare mesh.
+    pub require_emitter: bool,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        Self {
+            require_emitter: true,
+        }
+    }
+}
+
+impl LoadOptions {
+    /// Options that accept a scene without any emitter.
+    #[must_use]
+    pub fn allow_no_emitter() -> Self {
+        Self {
+            require_emitter: false,
+        }
+    }
+}
+
+/// Loads a scene file, choosing the loader by extension: `.toml`, `.obj`, `.gltf` or `.glb`
+/// (case-insensitive). The scene must contain an emitter.
+///
+/// # Errors
+/// Any [`LoadError`]: unreadable file, unknown extension, malformed or out-of-range content,
+/// empty scene, or no emitter.
+pub fn load(path: &Path) -> Result<SceneDescription, LoadError> {
+    load_with(path, &LoadOptions::default())
+}
+
+/// Loads a scene file like [`load`], with options.
+///
+/// # Errors
+/// As [`load`]; [`LoadError::NoEmitter`] only if `options.require_emitter` is set.
+pub fn load_with(path: &Path, options: &LoadOptions) -> Result<SceneDescription, LoadError> {
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match extension.as_str() {
+        "toml" => {
+            let text = read_text(path)?;
+            toml::load_toml(&text, path, options)
+        }
+        "obj" => {
+            let mesh = obj::load_obj(path)?;
+            mesh.into_scene(path, options)
+        }
+        "gltf" | "glb" => {
+            let mesh = gltf::load_gltf(path)?;
+            mesh.into_scene(path, options)
+        }
+        _ => Err(LoadError::UnsupportedExtension {
+            path: path.to_path_buf(),
+            extension,
+        }),
+    }
+}
+
+/// Parses a TOML scene held in memory, as if it had been read from `source`: paths inside
+/// resolve relative to `source`'s parent directory, and errors name `source`. The scene must
+/// contain an emitter.
+///
+/// # Errors
+/// As [`load`] for a `.toml` file (there is no IO error for the text itself).
+pub fn load_toml_str(text: &str, source: &Path) -> Result<SceneDescription, LoadError> {
+    toml::load_toml(text, source, &LoadOptions::default())
+}
+
+/// [`load_toml_str`] with options.
+///
+/// # Errors
+/// As [`load_toml_str`]; [`LoadError::NoEmitter`] only if `options.require_emitter` is set.
+pub fn load_toml_str_with(
+    text: &str,
+    source: &Path,
+    options: &LoadOptions,
+) -> Result<SceneDescription, LoadError> {
+    toml::load_toml(text, source, options)
+}
+
+/// Reads a whole file as UTF-8 text.
+pub(crate) fn read_text(path: &Path) -> Result<String, LoadError> {
+    let bytes = read_bytes(path)?;
+    String::from_utf8(bytes).map_err(|_| LoadError::NotUtf8 {
+        path: path.to_path_buf(),
+    })
+}
+
+/// Reads a whole file.
+pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, LoadError> {
+    std::fs::read(path).map_err(|source| LoadError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Geometry and materials read from one mesh file (OBJ or glTF), in the file's own space
+/// (glTF node transforms already applied). Triangle material indices are local.
+#[derive(Debug, Default)]
+pub(crate) struct MeshData {
+    pub(crate) materials: Vec<Material>,
+    pub(crate) triangles: Vec<Triangle>,
+    /// Local material indices that had at least one degenerate triangle.
+    pub(crate) degenerate_materials: HashSet<u32>,
+    pub(crate) degenerate_triangles: usize,
+    pub(crate) warnings: Vec<String>,
+    /// A camera from the file (glTF), with the aspect ratio (width / height) if it gives one.
+    pub(crate) camera: Option<(Camera, Option<f32>)>,
+    /// Delta lights from the file (glTF `KHR_lights_punctual`).
+    pub(crate) lights: Vec<Light>,
+}
+
+impl MeshData {
+    /// Adds a triangle unless it is degenerate (zero area), which is counted instead.
+    pub(crate) fn push_triangle(
+        &mut self,
+        positions: [Vec3; 3],
+        normals: Option<[Vec3; 3]>,
+        material: u32,
+    ) {
+        if is_degenerate(positions) {
+            self.degenerate_triangles += 1;
+            self.degenerate_materials.insert(material);
+            return;
+        }
+        self.triangles.push(Triangle {
+            positions,
+            normals: normals.and_then(clean_normals),
+            material,
+        });
+    }
+
+    /// Turns a lone mesh file into a whole scene: its camera or a framed one, default film.
+    fn into_scene(self, path: &Path, options: &LoadOptions) -> Result<SceneDescription, LoadError> {
+        let (camera, film) = match self.camera {
+            Some((camera, aspect)) => (Some(camera), film_for_aspect(aspect)),
+            None => (None, default_film()),
+        };
+        let parts = SceneParts {
+            camera,
+            film,
+            materials: self.materials,
+            triangles: self.triangles,
+            spheres: Vec::new(),
+            lights: self.lights,
+            render: RenderDefaults::default(),
+            notes: LoadNotes {
+                degenerate_triangles: self.degenerate_triangles,
+                camera_framed: false,
+                warnings: self.warnings,
+            },
+            degenerate_materials: self.degenerate_materials,
+        };
+        finish(path, parts, options)
+    }
+}
+
+/// Default film.
+pub(crate) fn default_film() -> Film {
+    Film {
+        width: DEFAULT_FILM_WIDTH,
+        height: DEFAULT_FILM_HEIGHT,
+    }
+}
+
+/// Film of the default width whose height follows an aspect ratio (width / height).
+fn film_for_aspect(aspect: Option<f32>) -> Film {
+    match aspect {
+        Some(a) if a.is_finite() && a > 0.0 => {
+            let height = (DEFAULT_FILM_WIDTH as f32 / a).round();
+            Film {
+                width: DEFAULT_FILM_WIDTH,
+                height: height.clamp(1.0, MAX_FILM_SIDE as f32) as u32,
+            }
+        }
+        _ => default_film(),
+    }
+}
+
+/// Whether a triangle has (numerically) zero area: collinear or coincident vertices.
+pub(crate) fn is_degenerate(p: [Vec3; 3]) -> bool {
+    let e1 = p[1] - p[0];
+    let e2 = p[2] - p[0];
+    let cross = e1.cross(e2).length();
+    let scale = e1.length_squared().max(e2.length_squared());
+    !(cross.is_finite() && cross > 0.0 && cross > 1e-12 * scale)
+}
+
+/// Normalises shading normals; drops them if any is zero or not finite.
+fn clean_normals(normals: [Vec3; 3]) -> Option<[Vec3; 3]> {
+    let mut out = [Vec3::ZERO; 3];
+    for (o, n) in out.iter_mut().zip(normals) {
+        *o = n.try_normalize()?;
+    }
+    Some(out)
+}
+
+/// Everything a loader gathered, before the final checks.
+pub(crate) struct SceneParts {
+    pub(crate) camera: Option<Camera>,
+    pub(crate) film: Film,
+    pub(crate) materials: Vec<Material>,
+    pub(crate) triangles: Vec<Triangle>,
+    pub(crate) spheres: Vec<Sphere>,
+    pub(crate) lights: Vec<Light>,
+    pub(crate) render: RenderDefaults,
+    pub(crate) notes: LoadNotes,
+    /// Material indices that lost at least one triangle as degenerate.
+    pub(crate) degenerate_materials: HashSet<u32>,
+}
+
+/// The checks every loader ends with, and the camera framing.
+pub(crate) fn finish(
+    path: &Path,
+    parts: SceneParts,
+    options: &LoadOptions,
+) -> Result<SceneDescription, LoadError> {
+    let SceneParts {
+        camera,
+        film,
+        materials,
+        triangles,
+        spheres,
+        lights,
+        render,
+        mut notes,
+        degenerate_materials,
+    } = parts;
+    for material in &materials {
+        check_material(path, material)?;
+    }
+    for light in &lights {
+        check_light(path, light)?;
+    }
+    if triangles.is_empty() && spheres.is_empty() {
+        return Err(LoadError::EmptyScene {
+            path: path.to_path_buf(),
+        });
+    }
+    let mut used = vec![false; materials.len()];
+    for m in triangles
+        .iter()
+        .map(|t| t.material)
+        .chain(spheres.iter().map(|s| s.material))
+    {
+        if let Some(u) = used.get_mut(m as usize) {
+            *u = true;
+        }
+    }
+    let is_emissive = |m: &Material| m.emission.max_element() > 0.0;
+    let mut sorted_degenerate: Vec<u32> = degenerate_materials.into_iter().collect();
+    sorted_degenerate.sort_unstable();
+    for m in sorted_degenerate {
+        if let Some(material) = materials.get(m as usize)
+            && is_emissive(material)
+            && !used[m as usize]
+        {
+            return Err(LoadError::ZeroAreaEmitter {
+                path: path.to_path_buf(),
+                material: material.name.clone(),
+            });
+        }
+    }
+    let has_area_emitter = materials
+        .iter()
+        .zip(&used)
+        .any(|(m, &u)| u && is_emissive(m));
+    let has_delta_emitter = lights.iter().any(|l| light_power(l).max_element() > 0.0);
+    if options.require_emitter && !has_area_emitter && !has_delta_emitter {
+        return Err(LoadError::NoEmitter {
+            path: path.to_path_buf(),
+        });
+    }
+    let camera = match camera {
+        Some(c) => c,
+        None => {
+            notes.camera_framed = true;
+            let aspect = film.width as f32 / film.height as f32;
+            frame_camera(&triangles, &spheres, aspect)
+        }
+    };
+    Ok(SceneDescription {
+        source: PathBuf::from(path),
+        camera,
+        film,
+        materials,
+        triangles,
+        spheres,
+        lights,
+        render,
+        notes,
+    })
+}
+
+/// The colour that says how strong a light is (intensity or irradiance).
+pub(crate) fn light_power(light: &Light) -> Vec3 {
+    match *light {
+        Light::Point { intensity, .. } | Light::Spot { intensity, .. } => intensity,
+        Light::Directional { irradiance, .. } => irradiance,
+    }
+}
+
+/// Checks a colour: finite and non-negative.
+pub(crate) fn check_colour(path: &Path, key: &str, c: Vec3) -> Result<(), LoadError> {
+    if !c.is_finite() {
+        return Err(LoadError::InvalidValue {
+            path: path.to_path_buf(),
+            key: key.to_owned(),
+            message: format!("must be finite, got {}", fmt_vec(c)),
+        });
+    }
+    if c.min_element() < 0.0 {
+        return Err(LoadError::InvalidValue {
+            path: path.to_path_buf(),
+            key: key.to_owned(),
+            message: format!("must not be negative, got {}", fmt_vec(c)),
+        });
+    }
+    Ok(())
+}
+
+/// Formats a vector as `[x, y, z]`.
+pub(crate) fn fmt_vec(v: Vec3) -> String {
+    format!("[{}, {}, {}]", v.x, v.y, v.z)
+}
+
+fn check_material(path: &Path, m: &Material) -> Result<(), LoadError> {
+    use crate::description::MaterialKind;
+    let key = |what: &str| format!("material {:?} {what}", m.name);
+    check_colour(path, &key("emission"), m.emission)?;
+    match m.kind {
+        MaterialKind::Diffuse { albedo } => check_colour(path, &key("albedo"), albedo),
+        MaterialKind::Mirror { reflectance } => {
+            check_colour(path, &key("reflectance"), reflectance)
+        }
+        MaterialKind::Dielectric { ior } => {
+            if ior.is_finite() && ior > 0.0 {
+                Ok(())
+            } else {
+                Err(LoadError::InvalidValue {
+                    path: path.to_path_buf(),
+                    key: key("ior"),
+                    message: format!("must be finite and > 0, got {ior}"),
+                })
+            }
+        }
+        MaterialKind::Glossy {
+            reflectance,
+            roughness,
+            diffuse,
+        } => {
+            check_colour(path, &key("reflectance"), reflectance)?;
+            check_colour(path, &key("diffuse"), diffuse)?;
+            if roughness.is_finite() && roughness > 0.0 {
+                Ok(())
+            } else {
+                Err(LoadError::InvalidValue {
+                    path: path.to_path_buf(),
+                    key: key("roughness"),
+                    message: format!("must be finite and > 0, got {roughness}"),
+                })
+            }
+        }
+    }
+}
+
+fn check_light(path: &Path, light: &Light) -> Result<(), LoadError> {
+    let name = match light {
+        Light::Point { .. } => "point light intensity",
+        Light::Spot { .. } => "spot light intensity",
+        Light::Directional { .. } => "directional light irradiance",
+    };
+    check_colour(path, name, light_power(light))
+}

@@ -1,0 +1,1 @@
+//! OBJ specifics: polygon triangulation, normals, MTL mapping.

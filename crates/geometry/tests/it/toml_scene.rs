@@ -1,0 +1,1 @@
+//! A TOML scene using every table and key of the format.
