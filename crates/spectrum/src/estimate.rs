@@ -48,8 +48,10 @@ impl FrequencyEstimate {
     ///
     /// Deposit the field the hitpoint will use for its radius: the photon's spectrum in
     /// the surface frame, reflected toward the camera (for a Lambertian hitpoint that is
-    /// b = b_max and the angular radius is +∞). The Lambertian flag of the merge is set
-    /// only when every deposit had it. Values are assumed to share one set of caps.
+    /// b = b_max and the angular radius is +∞). The Lambertian flag (b = +∞) merges like
+    /// b: under [`MergePolicy::MinRadius`] it survives only if every deposit had it, under
+    /// [`MergePolicy::PosterMax`] one flagged deposit sets it (and c = 0). Values are
+    /// assumed to share one set of caps.
     pub fn deposit(&mut self, spectrum: Spectrum, policy: MergePolicy) {
         let incoming = match policy {
             MergePolicy::MinRadius => spectrum.without_correlation(),

@@ -399,14 +399,15 @@ impl Spectrum {
         }
     }
 
-    /// Per-coefficient max of (a, b, c); Lambertian only if both are. Stays PSD:
-    /// |max c| ≤ √(max a · max b).
+    /// Per-coefficient max of (a, b, c); Lambertian (b = +∞, hence c = 0) if either is.
+    /// Stays PSD: |max c| ≤ √(max a · max b).
     pub(crate) fn merge_max(self, other: Self) -> Self {
+        let lambertian = self.lambertian || other.lambertian;
         Spectrum {
             a: self.a.max(other.a),
             b: self.b.max(other.b),
-            c: self.c.max(other.c),
-            lambertian: self.lambertian && other.lambertian,
+            c: if lambertian { 0.0 } else { self.c.max(other.c) },
+            lambertian,
         }
     }
 
