@@ -84,7 +84,10 @@ fn assert_radii(q: &Spectrum, z: f64) {
         let r = q.radius(z, k);
         assert!(r.is_finite() && r >= 0.0, "r = {r} for {q:?}");
         let r_cam = q.camera_line_radius(z, 0.5, k);
-        assert!(r_cam.is_finite() && r_cam >= 0.0, "r_cam = {r_cam} for {q:?}");
+        assert!(
+            r_cam.is_finite() && r_cam >= 0.0,
+            "r_cam = {r_cam} for {q:?}"
+        );
     }
 }
 

@@ -51,13 +51,22 @@ fn lambertian_hitpoints_are_limited_by_space_only() {
     let caps = Caps::for_scene_size(1.0);
     let mut estimate = FrequencyEstimate::default();
     for a in [0.3, 0.01, 2.0] {
-        let q = Spectrum::new(a, 1.0, 0.05, &caps).unwrap().bandlimit(Lobe::Lambert, &caps);
+        let q = Spectrum::new(a, 1.0, 0.05, &caps)
+            .unwrap()
+            .bandlimit(Lobe::Lambert, &caps);
         estimate.deposit(q, MergePolicy::MinRadius);
     }
     assert!(estimate.spectrum().unwrap().is_lambertian());
-    assert_close!(estimate.radius(5.0, K_STRICT).unwrap(), K_STRICT * 0.1, 1e-15);
+    assert_close!(
+        estimate.radius(5.0, K_STRICT).unwrap(),
+        K_STRICT * 0.1,
+        1e-15
+    );
     // One glossy deposit clears the flag.
-    estimate.deposit(Spectrum::new(1.0, 1.0, 0.0, &caps).unwrap(), MergePolicy::MinRadius);
+    estimate.deposit(
+        Spectrum::new(1.0, 1.0, 0.0, &caps).unwrap(),
+        MergePolicy::MinRadius,
+    );
     assert!(!estimate.spectrum().unwrap().is_lambertian());
 }
 
@@ -67,7 +76,11 @@ fn deposits() -> impl Strategy<Value = Vec<Spectrum>> {
         move |(la, lb, u, lambert)| {
             let (a, b) = (10f64.powf(la), 10f64.powf(lb));
             let q = Spectrum::new(a, b, u * (a * b).sqrt(), &caps).unwrap();
-            if lambert { q.bandlimit(Lobe::Lambert, &caps) } else { q }
+            if lambert {
+                q.bandlimit(Lobe::Lambert, &caps)
+            } else {
+                q
+            }
         },
     );
     prop::collection::vec(one, 1..8)

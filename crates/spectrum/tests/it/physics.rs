@@ -79,7 +79,9 @@ fn flipping_the_angle_alone_breaks_the_virtual_image() {
     let caps = Caps::for_scene_size(100.0);
     let light = Spectrum::point_light(&caps).travel(1.0, &caps);
     let wrong = light.flip(&caps).travel(2.0, &caps);
-    let right = light.reflect(0.7, 0.7, 0.0, Lobe::Mirror, &caps).travel(2.0, &caps);
+    let right = light
+        .reflect(0.7, 0.7, 0.0, Lobe::Mirror, &caps)
+        .travel(2.0, &caps);
     let direct = Spectrum::point_light(&caps).travel(3.0, &caps);
     assert_abc!(right, (direct.a(), direct.b(), direct.c()));
     assert!((wrong.a() - direct.a()).abs() > 0.1 * direct.a());
@@ -104,7 +106,11 @@ fn lens_focuses_a_point_light_on_its_image() {
     let d2 = 1.0 / (1.0 / f - 1.0 / d1);
     assert_close!(focus, d2, 1e-6);
     // The image a cancels from intermediates ≈ d1²·b = 0.15 down to 4·10⁻¹¹ (a 4·10⁹ loss).
-    assert_close!(at_lens.travel(d2, &caps).a(), (d2 / d1).powi(2) * source.a(), 2e-6);
+    assert_close!(
+        at_lens.travel(d2, &caps).a(),
+        (d2 / d1).powi(2) * source.a(),
+        2e-6
+    );
 }
 
 proptest! {
