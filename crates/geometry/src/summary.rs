@@ -60,12 +60,16 @@ pub struct MaterialSummary {
     /// `diffuse`, `mirror`, `dielectric` or `glossy`.
     pub kind: &'static str,
     /// Albedo, reflectance, … (whatever the kind has).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub albedo: Option<Rgb6>,
     /// Mirror or glossy reflectance.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub reflectance: Option<Rgb6>,
     /// Dielectric index of refraction.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub ior: Option<F6>,
     /// Glossy GGX α.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub roughness: Option<F6>,
     /// Emitted radiance (zero if none).
     pub emission: Rgb6,

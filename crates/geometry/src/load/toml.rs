@@ -724,16 +724,29 @@ fn find_key(text: &str, offset: usize, key: &str) -> Option<(u32, u32)> {
 /// For `invalid type: string "white", …`, the key in the table holding `offset` whose value
 /// is written `"white"` (serde does not name the key; this finds it for plain values).
 fn find_key_by_value(text: &str, offset: usize, message: &str) -> Option<(String, u32, u32)> {
-    let rest = message.strip_prefix("invalid type: ")?;
-    let literal = if let Some(r) = rest.strip_prefix("string ") {
-        r.split(", expected").next()?.to_owned()
+    let matches: Box<dyn Fn(&str) -> bool> = if let Some(rest) =
+        message.strip_prefix("invalid length ")
+    {
+        // `invalid length 2, expected an array of length 3`: an array of 2 elements.
+        let n: usize = rest.split(',').next()?.trim().parse().ok()?;
+        Box::new(move |v: &str| {
+            v.strip_prefix('[')
+                .and_then(|v| v.strip_suffix(']'))
+                .is_some_and(|inner| inner.split(',').filter(|e| !e.trim().is_empty()).count() == n)
+        })
     } else {
-        let (_, r) = rest.split_once('`')?;
-        r.split('`').next()?.to_owned()
+        let rest = message.strip_prefix("invalid type: ")?;
+        let literal = if let Some(r) = rest.strip_prefix("string ") {
+            r.split(", expected").next()?.to_owned()
+        } else {
+            let (_, r) = rest.split_once('`')?;
+            r.split('`').next()?.to_owned()
+        };
+        Box::new(move |v: &str| v == literal)
     };
     section(text, offset).into_iter().find_map(|(i, l)| {
         let (k, v) = l.split_once('=')?;
-        (uncomment(v) == literal).then(|| {
+        matches(uncomment(v)).then(|| {
             (
                 k.trim().to_owned(),
                 to_u32(i + 1),
@@ -763,13 +776,21 @@ fn schema_error(path: &Path, text: &str, e: &::toml::de::Error) -> LoadError {
             Some((l, c)) => (Some(l), Some(c)),
             None => (line, column),
         };
+        let mut expected = expected_list(rest);
+        // Serde leaves the tag out of a tagged table's list.
+        let tagged = ["[materials.", "[[shapes]]", "[[lights]]"]
+            .iter()
+            .any(|t| table.starts_with(t));
+        if tagged && !expected.split(", ").any(|k| k == "type") {
+            expected = format!("type, {expected}");
+        }
         return LoadError::UnknownKey {
             path,
             line,
             column,
             table,
             key: key.to_owned(),
-            expected: expected_list(rest),
+            expected,
         };
     }
     if let Some(rest) = message.strip_prefix("missing field `")

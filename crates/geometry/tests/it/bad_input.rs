@@ -514,3 +514,44 @@ fn mesh_file_errors_name_the_mesh_file() {
     assert!(matches!(err, LoadError::NonFiniteVertex { .. }), "{err:?}");
     assert_names_file(&err, &dir.join("nan.obj"));
 }
+
+/// The messages users see, one line each, file first.
+#[test]
+fn messages_read_well() {
+    let edits = [
+        ("fov_y = 39.3", "fov_y = = 39.3"),
+        ("albedo = [0.8, 0.8, 0.8]", "colour = [0.8, 0.8, 0.8]"),
+        ("albedo = [0.8, 0.8, 0.8]", "albedo = \"white\""),
+        ("albedo = [0.8, 0.8, 0.8]", "albedo = [0.8, 0.8]"),
+        ("fov_y = 39.3\n", ""),
+        ("type = \"diffuse\"", "type = \"velvet\""),
+        ("material = \"white\"", "material = \"chalk\""),
+        ("format = 1", "format = 2"),
+        ("fov_y = 39.3", "fov_y = 180"),
+        ("radius = 1.0", "radius = 0"),
+        (
+            "emission = [17.0, 12.0, 4.0]",
+            "emission = [17.0, -1.0, 4.0]",
+        ),
+        ("emission = [17.0, 12.0, 4.0]", "emission = [0.0, 0.0, 0.0]"),
+        ("edge2 = [0.0, 0.0, 0.4]", "edge2 = [1.0, 0.0, 0.0]"),
+        ("fov_y = 39.3", "fov_y = 39.3\nfocal = 1"),
+    ];
+    let mut lines: Vec<String> = edits
+        .iter()
+        .map(|(from, to)| load_edited(from, to).0.unwrap_err().to_string())
+        .collect();
+    let dir = crate::temp_dir("messages");
+    let files = [
+        ("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"),
+        ("nan.obj", "v 0 0 0\nv nan 0 0\n"),
+        ("bad.gltf", "{ \"asset\": 1 }"),
+        ("scene.ply", ""),
+    ];
+    for (name, text) in files {
+        std::fs::write(dir.join(name), text).unwrap();
+        let err = load(&dir.join(name)).unwrap_err();
+        lines.push(err.to_string().replace(&dir.display().to_string(), "<dir>"));
+    }
+    insta::assert_snapshot!(lines.join("\n"));
+}
