@@ -9,7 +9,8 @@
 //!   Emission = emissive factor × emissive strength. A primitive without a material gets
 //!   the glTF default material (white, metallic 1, roughness 1, so glossy with α = 1);
 //! - the camera is the perspective camera with the lowest index that a node of the scene
-//!   uses (its first such node); it looks down the node's −Z with the node's +Y up;
+//!   uses (its first such node); it looks down the node's −Z with the node's +Y up; its
+//!   focus distance is the depth of the scene's bounding-box centre (1 if that is behind it);
 //! - `KHR_lights_punctual` intensities are taken as radiometric (cd → W/sr, lux → W/m²) and
 //!   multiplied by the colour; spot outer cone → `cone_angle`, inner → `falloff_start`;
 //! - triangle strips and fans are converted to triangles; points and lines are skipped with
@@ -104,7 +105,17 @@ pub(crate) fn load_gltf(path: &Path) -> Result<MeshData, LoadError> {
             walker.skipped_primitives
         ));
     }
-    data.camera = walker.camera.map(|(_, camera, aspect)| (camera, aspect));
+    data.camera = walker.camera.map(|(_, mut camera, aspect)| {
+        // Focus on the scene's centre (depth along the view), for a later thin lens.
+        if let Some((lo, hi)) = super::bounds(&data.triangles, &[]) {
+            let forward = camera.look_at - camera.position;
+            let depth = (0.5 * (lo + hi) - camera.position).dot(forward);
+            if depth.is_finite() && depth > 0.0 {
+                camera.focus_distance = depth;
+            }
+        }
+        (camera, aspect)
+    });
     Ok(data)
 }
 

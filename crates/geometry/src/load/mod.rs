@@ -42,9 +42,9 @@ pub const DEFAULT_FILM_HEIGHT: u32 = 512;
 /// Largest film width or height accepted.
 pub const MAX_FILM_SIDE: u32 = 16384;
 
-/// Options of [`load_with`].
+/// Options of [`load_with`]. Build them with `LoadOptions { require_emitter: false,
+/// ..Default::default() }` or [`LoadOptions::allow_no_emitter`].
 #[derive(Clone, Debug, PartialEq, Eq)]
-#[non_exhaustive]
 pub struct LoadOptions {
     /// Fail with [`LoadError::NoEmitter`] when nothing emits light (the default, and what
     /// [`load`] does). Turn it off to inspect a scene (`fppm info`) or to load a bare mesh.

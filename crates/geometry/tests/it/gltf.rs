@@ -1,0 +1,151 @@
+//! A hand-written glTF: node hierarchy, negative scale, camera, spot light, a skipped
+//! line primitive, emissive strength.
+
+use geometry::{Light, LoadError, load};
+use glam::Vec3;
+
+fn assert_close(a: Vec3, b: Vec3) {
+    assert!((a - b).length() < 1e-5, "{a} != {b}");
+}
+
+const GLTF: &str = r#"{
+  "asset": { "version": "2.0" },
+  "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength"],
+  "extensions": { "KHR_lights_punctual": { "lights": [
+    { "type": "spot", "color": [1.0, 0.5, 0.25], "intensity": 3.0,
+      "spot": { "innerConeAngle": 0.2, "outerConeAngle": 0.4 } } ] } },
+  "scene": 0,
+  "scenes": [ { "nodes": [0] } ],
+  "nodes": [
+    { "translation": [0, 0, -5], "children": [1, 2, 3, 4, 5] },
+    { "mesh": 0, "rotation": [0, 0, 0.70710678, 0.70710678] },
+    { "mesh": 0, "scale": [-1, 1, 1] },
+    { "camera": 0, "translation": [0, 0, 10] },
+    { "rotation": [0.70710678, 0, 0, 0.70710678],
+      "extensions": { "KHR_lights_punctual": { "light": 0 } } },
+    { "mesh": 1 }
+  ],
+  "cameras": [ { "type": "perspective",
+                 "perspective": { "yfov": 0.5, "aspectRatio": 2.0, "znear": 0.1 } } ],
+  "materials": [ { "name": "glow", "emissiveFactor": [1, 1, 1],
+                   "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 2 } },
+                   "pbrMetallicRoughness": { "baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0 } } ],
+  "meshes": [
+    { "primitives": [ { "attributes": { "POSITION": 0 }, "material": 0 } ] },
+    { "primitives": [ { "attributes": { "POSITION": 0 }, "mode": 1 } ] }
+  ],
+  "accessors": [ { "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                   "min": [0, 0, 0], "max": [1, 1, 0] } ],
+  "bufferViews": [ { "buffer": 0, "byteLength": 36 } ],
+  "buffers": [ { "uri": "tri.bin", "byteLength": 36 } ]
+}"#;
+
+fn write(test: &str, gltf: &str) -> std::path::PathBuf {
+    let dir = crate::temp_dir(test);
+    let floats: [f32; 9] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let bytes: Vec<u8> = floats.iter().flat_map(|f| f.to_le_bytes()).collect();
+    std::fs::write(dir.join("tri.bin"), bytes).unwrap();
+    let path = dir.join("scene.gltf");
+    std::fs::write(&path, gltf).unwrap();
+    path
+}
+
+#[test]
+fn hierarchy_camera_light_and_materials() {
+    let scene = load(&write("gltf_hierarchy", GLTF)).unwrap();
+
+    // Node 1: rotated 90° about z, then moved by the parent to z = −5.
+    assert_eq!(scene.triangles.len(), 2);
+    let [a, b, c] = scene.triangles[0].positions;
+    assert_close(a, Vec3::new(0.0, 0.0, -5.0));
+    assert_close(b, Vec3::new(0.0, 1.0, -5.0));
+    assert_close(c, Vec3::new(-1.0, 0.0, -5.0));
+    // Node 2: mirrored in x; the winding is swapped so the front still faces +z.
+    for t in &scene.triangles {
+        let [a, b, c] = t.positions;
+        assert!((b - a).cross(c - a).z > 0.0, "{t:?}");
+    }
+
+    // Emission = factor × strength; metallic 0 → diffuse base colour.
+    let glow = &scene.materials[0];
+    assert_eq!(glow.emission, Vec3::splat(2.0));
+    assert_eq!(
+        glow.kind,
+        geometry::MaterialKind::Diffuse {
+            albedo: Vec3::splat(0.5)
+        }
+    );
+
+    // Camera: world position (0, 0, 5), looking down −z; film from the aspect ratio.
+    assert_close(scene.camera.position, Vec3::new(0.0, 0.0, 5.0));
+    assert_close(
+        (scene.camera.look_at - scene.camera.position).normalize(),
+        Vec3::NEG_Z,
+    );
+    assert_close(scene.camera.up, Vec3::Y);
+    assert_eq!(scene.camera.fov_y, 0.5);
+    assert_eq!((scene.film.width, scene.film.height), (512, 256));
+    assert!(!scene.notes.camera_framed);
+
+    // Spot light: node −z rotated 90° about x points along +y; colour × intensity.
+    let [
+        Light::Spot {
+            position,
+            direction,
+            intensity,
+            cone_angle,
+            falloff_start,
+        },
+    ] = scene.lights[..]
+    else {
+        panic!("{:?}", scene.lights)
+    };
+    assert_close(position, Vec3::new(0.0, 0.0, -5.0));
+    assert_close(direction, Vec3::Y);
+    assert_close(intensity, Vec3::new(3.0, 1.5, 0.75));
+    assert_eq!((cone_angle, falloff_start), (0.4, 0.2));
+
+    // The line primitive is skipped with a warning.
+    assert!(
+        scene.notes.warnings.iter().any(|w| w.contains("skipped")),
+        "{:?}",
+        scene.notes.warnings
+    );
+}
+
+#[test]
+fn missing_buffer_is_a_gltf_error() {
+    let path = write("gltf_missing_buffer", &GLTF.replace("tri.bin", "gone.bin"));
+    let err = load(&path).unwrap_err();
+    assert!(matches!(err, LoadError::Gltf { .. }), "{err:?}");
+    crate::assert_names_file(&err, &path);
+}
+
+#[test]
+fn nan_position_in_gltf() {
+    let dir = crate::temp_dir("gltf_nan");
+    let floats: [f32; 9] = [0.0, 0.0, 0.0, f32::NAN, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let bytes: Vec<u8> = floats.iter().flat_map(|f| f.to_le_bytes()).collect();
+    std::fs::write(dir.join("tri.bin"), bytes).unwrap();
+    let path = dir.join("scene.gltf");
+    std::fs::write(&path, GLTF).unwrap();
+    let err = load(&path).unwrap_err();
+    assert!(
+        matches!(err, LoadError::NonFiniteVertex { what: "nan", .. }),
+        "{err:?}"
+    );
+    crate::assert_names_file(&err, &path);
+}
+
+#[test]
+fn unsupported_required_extension() {
+    let gltf = GLTF.replacen(
+        "\"extensionsUsed\"",
+        "\"extensionsRequired\": [\"KHR_mesh_quantization\"], \"extensionsUsed\"",
+        1,
+    );
+    let path = write("gltf_required_extension", &gltf);
+    let err = load(&path).unwrap_err();
+    assert!(matches!(err, LoadError::Gltf { .. }), "{err:?}");
+    crate::assert_names_file(&err, &path);
+}
