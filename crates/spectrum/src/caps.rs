@@ -17,7 +17,7 @@ const CAP_LIMIT: f64 = 1e150;
 
 /// Bounds applied to (a, b, c) after every operator.
 ///
-/// `a ∈ [a_min, a_max]` [m²], `b ∈ [b_min, b_max]` [rad²], then `c² ≤ a·b·(1 − 10⁻¹²)`.
+/// `a ∈ [a_min, a_max]` \[m²\], `b ∈ [b_min, b_max]` \[rad²\], then `c² ≤ a·b·(1 − 10⁻¹²)`.
 /// A capped value stands for the physical limit: `a = a_max` is "spatially constant over
 /// the scene", `b = b_max` is "angularly constant over the analysis window", `a_min` and
 /// `b_min` are the finest spatial and angular detail the renderer resolves.
@@ -56,8 +56,8 @@ impl Caps {
         })
     }
 
-    /// Caps from primal scales: the largest and smallest spatial extents [m] and the
-    /// largest and smallest angular extents [rad], each mapped through `2π²·s²`.
+    /// Caps from primal scales: the largest and smallest spatial extents \[m\] and the
+    /// largest and smallest angular extents \[rad\], each mapped through `2π²·s²`.
     ///
     /// `None` when the scales are not ordered non-negative numbers or exceed the limit.
     #[must_use]
@@ -74,7 +74,7 @@ impl Caps {
         Caps::new(sq(min_extent), sq(max_extent), sq(min_angle), sq(max_angle))
     }
 
-    /// The suggested caps for a scene of length scale `scene_size` = L [m]:
+    /// The suggested caps for a scene of length scale `scene_size` = L \[m\]:
     /// spatial window L and resolution ε_x = 10⁻⁴·L, angular window W_θ = 1 rad and
     /// resolution ε_θ = 10⁻⁴ rad, i.e.
     ///
@@ -97,25 +97,25 @@ impl Caps {
         }
     }
 
-    /// Lower bound of a [m²]: the finest spatial detail.
+    /// Lower bound of a \[m²\]: the finest spatial detail.
     #[must_use]
     pub fn a_min(&self) -> f64 {
         self.a_min
     }
 
-    /// Upper bound of a [m²]: "spatially constant".
+    /// Upper bound of a \[m²\]: "spatially constant".
     #[must_use]
     pub fn a_max(&self) -> f64 {
         self.a_max
     }
 
-    /// Lower bound of b [rad²]: the finest angular detail ("collimated").
+    /// Lower bound of b \[rad²\]: the finest angular detail ("collimated").
     #[must_use]
     pub fn b_min(&self) -> f64 {
         self.b_min
     }
 
-    /// Upper bound of b [rad²]: "angularly constant" (Lambertian).
+    /// Upper bound of b \[rad²\]: "angularly constant" (Lambertian).
     #[must_use]
     pub fn b_max(&self) -> f64 {
         self.b_max

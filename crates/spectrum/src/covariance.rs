@@ -6,7 +6,7 @@ use crate::caps::{clamp_eta, clamp_mu, harmonic};
 use crate::lobe::Lobe;
 
 /// The spectral covariance Σ = (2Q)⁻¹ = [[p, q], [q, r]] of the local spectrum viewed as a
-/// density over (Ωx [cycles/m], Ωθ [cycles/rad]): p [m⁻²], q [m⁻¹rad⁻¹], r [rad⁻²].
+/// density over (Ωx \[cycles/m\], Ωθ \[cycles/rad\]): p \[m⁻²\], q \[m⁻¹rad⁻¹\], r \[rad⁻²\].
 ///
 /// Every ray map M acts as Σ' = M⁻ᵀ Σ M⁻¹; windows (occlusion, cosine) add to Σ; the BRDF
 /// is a Woodbury update. These operators mirror those of [`Spectrum`](crate::Spectrum)
@@ -34,25 +34,25 @@ impl Covariance {
         ok.then_some(Covariance { p, q, r })
     }
 
-    /// Σxx = p [m⁻²], the spatial-frequency variance.
+    /// Σxx = p \[m⁻²\], the spatial-frequency variance.
     #[must_use]
     pub fn p(&self) -> f64 {
         self.p
     }
 
-    /// Σxθ = q [m⁻¹·rad⁻¹].
+    /// Σxθ = q \[m⁻¹·rad⁻¹\].
     #[must_use]
     pub fn q(&self) -> f64 {
         self.q
     }
 
-    /// Σθθ = r [rad⁻²], the angular-frequency variance.
+    /// Σθθ = r \[rad⁻²\], the angular-frequency variance.
     #[must_use]
     pub fn r(&self) -> f64 {
         self.r
     }
 
-    /// Travel by d [m]: `p' = p`, `q' = q − d·p`, `r' = r − 2d·q + d²·p`.
+    /// Travel by d \[m\]: `p' = p`, `q' = q − d·p`, `r' = r − 2d·q + d²·p`.
     #[must_use]
     pub fn travel(self, distance: f64) -> Self {
         let d = distance;
@@ -63,7 +63,7 @@ impl Covariance {
         }
     }
 
-    /// Angular kick by g [rad/m]: `p' = p − 2g·q + g²·r`, `q' = q − g·r`, `r' = r`.
+    /// Angular kick by g \[rad/m\]: `p' = p − 2g·q + g²·r`, `q' = q − g·r`, `r' = r`.
     #[must_use]
     pub fn kick(self, g: f64) -> Self {
         Covariance {
@@ -133,7 +133,7 @@ impl Covariance {
         }
     }
 
-    /// BRDF band-limit by Woodbury (no inverse), with β = 4π²σρ² [rad²]:
+    /// BRDF band-limit by Woodbury (no inverse), with β = 4π²σρ² \[rad²\]:
     /// `p' = p − β·q²/(1 + β·r)`, `q' = q/(1 + β·r)`, `r' = r/(1 + β·r)`.
     ///
     /// [`Lobe::Lambert`] (β = ∞): `p' = p − q²/r` (p if r = 0), `q' = r' = 0`.
@@ -148,7 +148,7 @@ impl Covariance {
         Covariance { p, q, r }
     }
 
-    /// Partial occlusion with spectral variance o [m⁻²]: `p' = p + o` (negative o counts
+    /// Partial occlusion with spectral variance o \[m⁻²\]: `p' = p + o` (negative o counts
     /// as 0).
     #[must_use]
     pub fn occlude(self, o: f64) -> Self {

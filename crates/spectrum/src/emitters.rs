@@ -7,7 +7,7 @@ use crate::caps::{Caps, TWO_PI_SQ, clamp_mu};
 use crate::spectrum::Spectrum;
 
 impl Spectrum {
-    /// A Lambertian area light of size s [m] seen at cosine μe between the emitted
+    /// A Lambertian area light of size s \[m\] seen at cosine μe between the emitted
     /// direction and the emitter normal:
     ///
     /// `a = 2π²·(s²/12)·μe² = (π²/6)·s²·μe²`, `b = b_max`, `c = 0`, Lambertian.
@@ -29,7 +29,7 @@ impl Spectrum {
         Spectrum::finish(0.0, 0.0, 0.0, true, caps)
     }
 
-    /// A spot light with a hard cone of half-angle θs [rad] (a box of width 2θs):
+    /// A spot light with a hard cone of half-angle θs \[rad\] (a box of width 2θs):
     /// `a = a_min`, `b = 2π²·θs²/3`, `c = 0`.
     #[must_use]
     pub fn spot_light(half_angle: f64, caps: &Caps) -> Self {
@@ -62,7 +62,7 @@ impl Spectrum {
         Spectrum::finish(f64::INFINITY, 0.0, 0.0, false, caps)
     }
 
-    /// A sun of angular diameter δ [rad] (a disc seen as a box of width δ):
+    /// A sun of angular diameter δ \[rad\] (a disc seen as a box of width δ):
     /// `a = a_max`, `b = 2π²·δ²/12 = π²δ²/6`, `c = 0` (δ = 0.0093 gives b ≈ 1.42·10⁻⁴).
     #[must_use]
     pub fn sun(angular_diameter: f64, caps: &Caps) -> Self {

@@ -46,9 +46,10 @@ impl FrequencyEstimate {
 
     /// Merges a frequency photon's spectrum under `policy`.
     ///
-    /// Deposit the field the hitpoint will use for its radius: the photon's spectrum in
-    /// the surface frame, reflected toward the camera (for a Lambertian hitpoint that is
-    /// b = b_max and the angular radius is +∞). The Lambertian flag (b = +∞) merges like
+    /// Deposit the field the hitpoint will use for its radius: the photon's spectrum
+    /// reflected with the hitpoint's lobe and curvature, `reflect(μi, 1.0, κ, lobe)`, so
+    /// that a is in surface units (for a Lambertian hitpoint b = b_max and the angular
+    /// radius is +∞). The Lambertian flag (b = +∞) merges like
     /// b: under [`MergePolicy::MinRadius`] it survives only if every deposit had it, under
     /// [`MergePolicy::PosterMax`] one flagged deposit sets it (and c = 0). Values are
     /// assumed to share one set of caps.
@@ -66,7 +67,7 @@ impl FrequencyEstimate {
         });
     }
 
-    /// The frequency radius `r_freq = min(r_x, r_θ)` [m] of the merged spectrum (see
+    /// The frequency radius `r_freq = min(r_x, r_θ)` \[m\] of the merged spectrum (see
     /// [`Spectrum::radius`]), or `None` before the first deposit.
     #[must_use]
     pub fn radius(&self, normal_distance: f64, k: f64) -> Option<f64> {

@@ -2,7 +2,7 @@
 
 use crate::caps::TWO_PI_SQ;
 
-/// A BRDF lobe seen as a Gaussian of angular variance σρ² [rad²] about the (local) mirror
+/// A BRDF lobe seen as a Gaussian of angular variance σρ² \[rad²\] about the (local) mirror
 /// direction, in the outgoing angle.
 ///
 /// Widths come from matching the lobe's peak curvature. That sets the high-frequency
@@ -34,16 +34,16 @@ pub enum Lobe {
         /// The roughness α (dimensionless).
         roughness: f64,
     },
-    /// Any other lobe given by its angular variance σρ² [rad²] directly, e.g. rough
+    /// Any other lobe given by its angular variance σρ² \[rad²\] directly, e.g. rough
     /// dielectric transmission with σρ² = (1 − s)²σh².
     Gaussian {
-        /// σρ² [rad²].
+        /// σρ² \[rad²\].
         variance: f64,
     },
 }
 
 impl Lobe {
-    /// The lobe's angular variance σρ² [rad²]; `None` for [`Lobe::Lambert`] (infinite).
+    /// The lobe's angular variance σρ² \[rad²\]; `None` for [`Lobe::Lambert`] (infinite).
     #[must_use]
     pub fn angular_variance(&self) -> Option<f64> {
         let raw = match *self {
@@ -59,7 +59,7 @@ impl Lobe {
         Some(if raw >= 0.0 { raw } else { 0.0 })
     }
 
-    /// The lobe's quadratic-form increment `b_ρ = 2π²σρ²` [rad²], added to b by the
+    /// The lobe's quadratic-form increment `b_ρ = 2π²σρ²` \[rad²\], added to b by the
     /// band-limit; `None` for [`Lobe::Lambert`]. (Σ form: β = 4π²σρ² = 2·b_ρ.)
     #[must_use]
     pub fn bandwidth(&self) -> Option<f64> {

@@ -15,15 +15,15 @@ pub const K_POSTER: f64 = 0.711_508_625_410_642;
 /// to 95 % of its peak at x = K·√a (≈ 0.320·σx).
 pub const K_STRICT: f64 = 0.072_090_896_098_338_98;
 
-/// The spatial radius `r_x = K·√a` [m] for a spatial coefficient a [m²] and radius
+/// The spatial radius `r_x = K·√a` \[m\] for a spatial coefficient a \[m²\] and radius
 /// constant K ([`K_POSTER`] or [`K_STRICT`]). Negative a counts as 0.
 #[must_use]
 pub fn spatial_radius(a: f64, k: f64) -> f64 {
     k * a.max(0.0).sqrt()
 }
 
-/// The angular radius `r_θ = z·tan(K·√b)` [m] for an angular coefficient b [rad²], the
-/// camera distance projected on the hitpoint normal z [m] and radius constant K.
+/// The angular radius `r_θ = z·tan(K·√b)` \[m\] for an angular coefficient b \[rad²\], the
+/// camera distance projected on the hitpoint normal z \[m\] and radius constant K.
 ///
 /// It is the displacement on the surface that turns the direction to the camera by
 /// K·√b (exact at normal viewing, conservative at oblique viewing). Once K·√b ≥ π/2 the

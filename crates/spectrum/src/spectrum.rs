@@ -10,7 +10,7 @@ use crate::radius::{angular_radius, spatial_radius};
 /// The local light-field spectrum `l̂(Ωx, Ωθ) ∝ exp(−(a·Ωx² + 2c·ΩxΩθ + b·Ωθ²))`, stored
 /// as the poster's quadratic form Q = [[a, c], [c, b]] in `f64`.
 ///
-/// Units: a [m²], b [rad²], c [m·rad]. Q = 2π²·P where P is the primal covariance of the
+/// Units: a \[m²\], b \[rad²\], c \[m·rad\]. Q = 2π²·P where P is the primal covariance of the
 /// light field over (x, θ), so a larger coefficient means a *smoother* field.
 ///
 /// Invariants, kept by every constructor and operator (see [`Caps`]): a and b lie inside
@@ -27,14 +27,14 @@ pub struct Spectrum {
     lambertian: bool,
 }
 
-/// The primal covariance P = Q/(2π²) of the light field over (x [m], θ [rad]).
+/// The primal covariance P = Q/(2π²) of the light field over (x \[m\], θ \[rad\]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PrimalCovariance {
-    /// Var(x) [m²].
+    /// Var(x) \[m²\].
     pub xx: f64,
-    /// Cov(x, θ) [m·rad].
+    /// Cov(x, θ) \[m·rad\].
     pub xt: f64,
-    /// Var(θ) [rad²].
+    /// Var(θ) \[rad²\].
     pub tt: f64,
 }
 
@@ -75,19 +75,19 @@ impl Spectrum {
         Self::new(r * s, p * s, -q * s, caps)
     }
 
-    /// The spatial coefficient a [m²]: the irradiance ∫L dθ varies as exp(−π²x²/a).
+    /// The spatial coefficient a \[m²\]: the irradiance ∫L dθ varies as exp(−π²x²/a).
     #[must_use]
     pub fn a(&self) -> f64 {
         self.a
     }
 
-    /// The angular coefficient b [rad²]: ∫L dx varies as exp(−π²θ²/b).
+    /// The angular coefficient b \[rad²\]: ∫L dx varies as exp(−π²θ²/b).
     #[must_use]
     pub fn b(&self) -> f64 {
         self.b
     }
 
-    /// The cross coefficient c [m·rad] (space–angle correlation).
+    /// The cross coefficient c \[m·rad\] (space–angle correlation).
     #[must_use]
     pub fn c(&self) -> f64 {
         self.c
@@ -102,7 +102,7 @@ impl Spectrum {
         self.lambertian
     }
 
-    /// det Q = a·b − c² [m²·rad²], computed with one rounding error.
+    /// det Q = a·b − c² \[m²·rad²\], computed with one rounding error.
     #[must_use]
     pub fn determinant(&self) -> f64 {
         det2(self.a, self.b, self.c, self.c)
@@ -140,7 +140,7 @@ impl Spectrum {
     // ----------------------------------------------------------------------------------
     // Operators.
 
-    /// Travel in free space by d [m]: T(d) = [[1, d], [0, 1]] (x' = x + d·θ), Q' = T Q Tᵀ:
+    /// Travel in free space by d \[m\]: T(d) = [[1, d], [0, 1]] (x' = x + d·θ), Q' = T Q Tᵀ:
     ///
     /// `a' = a + 2d·c + d²·b`, `c' = c + d·b`, `b' = b`.
     ///
@@ -154,7 +154,7 @@ impl Spectrum {
         Self::finish(a, self.b, c, self.lambertian && d == 0.0, caps)
     }
 
-    /// Angular kick by g [rad/m]: K(g) = [[1, 0], [g, 1]] (θ' = θ + g·x), Q' = K Q Kᵀ:
+    /// Angular kick by g \[rad/m\]: K(g) = [[1, 0], [g, 1]] (θ' = θ + g·x), Q' = K Q Kᵀ:
     ///
     /// `a' = a`, `c' = c + g·a`, `b' = b + 2g·c + g²·a`.
     ///
@@ -216,7 +216,7 @@ impl Spectrum {
     /// With m = μo/μi and g = 2κ/μi:
     /// `a' = m²·a`, `c' = m·(c − g·a)`, `b' = b − 2g·c + g²·a + 2π²σρ²`.
     ///
-    /// κ [1/m] is the signed curvature in the plane of incidence, positive when the centre
+    /// κ \[1/m\] is the signed curvature in the plane of incidence, positive when the centre
     /// of curvature lies on the side the light comes from (concave, focusing). A flat
     /// mirror (κ = 0, μo = μi, [`Lobe::Mirror`]) leaves (a, b, c) unchanged; a concave
     /// mirror focuses a collimated beam at (R/2)·cos θ. For glossy lobes pass the cosine
@@ -247,7 +247,7 @@ impl Spectrum {
     }
 
     /// Refraction through a smooth interface from index ηi to ηt, at incident and
-    /// transmitted cosines μi, μt, with signed curvature κ [1/m] (as in
+    /// transmitted cosines μi, μt, with signed curvature κ \[1/m\] (as in
     /// [`Spectrum::reflect`]):
     ///
     /// R_t = [[t, 0], [h, s]] with s = ηi·μi/(ηt·μt), t = μt/μi, h = (1 − s)·κ/μi;
@@ -292,13 +292,13 @@ impl Spectrum {
         }
     }
 
-    /// Partial occlusion by a window in the current plane with spectral variance o [m⁻²]
+    /// Partial occlusion by a window in the current plane with spectral variance o \[m⁻²\]
     /// (a primal multiplication, so a spectral convolution: Σ' = Σ + diag(o, 0)). In Q
     /// form, with den = 1 + 2o·a:
     ///
     /// `a' = a/den`, `c' = c/den`, `b' = b − 2o·c²/den`.
     ///
-    /// For a Gaussian window of primal width w [m], o = 1/(4π²w²). A blocker at distance
+    /// For a Gaussian window of primal width w \[m\], o = 1/(4π²w²). A blocker at distance
     /// t inside a segment of length d is `travel(t)`, `occlude(o)`, `travel(d − t)`.
     /// Negative o counts as 0.
     #[must_use]
@@ -309,12 +309,12 @@ impl Spectrum {
     }
 
     /// The optional cosine term of covariance tracing (not in the poster): Σ' = Σ +
-    /// diag(0, w_c) with w_c = 1/max(π/2 − θi, 10⁻¹⁰)² [rad⁻²]. In Q form, with
+    /// diag(0, w_c) with w_c = 1/max(π/2 − θi, 10⁻¹⁰)² \[rad⁻²\]. In Q form, with
     /// den = 1 + 2w_c·b:
     ///
     /// `b' = b/den`, `c' = c/den`, `a' = a − 2w_c·c²/den`.
     ///
-    /// θi [rad] is the incidence angle |θi| ∈ [0, π/2].
+    /// θi \[rad\] is the incidence angle |θi| ∈ [0, π/2].
     #[must_use]
     pub fn cosine(self, theta_i: f64, caps: &Caps) -> Self {
         let gap = (FRAC_PI_2 - theta_i.abs()).max(1e-10);
@@ -326,14 +326,14 @@ impl Spectrum {
     // ----------------------------------------------------------------------------------
     // Kernel radii.
 
-    /// Spatial radius `r_x = K·√a` [m], see [`spatial_radius`](crate::spatial_radius).
+    /// Spatial radius `r_x = K·√a` \[m\], see [`spatial_radius`](crate::spatial_radius).
     #[must_use]
     pub fn spatial_radius(&self, k: f64) -> f64 {
         spatial_radius(self.a, k)
     }
 
-    /// Angular radius `r_θ = z·tan(K·√b)` [m] (+∞ once K·√b ≥ π/2, and for a Lambertian
-    /// spectrum), see [`angular_radius`](crate::angular_radius). `normal_distance` z [m]
+    /// Angular radius `r_θ = z·tan(K·√b)` \[m\] (+∞ once K·√b ≥ π/2, and for a Lambertian
+    /// spectrum), see [`angular_radius`](crate::angular_radius). `normal_distance` z \[m\]
     /// is the camera distance projected on the hitpoint normal.
     #[must_use]
     pub fn angular_radius(&self, normal_distance: f64, k: f64) -> f64 {
@@ -344,15 +344,15 @@ impl Spectrum {
         }
     }
 
-    /// The poster's kernel radius `r_freq = min(r_x, r_θ)` [m].
+    /// The poster's kernel radius `r_freq = min(r_x, r_θ)` \[m\].
     #[must_use]
     pub fn radius(&self, normal_distance: f64, k: f64) -> f64 {
         self.spatial_radius(k)
             .min(self.angular_radius(normal_distance, k))
     }
 
-    /// The field restricted to the rays that converge to a camera at distance D [m]
-    /// (θ = −x/D in this frame), as an a-like bandwidth [m²]:
+    /// The field restricted to the rays that converge to a camera at distance D \[m\]
+    /// (θ = −x/D in this frame), as an a-like bandwidth \[m²\]:
     ///
     /// `a_cam = (a·b − c²) / (b + 2c/D + a/D²)`.
     ///
@@ -372,7 +372,7 @@ impl Spectrum {
         }
     }
 
-    /// The optional camera-line radius `r_cam = K·√a_cam / μo` [m] on the surface, with
+    /// The optional camera-line radius `r_cam = K·√a_cam / μo` \[m\] on the surface, with
     /// a_cam from [`Spectrum::camera_line_bandwidth`] and μo the cosine toward the camera
     /// (clamped to [[`MU_MIN`](crate::MU_MIN), 1]). Use `min(r_x, r_θ, r_cam)` if the
     /// poster-literal radius blurs highlights.
