@@ -1,2 +1,150 @@
-//! Gather benchmark (placeholder).
-fn main() {}
+//! Hash-grid build time and gather throughput on a surface-like distribution.
+//!
+//! Setup (the obvhs `Bvh2` comparison of `crates.md`): 2²⁰ hitpoints uniform on the unit sphere
+//! with radius 0.004 (±50 % jitter for some cases) and 2²⁰ photon query points on the same
+//! sphere, ~4 hitpoints found per photon. Queries run (a) in random order and (b) Morton-sorted,
+//! on 1 and 2 threads.
+//!
+//! Run: `cargo bench -p photon --bench gather`. Divan reports items/s = queries per second.
+#![allow(clippy::unwrap_used, clippy::print_stdout, missing_docs)]
+
+use std::sync::LazyLock;
+
+use divan::{Bencher, black_box, counter::ItemsCount};
+use glam::Vec3;
+use photon::{CellSize, GridParams, HitPointGrid, morton_order};
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg32;
+use rayon::prelude::*;
+
+const N_HITPOINTS: usize = 1 << 20;
+const N_PHOTONS: usize = 1 << 20;
+const RADIUS: f64 = 0.004;
+
+fn main() {
+    let stats = HitPointGrid::build(&DATA.positions, &DATA.radii, GridParams::DEFAULT).stats();
+    let found: usize = DATA.photons.iter().map(|&p| count(&GRIDS[0], &DATA.radii, p)).sum();
+    println!(
+        "default grid: {stats:?}, {:.1} grid bytes/hitpoint, {:.2} found/photon",
+        stats.bytes as f64 / N_HITPOINTS as f64,
+        found as f64 / N_PHOTONS as f64
+    );
+    divan::main();
+}
+
+struct Data {
+    positions: Vec<Vec3>,
+    radii: Vec<f64>,
+    jittered_radii: Vec<f64>,
+    photons: Vec<Vec3>,
+    photons_sorted: Vec<Vec3>,
+}
+
+fn on_sphere(rng: &mut Pcg32) -> Vec3 {
+    let z: f32 = rng.random_range(-1.0..1.0);
+    let phi: f32 = rng.random_range(0.0..std::f32::consts::TAU);
+    let s = (1.0 - z * z).max(0.0).sqrt();
+    Vec3::new(s * phi.cos(), s * phi.sin(), z)
+}
+
+static DATA: LazyLock<Data> = LazyLock::new(|| {
+    let mut rng = Pcg32::seed_from_u64(1);
+    let positions: Vec<Vec3> = (0..N_HITPOINTS).map(|_| on_sphere(&mut rng)).collect();
+    let radii = vec![RADIUS; N_HITPOINTS];
+    let jittered_radii = (0..N_HITPOINTS).map(|_| RADIUS * rng.random_range(0.5..1.5)).collect();
+    let photons: Vec<Vec3> = (0..N_PHOTONS).map(|_| on_sphere(&mut rng)).collect();
+    let photons_sorted = morton_order(&photons).iter().map(|&i| photons[i as usize]).collect();
+    Data { positions, radii, jittered_radii, photons, photons_sorted }
+});
+
+const CONFIGS: [(&str, CellSize); 5] = [
+    ("mean x2", CellSize::MeanRadius(2.0)),
+    ("mean x1", CellSize::MeanRadius(1.0)),
+    ("mean x3", CellSize::MeanRadius(3.0)),
+    ("mean x4", CellSize::MeanRadius(4.0)),
+    ("max x2", CellSize::MaxRadius(2.0)),
+];
+
+fn params(name: &str) -> GridParams {
+    let cell_size = CONFIGS.iter().find(|c| c.0 == name).unwrap().1;
+    GridParams { cell_size, rebuild_below: 0.8 }
+}
+
+static GRIDS: LazyLock<Vec<HitPointGrid>> = LazyLock::new(|| {
+    CONFIGS
+        .iter()
+        .map(|&(name, _)| HitPointGrid::build(&DATA.positions, &DATA.radii, params(name)))
+        .collect()
+});
+
+fn grid(name: &str) -> &'static HitPointGrid {
+    &GRIDS[CONFIGS.iter().position(|c| c.0 == name).unwrap()]
+}
+
+fn count(grid: &HitPointGrid, radii: &[f64], p: Vec3) -> usize {
+    let mut n = 0;
+    grid.for_each_containing(p, radii, |_| n += 1);
+    n
+}
+
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap()
+}
+
+#[divan::bench(args = ["mean x2", "mean x1", "mean x3", "mean x4", "max x2"], sample_count = 5)]
+fn build(bencher: Bencher, name: &str) {
+    let data = &*DATA;
+    bencher
+        .counter(ItemsCount::new(N_HITPOINTS))
+        .bench(|| HitPointGrid::build(&data.positions, &data.radii, params(name)));
+}
+
+#[divan::bench(args = ["mean x2", "max x2"], sample_count = 5)]
+fn build_jittered(bencher: Bencher, name: &str) {
+    let data = &*DATA;
+    bencher
+        .counter(ItemsCount::new(N_HITPOINTS))
+        .bench(|| HitPointGrid::build(&data.positions, &data.jittered_radii, params(name)));
+}
+
+fn gather(bencher: Bencher, name: &str, sorted: bool, threads: usize) {
+    let data = &*DATA;
+    let grid = grid(name);
+    let photons = if sorted { &data.photons_sorted } else { &data.photons };
+    let pool = pool(threads);
+    bencher.counter(ItemsCount::new(N_PHOTONS)).bench(|| {
+        pool.install(|| {
+            photons
+                .par_chunks(4096)
+                .map(|chunk| chunk.iter().map(|&p| count(grid, &data.radii, p)).sum::<usize>())
+                .sum::<usize>()
+        })
+    });
+    black_box(());
+}
+
+#[divan::bench(args = ["mean x2", "mean x1", "mean x3", "mean x4", "max x2"], sample_count = 5)]
+fn gather_sorted_1_thread(bencher: Bencher, name: &str) {
+    gather(bencher, name, true, 1);
+}
+
+#[divan::bench(args = ["mean x2", "mean x1", "mean x3", "mean x4", "max x2"], sample_count = 5)]
+fn gather_random_1_thread(bencher: Bencher, name: &str) {
+    gather(bencher, name, false, 1);
+}
+
+#[divan::bench(args = ["mean x2", "max x2"], sample_count = 5)]
+fn gather_sorted_2_threads(bencher: Bencher, name: &str) {
+    gather(bencher, name, true, 2);
+}
+
+#[divan::bench(args = ["mean x2", "max x2"], sample_count = 5)]
+fn gather_random_2_threads(bencher: Bencher, name: &str) {
+    gather(bencher, name, false, 2);
+}
+
+#[divan::bench(sample_count = 5)]
+fn morton_sort_photons(bencher: Bencher) {
+    let data = &*DATA;
+    bencher.counter(ItemsCount::new(N_PHOTONS)).bench(|| morton_order(&data.photons));
+}

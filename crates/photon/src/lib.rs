@@ -23,8 +23,10 @@
 
 mod grid;
 mod hitpoints;
+mod morton;
 mod photon;
 
 pub use crate::grid::{CellSize, GridParams, GridStats, HitPointGrid};
 pub use crate::hitpoints::{HitPointColumnsMut, HitPoints, NewHitPoint};
+pub use crate::morton::morton_order;
 pub use crate::photon::{AcceptParams, Photon, accepts, within_radius};
