@@ -12,7 +12,7 @@ use std::path::PathBuf;
 #[non_exhaustive]
 pub enum LoadError {
     /// The file could not be opened or read.
-    #[error("{}: cannot read file: {source}", path.display())]
+    #[error("{}: cannot read file: {}", path.display(), lower_first(&source.to_string()))]
     Io {
         /// The file.
         path: PathBuf,
@@ -211,6 +211,16 @@ pub enum LoadError {
         /// The material's name.
         material: String,
     },
+}
+
+/// The message with its first letter in lower case (OS and library messages start with a
+/// capital).
+pub(crate) fn lower_first(message: &str) -> String {
+    let mut chars = message.chars();
+    match chars.next() {
+        Some(c) => c.to_lowercase().chain(chars).collect(),
+        None => String::new(),
+    }
 }
 
 /// `" for \"albedo\""`, or nothing for an unknown key.

@@ -59,7 +59,7 @@ pub struct MaterialSummary {
     pub name: String,
     /// `diffuse`, `mirror`, `dielectric` or `glossy`.
     pub kind: &'static str,
-    /// Albedo, reflectance, … (whatever the kind has).
+    /// Diffuse albedo, or the Lambertian base of a glossy material from an OBJ file.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub albedo: Option<Rgb6>,
     /// Mirror or glossy reflectance.

@@ -40,7 +40,7 @@ const MAX_DEPTH: usize = 1024;
 fn gltf_error(path: &Path, message: impl std::fmt::Display) -> LoadError {
     LoadError::Gltf {
         path: path.to_path_buf(),
-        message: message.to_string().to_lowercase(),
+        message: crate::error::lower_first(&message.to_string()),
     }
 }
 

@@ -61,6 +61,10 @@ fn missing_file() {
     let err = load(&path).unwrap_err();
     assert!(matches!(err, LoadError::Io { .. }), "{err:?}");
     assert_names_file(&err, &path);
+    // The OS message ("No such file…") is lowercased after the path.
+    let msg = err.to_string();
+    let rest = msg.split("cannot read file: ").nth(1).unwrap();
+    assert!(rest.starts_with(char::is_lowercase), "{msg}");
 }
 
 #[test]
