@@ -344,3 +344,45 @@ fn paths_resolve_relative_to_the_source() {
     assert!(matches!(err, geometry::LoadError::Io { .. }), "{err:?}");
     crate::assert_names_file(&err, Path::new("elsewhere/meshes/tri.obj"));
 }
+
+#[test]
+fn gltf_mesh_inside_a_toml_scene() {
+    let gltf = crate::shared_scenes().join("gltf/Box/glTF-Binary/Box.glb");
+    let text = format!(
+        r#"format = 1
+[materials.lamp]
+type = "diffuse"
+albedo = [0.0, 0.0, 0.0]
+emission = [1.0, 1.0, 1.0]
+[[shapes]]
+type = "mesh"
+file = {file:?}
+transform = {{ translate = [0.0, 0.0, -3.0] }}
+[[shapes]]
+type = "quad"
+corner = [-1.0, 2.0, -1.0]
+edge1 = [0.0, 0.0, 2.0]
+edge2 = [2.0, 0.0, 0.0]
+material = "lamp"
+"#,
+        file = gltf.display().to_string()
+    );
+    let scene = load_toml_str(&text, Path::new("box.toml")).unwrap();
+    let summary = scene.summary();
+    assert_eq!(summary.triangles, 12 + 2);
+    assert_eq!(summary.emissive_triangles, 2);
+    let red = summary
+        .materials
+        .iter()
+        .find(|m| m.name.ends_with("Box.glb/Red"))
+        .unwrap();
+    assert_eq!(red.triangles, 12);
+    // The Box is a unit cube around the origin; moved to z = −3.
+    let bounds = summary.bounds.unwrap();
+    assert!((bounds.min.0.z - -3.5).abs() < 1e-5 && (bounds.max.0.y - 2.0).abs() < 1e-5);
+    // The lamp quad's front is edge1 × edge2 = (0, 0, 2) × (2, 0, 0) = (0, 4, 0): up.
+    let quad = scene.triangles.iter().find(|t| t.material == 0).unwrap();
+    let [a, b, c] = quad.positions;
+    assert!((b - a).cross(c - a).y > 0.0);
+    assert!(scene.notes.camera_framed);
+}
