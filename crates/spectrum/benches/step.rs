@@ -44,7 +44,7 @@ fn reflect(bencher: Bencher) {
 #[divan::bench]
 fn reflect_travel_step(bencher: Bencher) {
     let (caps, q) = setup();
-    let lobe = Lobe::Ggx { roughness: 0.2 };
+    let lobe = Lobe::Phong { exponent: 100.0 };
     bencher.bench_local(|| {
         black_box(q)
             .reflect(

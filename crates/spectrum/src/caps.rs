@@ -136,10 +136,14 @@ impl Caps {
         } else {
             b.clamp(self.b_min, self.b_max)
         };
-        let limit = (a * b * (1.0 - 1e-12)).sqrt();
-        let c = if c.is_nan() {
+        // The common case (inside the bound) needs no square root.
+        let bound = a * b * (1.0 - 1e-12);
+        let c = if c * c <= bound {
+            c
+        } else if c.is_nan() {
             0.0
         } else {
+            let limit = bound.sqrt();
             c.clamp(-limit, limit)
         };
         (a, b, c)

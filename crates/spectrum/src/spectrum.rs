@@ -224,9 +224,9 @@ impl Spectrum {
     /// [[`MU_MIN`](crate::MU_MIN), 1].
     #[must_use]
     pub fn reflect(self, mu_i: f64, mu_o: f64, curvature: f64, lobe: Lobe, caps: &Caps) -> Self {
-        let mu_i = clamp_mu(mu_i);
-        let m = clamp_mu(mu_o) / mu_i;
-        let g = 2.0 * curvature / mu_i;
+        let inv_mu_i = 1.0 / clamp_mu(mu_i);
+        let m = clamp_mu(mu_o) * inv_mu_i;
+        let g = 2.0 * curvature * inv_mu_i;
         let a = m * m * self.a;
         let c = m * (self.c - g * self.a);
         let b = overflow_to_inf(self.b + g * (g * self.a - 2.0 * self.c));
