@@ -108,6 +108,12 @@ pub(crate) fn load_obj(path: &Path) -> Result<MeshData, LoadError> {
                 (data.materials.len() - 1) as u32
             }),
         };
+        if !mesh.normals.is_empty() && mesh.normals.len() != mesh.positions.len() {
+            data.warnings.push(format!(
+                "object {:?}: only some faces have vertex normals, so none are used (flat shading)",
+                model.name
+            ));
+        }
         add_mesh(&mut data, mesh, material);
     }
     Ok(data)

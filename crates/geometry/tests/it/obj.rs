@@ -147,6 +147,20 @@ fn vertex_normals_are_normalised_and_follow_the_triangulation() {
 }
 
 #[test]
+fn mixed_normals_in_one_object_are_dropped_with_a_warning() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 5 5\nvn 0 0 1\nf 1//1 2//1 3//1\nf 1 2 4\n";
+    let scene = load_obj("obj_mixed_normals", obj, "");
+    assert!(scene.triangles.iter().all(|t| t.normals.is_none()));
+    assert!(
+        scene
+            .notes
+            .warnings
+            .iter()
+            .any(|w| w.contains("only some faces"))
+    );
+}
+
+#[test]
 fn zero_normals_are_dropped() {
     let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 0\nf 1//1 2//1 3//1\n";
     let scene = load_obj("obj_zero_normals", obj, "");
