@@ -23,7 +23,7 @@ const RADIUS: f64 = 0.004;
 
 fn main() {
     let stats = HitPointGrid::build(&DATA.positions, &DATA.radii, GridParams::DEFAULT).stats();
-    let found: usize = DATA.photons.iter().map(|&p| count(&GRIDS[0], &DATA.radii, p)).sum();
+    let found: usize = DATA.photons.iter().map(|&p| count(&GRIDS[0], p)).sum();
     println!(
         "default grid: {stats:?}, {:.1} grid bytes/hitpoint, {:.2} found/photon",
         stats.bytes as f64 / N_HITPOINTS as f64,
@@ -51,10 +51,21 @@ static DATA: LazyLock<Data> = LazyLock::new(|| {
     let mut rng = Pcg32::seed_from_u64(1);
     let positions: Vec<Vec3> = (0..N_HITPOINTS).map(|_| on_sphere(&mut rng)).collect();
     let radii = vec![RADIUS; N_HITPOINTS];
-    let jittered_radii = (0..N_HITPOINTS).map(|_| RADIUS * rng.random_range(0.5..1.5)).collect();
+    let jittered_radii = (0..N_HITPOINTS)
+        .map(|_| RADIUS * rng.random_range(0.5..1.5))
+        .collect();
     let photons: Vec<Vec3> = (0..N_PHOTONS).map(|_| on_sphere(&mut rng)).collect();
-    let photons_sorted = morton_order(&photons).iter().map(|&i| photons[i as usize]).collect();
-    Data { positions, radii, jittered_radii, photons, photons_sorted }
+    let photons_sorted = morton_order(&photons)
+        .iter()
+        .map(|&i| photons[i as usize])
+        .collect();
+    Data {
+        positions,
+        radii,
+        jittered_radii,
+        photons,
+        photons_sorted,
+    }
 });
 
 const CONFIGS: [(&str, CellSize); 5] = [
@@ -67,7 +78,10 @@ const CONFIGS: [(&str, CellSize); 5] = [
 
 fn params(name: &str) -> GridParams {
     let cell_size = CONFIGS.iter().find(|c| c.0 == name).unwrap().1;
-    GridParams { cell_size, rebuild_below: 0.8 }
+    GridParams {
+        cell_size,
+        rebuild_below: 0.8,
+    }
 }
 
 static GRIDS: LazyLock<Vec<HitPointGrid>> = LazyLock::new(|| {
@@ -81,14 +95,17 @@ fn grid(name: &str) -> &'static HitPointGrid {
     &GRIDS[CONFIGS.iter().position(|c| c.0 == name).unwrap()]
 }
 
-fn count(grid: &HitPointGrid, radii: &[f64], p: Vec3) -> usize {
+fn count(grid: &HitPointGrid, p: Vec3) -> usize {
     let mut n = 0;
-    grid.for_each_containing(p, radii, |_| n += 1);
+    grid.for_each_containing(p, |_| n += 1);
     n
 }
 
 fn pool(threads: usize) -> rayon::ThreadPool {
-    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap()
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
 }
 
 #[divan::bench(args = ["mean x2", "mean x1", "mean x3", "mean x4", "max x2"], sample_count = 5)]
@@ -110,13 +127,17 @@ fn build_jittered(bencher: Bencher, name: &str) {
 fn gather(bencher: Bencher, name: &str, sorted: bool, threads: usize) {
     let data = &*DATA;
     let grid = grid(name);
-    let photons = if sorted { &data.photons_sorted } else { &data.photons };
+    let photons = if sorted {
+        &data.photons_sorted
+    } else {
+        &data.photons
+    };
     let pool = pool(threads);
     bencher.counter(ItemsCount::new(N_PHOTONS)).bench(|| {
         pool.install(|| {
             photons
                 .par_chunks(4096)
-                .map(|chunk| chunk.iter().map(|&p| count(grid, &data.radii, p)).sum::<usize>())
+                .map(|chunk| chunk.iter().map(|&p| count(grid, p)).sum::<usize>())
                 .sum::<usize>()
         })
     });
@@ -146,5 +167,7 @@ fn gather_random_2_threads(bencher: Bencher, name: &str) {
 #[divan::bench(sample_count = 5)]
 fn morton_sort_photons(bencher: Bencher) {
     let data = &*DATA;
-    bencher.counter(ItemsCount::new(N_PHOTONS)).bench(|| morton_order(&data.photons));
+    bencher
+        .counter(ItemsCount::new(N_PHOTONS))
+        .bench(|| morton_order(&data.photons));
 }

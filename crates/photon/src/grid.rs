@@ -1,8 +1,7 @@
 //! A spatial hash grid over hitpoints, answering "which hitpoints' spheres contain p".
 
-use glam::Vec3;
-
-use crate::photon::within_radius;
+use glam::{Vec3, Vec4};
+use rayon::prelude::*;
 
 #[cfg(test)]
 mod tests;
@@ -38,21 +37,26 @@ impl GridParams {
     };
 }
 
-/// A hash grid over hitpoint spheres (centre, radius R), in compressed sparse row form.
+/// A hash grid over hitpoint spheres (centre x, radius R), in compressed sparse row form.
 ///
 /// Every hitpoint is inserted into each grid cell that its bounding box (slightly inflated to
 /// absorb rounding) overlaps, so a query looks in exactly one cell: the one containing the query
 /// point. Cells are hashed into a power-of-two table of about 2 × the number of hitpoints;
-/// `cell_start[b]..cell_start[b + 1]` indexes the bucket's entries in `entries`. Each entry
-/// copies the hitpoint's position and squared build-time radius, so a query reads one
-/// contiguous run of memory and touches the caller's radius column only for true candidates.
+/// `cell_start[b]..cell_start[b + 1]` indexes bucket b's entries. Each entry copies the
+/// hitpoint's position and R² (16 bytes, one quarter of a cache line) and a query scans one
+/// contiguous run of them; the hitpoint index sits in a parallel array read only on a hit.
 ///
-/// The build is a serial two-pass counting sort: deterministic, entries within a bucket are in
-/// increasing hitpoint index, no per-cell allocation and no locks. Queries take `&self` and run
-/// in parallel freely.
+/// The stored R² is the largest `f32` not above the exact `f64` R², which makes the `f32` test
+/// `|p − x|² ≤ R²_f32` equivalent to [`crate::within_radius`]: the results are exact.
 ///
-/// Radii may shrink after the build (as in PPM) but must not grow: queries use the build-time
-/// radius to find candidates. Positions must not change.
+/// Build: the (bucket, hitpoint) pairs are generated in parallel over fixed chunks of hitpoints,
+/// concatenated in chunk order and sorted by bucket with a stable LSD radix sort, so entries of
+/// a bucket are in increasing hitpoint index whatever the thread count. No per-cell allocation,
+/// no locks. Queries take `&self` and run in parallel freely.
+///
+/// PPM radii shrink between passes: [`Self::refresh_radii`] copies the new radii into the
+/// entries (the cells stay valid because the spheres only shrink), and
+/// [`Self::needs_rebuild`] says when smaller cells would pay off. Positions must not change.
 #[derive(Clone, Debug)]
 pub struct HitPointGrid {
     origin: Vec3,
@@ -60,8 +64,13 @@ pub struct HitPointGrid {
     cell_edge: f32,
     hash_shift: u32,
     cell_start: Vec<u32>,
-    entries: Vec<Entry>,
-    overflow: Vec<Entry>,
+    /// Per entry: position and R² (rounded down to `f32`).
+    entries: Vec<Vec4>,
+    /// Per entry: hitpoint index.
+    entry_idx: Vec<u32>,
+    /// Hitpoints spanning too many cells, scanned by every query; same layout.
+    overflow: Vec<Vec4>,
+    overflow_idx: Vec<u32>,
     reference_radius: f64,
     n_hitpoints: usize,
     params: GridParams,
@@ -84,14 +93,8 @@ pub struct GridStats {
     pub bytes: usize,
 }
 
-/// One hitpoint in one bucket: 20 bytes.
-#[derive(Clone, Copy, Debug)]
-struct Entry {
-    position: Vec3,
-    /// Build-time R², rounded up to `f32`.
-    radius_sq: f32,
-    idx: u32,
-}
+/// Hitpoints per parallel work item of the build (fixed, so the result is thread-independent).
+const BUILD_CHUNK: usize = 1 << 14;
 
 impl HitPointGrid {
     /// A hitpoint whose bounding box overlaps more cells than this goes to the overflow list.
@@ -103,20 +106,20 @@ impl HitPointGrid {
     /// never reported. An infinite radius contains every point.
     ///
     /// # Panics
-    /// If `positions` and `radii` differ in length, or there are more than `u32::MAX` hitpoints.
+    /// If `positions` and `radii` differ in length, or there are `u32::MAX` hitpoints or more.
     #[must_use]
     pub fn build(positions: &[Vec3], radii: &[f64], params: GridParams) -> Self {
         assert_eq!(positions.len(), radii.len(), "one radius per hitpoint");
         assert!(
-            u32::try_from(positions.len()).is_ok(),
+            positions.len() < u32::MAX as usize,
             "hitpoint indices must fit in u32"
         );
         let n = positions.len();
 
-        // Bounds and radius statistics of the valid hitpoints.
+        // Bounds and radius statistics of the valid hitpoints (serial: a fixed summation order).
         let mut lo = Vec3::splat(f32::INFINITY);
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
-        let (mut max_r, mut sum_r, mut n_valid) = (0.0_f64, 0.0_f64, 0_usize);
+        let (mut max_r, mut sum_r, mut n_finite) = (0.0_f64, 0.0_f64, 0_usize);
         for (&x, &r) in positions.iter().zip(radii) {
             if is_valid(x, r) {
                 lo = lo.min(x);
@@ -125,17 +128,17 @@ impl HitPointGrid {
                 if r.is_finite() {
                     max_r = max_r.max(r);
                     sum_r += r;
-                    n_valid += 1;
+                    n_finite += 1;
                 }
             }
         }
-        if n_valid == 0 {
+        if !lo.is_finite() {
             lo = Vec3::ZERO;
         }
-        let mean_r = if n_valid == 0 {
+        let mean_r = if n_finite == 0 {
             0.0
         } else {
-            sum_r / n_valid as f64
+            sum_r / n_finite as f64
         };
         let reference_radius = reference(params.cell_size, max_r, mean_r);
         let extent = lo.abs().max(hi.abs()).max_element();
@@ -152,9 +155,11 @@ impl HitPointGrid {
             inv_cell: 1.0 / cell_edge,
             cell_edge,
             hash_shift: 32 - n_buckets.trailing_zeros(),
-            cell_start: vec![0; n_buckets + 1],
+            cell_start: Vec::new(),
             entries: Vec::new(),
+            entry_idx: Vec::new(),
             overflow: Vec::new(),
+            overflow_idx: Vec::new(),
             reference_radius,
             n_hitpoints: n,
             params,
@@ -163,97 +168,121 @@ impl HitPointGrid {
         // rounding of `x ± r` and of `p − x` in the distance test. It stays below `min_edge`.
         let pad = extent * 2.0_f32.powi(-21);
 
-        // Pass 1: count entries per bucket.
-        let mut buckets = [0_u32; Self::MAX_CELLS_PER_HITPOINT];
-        let mut counts = vec![0_u32; n_buckets];
-        let mut overflow = Vec::new();
-        for (i, (&x, &r)) in positions.iter().zip(radii).enumerate() {
-            if !is_valid(x, r) {
-                continue;
-            }
-            match grid.buckets_of(x, r, pad, &mut buckets) {
-                Some(k) => buckets[..k].iter().for_each(|&b| counts[b as usize] += 1),
-                None => overflow.push(i),
-            }
-        }
-
-        // Exclusive prefix sum into `cell_start`, then pass 2 fills the entries in index order.
-        let mut total = 0_u32;
-        for (start, &count) in grid.cell_start.iter_mut().zip(&counts) {
-            *start = total;
-            total += count;
-        }
-        grid.cell_start[n_buckets] = total;
-        let mut cursor = grid.cell_start[..n_buckets].to_vec();
-        let placeholder = Entry {
-            position: Vec3::ZERO,
-            radius_sq: 0.0,
-            idx: u32::MAX,
-        };
-        grid.entries = vec![placeholder; total as usize];
-        for (i, (&x, &r)) in positions.iter().zip(radii).enumerate() {
-            if !is_valid(x, r) {
-                continue;
-            }
-            if let Some(k) = grid.buckets_of(x, r, pad, &mut buckets) {
-                let entry = Entry {
-                    position: x,
-                    radius_sq: radius_sq_up(r),
-                    idx: i as u32,
-                };
-                for &b in &buckets[..k] {
-                    grid.entries[cursor[b as usize] as usize] = entry;
-                    cursor[b as usize] += 1;
+        // (bucket << 32 | hitpoint) keys in hitpoint order, and the overflow hitpoints.
+        let chunks: Vec<(Vec<u64>, Vec<u32>)> = positions
+            .par_chunks(BUILD_CHUNK)
+            .zip(radii.par_chunks(BUILD_CHUNK))
+            .enumerate()
+            .map(|(chunk_idx, (xs, rs))| {
+                let mut keys = Vec::with_capacity(xs.len() * 4);
+                let mut overflow = Vec::new();
+                let mut buckets = [0_u32; Self::MAX_CELLS_PER_HITPOINT];
+                for (j, (&x, &r)) in xs.iter().zip(rs).enumerate() {
+                    let idx = (chunk_idx * BUILD_CHUNK + j) as u32;
+                    if !is_valid(x, r) {
+                        continue;
+                    }
+                    match grid.buckets_of(x, r, pad, &mut buckets) {
+                        Some(k) => keys.extend(
+                            buckets[..k]
+                                .iter()
+                                .map(|&b| u64::from(b) << 32 | u64::from(idx)),
+                        ),
+                        None => overflow.push(idx),
+                    }
                 }
-            }
-        }
-        grid.overflow = overflow
-            .into_iter()
-            .map(|i| Entry {
-                position: positions[i],
-                radius_sq: radius_sq_up(radii[i]),
-                idx: i as u32,
+                (keys, overflow)
             })
             .collect();
+        let mut keys = Vec::with_capacity(chunks.iter().map(|c| c.0.len()).sum());
+        for (chunk_keys, chunk_overflow) in &chunks {
+            keys.extend_from_slice(chunk_keys);
+            grid.overflow_idx.extend_from_slice(chunk_overflow);
+        }
+        drop(chunks);
+        radix_sort_by_bucket(&mut keys, 32 - grid.hash_shift);
+
+        // Bucket starts from the sorted keys.
+        grid.cell_start = vec![0; n_buckets + 1];
+        let mut j = 0;
+        for (b, start) in grid.cell_start.iter_mut().enumerate() {
+            while j < keys.len() && (keys[j] >> 32) < b as u64 {
+                j += 1;
+            }
+            *start = j as u32;
+        }
+
+        // Entries, in parallel (a pure map of the sorted keys).
+        let entry = |idx: u32| {
+            let x = positions[idx as usize];
+            x.extend(radius_sq_down(radii[idx as usize]))
+        };
+        grid.entry_idx = keys.par_iter().map(|&k| k as u32).collect();
+        grid.entries = grid.entry_idx.par_iter().map(|&idx| entry(idx)).collect();
+        grid.overflow = grid.overflow_idx.iter().map(|&idx| entry(idx)).collect();
         grid
     }
 
-    /// Calls `f(idx)` for every hitpoint whose **build-time** sphere contains `p`, with R² rounded
-    /// up to `f32`: a superset of [`Self::for_each_containing`]. Order: bucket order (increasing
-    /// index), then the overflow list (increasing index).
+    /// Calls `f(idx)` for exactly the hitpoints with `|p − x_idx|² ≤ R_idx²` (the predicate of
+    /// [`crate::within_radius`]), R being the radius of the last build or
+    /// [`Self::refresh_radii`]. Each hitpoint is reported once; the order is fixed: bucket order
+    /// (increasing index), then the overflow list (increasing index).
     #[inline]
-    pub fn for_each_candidate(&self, p: Vec3, mut f: impl FnMut(u32)) {
-        self.for_each_entry(p, |e| {
-            if within_radius(p, e.position, f64::from(e.radius_sq)) {
-                f(e.idx);
+    pub fn for_each_containing(&self, p: Vec3, mut f: impl FnMut(u32)) {
+        let [x, y, z] = self.cell_of(p);
+        let b = self.bucket(x, y, z);
+        let range = self.cell_start[b] as usize..self.cell_start[b + 1] as usize;
+        for (e, &idx) in self.entries[range.clone()]
+            .iter()
+            .zip(&self.entry_idx[range])
+        {
+            if distance_sq(p, e.truncate()) <= e.w {
+                f(idx);
             }
-        });
+        }
+        for (e, &idx) in self.overflow.iter().zip(&self.overflow_idx) {
+            if distance_sq(p, e.truncate()) <= e.w {
+                f(idx);
+            }
+        }
     }
 
-    /// Calls `f(idx)` for exactly the hitpoints with `|p − x_idx|² ≤ radii[idx]²` (the predicate
-    /// of [`crate::within_radius`]), each once, in the order of [`Self::for_each_candidate`].
-    /// Hitpoints skipped at build (see [`Self::build`]) are never reported.
+    /// Copies shrunk radii into the grid; `radii` is indexed by hitpoint like at build time.
     ///
-    /// `radii` is the current radius column; each radius must be at most its build-time value.
-    #[inline]
-    pub fn for_each_containing(&self, p: Vec3, radii: &[f64], mut f: impl FnMut(u32)) {
-        debug_assert_eq!(
-            radii.len(),
-            self.n_hitpoints,
-            "radius column of the built hitpoints"
-        );
-        self.for_each_entry(p, |e| {
-            if within_radius(p, e.position, f64::from(e.radius_sq)) {
-                let r = radii[e.idx as usize];
-                debug_assert!(
-                    f64::from(e.radius_sq) >= r * r,
-                    "radii must not grow after build"
-                );
-                if within_radius(p, e.position, r * r) {
-                    f(e.idx);
-                }
+    /// Returns `false` if some radius grew since the last build or refresh (or the length
+    /// differs): the grid then keeps the smaller radius for those hitpoints and must be rebuilt.
+    /// A negative or NaN radius removes the hitpoint from the results; hitpoints skipped at
+    /// build stay absent until the next build.
+    #[must_use]
+    pub fn refresh_radii(&mut self, radii: &[f64]) -> bool {
+        if radii.len() != self.n_hitpoints {
+            return false;
+        }
+        let refresh = |(e, &idx): (&mut Vec4, &u32)| {
+            let r2 = radius_sq_down(radii[idx as usize]);
+            // A NaN R² (negative or NaN radius) never matches, as if skipped at build.
+            let ok = r2.is_nan() || r2 <= e.w;
+            if ok {
+                e.w = r2;
             }
-        });
+            ok
+        };
+        let entries_ok = self
+            .entries
+            .par_iter_mut()
+            .zip(self.entry_idx.par_iter())
+            .with_min_len(BUILD_CHUNK)
+            .map(refresh)
+            .reduce(|| true, |a, b| a && b);
+        let overflow_ok = self
+            .overflow
+            .iter_mut()
+            .zip(&self.overflow_idx)
+            .map(refresh)
+            .filter(|&ok| !ok)
+            .count()
+            == 0;
+        entries_ok && overflow_ok
     }
 
     /// Whether the radii have shrunk enough that a rebuild pays off (or the hitpoint count
@@ -264,18 +293,18 @@ impl HitPointGrid {
         if radii.len() != self.n_hitpoints {
             return true;
         }
-        let (mut max_r, mut sum_r, mut n_valid) = (0.0_f64, 0.0_f64, 0_usize);
+        let (mut max_r, mut sum_r, mut n_finite) = (0.0_f64, 0.0_f64, 0_usize);
         for &r in radii {
             if r.is_finite() && r >= 0.0 {
                 max_r = max_r.max(r);
                 sum_r += r;
-                n_valid += 1;
+                n_finite += 1;
             }
         }
-        let mean_r = if n_valid == 0 {
+        let mean_r = if n_finite == 0 {
             0.0
         } else {
-            sum_r / n_valid as f64
+            sum_r / n_finite as f64
         };
         reference(self.params.cell_size, max_r, mean_r)
             < self.params.rebuild_below * self.reference_radius
@@ -284,6 +313,7 @@ impl HitPointGrid {
     /// Counters and memory of the grid.
     #[must_use]
     pub fn stats(&self) -> GridStats {
+        let n_entries = self.entries.len() + self.overflow.len();
         GridStats {
             n_hitpoints: self.n_hitpoints,
             n_buckets: self.cell_start.len() - 1,
@@ -291,18 +321,8 @@ impl HitPointGrid {
             n_overflow: self.overflow.len(),
             cell_edge: self.cell_edge,
             bytes: self.cell_start.len() * size_of::<u32>()
-                + (self.entries.len() + self.overflow.len()) * size_of::<Entry>(),
+                + n_entries * (size_of::<Vec4>() + size_of::<u32>()),
         }
-    }
-
-    /// Visits the entries of `p`'s bucket, then the overflow list.
-    #[inline]
-    fn for_each_entry(&self, p: Vec3, mut f: impl FnMut(&Entry)) {
-        let [x, y, z] = self.cell_of(p);
-        let b = self.bucket(x, y, z);
-        let (start, end) = (self.cell_start[b] as usize, self.cell_start[b + 1] as usize);
-        self.entries[start..end].iter().for_each(&mut f);
-        self.overflow.iter().for_each(f);
     }
 
     /// Integer cell coordinates; `as` saturates, which keeps the map monotone.
@@ -362,6 +382,36 @@ impl HitPointGrid {
     }
 }
 
+/// Stable LSD radix sort of `keys` by their high `bucket_bits` bits (11 bits per pass).
+fn radix_sort_by_bucket(keys: &mut Vec<u64>, bucket_bits: u32) {
+    const DIGIT: u32 = 11;
+    let mut scratch = vec![0_u64; keys.len()];
+    let mut shift = 32;
+    while shift < 32 + bucket_bits {
+        let mut offsets = vec![0_usize; 1 << DIGIT];
+        for &k in keys.iter() {
+            offsets[((k >> shift) & ((1 << DIGIT) - 1)) as usize] += 1;
+        }
+        let mut total = 0;
+        for o in &mut offsets {
+            (*o, total) = (total, total + *o);
+        }
+        for &k in keys.iter() {
+            let d = ((k >> shift) & ((1 << DIGIT) - 1)) as usize;
+            scratch[offsets[d]] = k;
+            offsets[d] += 1;
+        }
+        std::mem::swap(keys, &mut scratch);
+        shift += DIGIT;
+    }
+}
+
+/// The squared distance of [`crate::within_radius`], shared so both round identically.
+#[inline]
+pub(crate) fn distance_sq(p: Vec3, x: Vec3) -> f32 {
+    (p - x).length_squared()
+}
+
 fn is_valid(x: Vec3, r: f64) -> bool {
     x.is_finite() && r >= 0.0
 }
@@ -373,12 +423,18 @@ fn reference(cell_size: CellSize, max_r: f64, mean_r: f64) -> f64 {
     }
 }
 
-/// R² as an `f32` that is not below the exact `f64` value.
-fn radius_sq_up(r: f64) -> f32 {
+/// The largest `f32` not above the exact `f64` R², or NaN (never matches) if R is negative or
+/// NaN.
+///
+/// For any `f32` d², `d² ≤ R²_f32` ⟺ `f64(d²) ≤ R²`, so the grid's `f32` test is exact.
+fn radius_sq_down(r: f64) -> f32 {
+    if r.is_nan() || r < 0.0 {
+        return f32::NAN;
+    }
     let r2 = r * r;
     let r2_f32 = r2 as f32;
-    if f64::from(r2_f32) < r2 {
-        r2_f32.next_up()
+    if f64::from(r2_f32) > r2 {
+        r2_f32.next_down()
     } else {
         r2_f32
     }

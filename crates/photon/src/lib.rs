@@ -17,7 +17,7 @@
 //! let radii = [0.5, 0.25];
 //! let grid = HitPointGrid::build(&positions, &radii, GridParams::DEFAULT);
 //! let mut found = Vec::new();
-//! grid.for_each_containing(Vec3::new(0.9, 0.0, 0.0), &radii, |idx| found.push(idx));
+//! grid.for_each_containing(Vec3::new(0.9, 0.0, 0.0), |idx| found.push(idx));
 //! assert_eq!(found, [1]);
 //! ```
 

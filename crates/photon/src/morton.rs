@@ -12,7 +12,9 @@ pub fn morton_order(points: &[Vec3]) -> Vec<u32> {
     let (lo, hi) = points
         .iter()
         .filter(|p| p.is_finite())
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        });
     let scale = ((1 << 21) - 1) as f32 / (hi - lo).max_element().max(f32::MIN_POSITIVE);
     let mut keyed: Vec<(u64, u32)> = points
         .iter()
@@ -54,7 +56,12 @@ mod tests {
 
     #[test]
     fn order_is_a_permutation_following_the_curve() {
-        let points = [Vec3::ONE, Vec3::ZERO, Vec3::new(f32::NAN, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0)];
+        let points = [
+            Vec3::ONE,
+            Vec3::ZERO,
+            Vec3::new(f32::NAN, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+        ];
         assert_eq!(morton_order(&points), [1, 3, 0, 2]);
         assert!(morton_order(&[]).is_empty());
     }

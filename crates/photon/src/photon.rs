@@ -74,7 +74,7 @@ pub fn accepts(
 #[must_use]
 #[inline]
 pub fn within_radius(p: Vec3, x: Vec3, radius_sq: f64) -> bool {
-    f64::from((p - x).length_squared()) <= radius_sq
+    f64::from(crate::grid::distance_sq(p, x)) <= radius_sq
 }
 
 #[cfg(test)]

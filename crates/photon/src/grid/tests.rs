@@ -1,11 +1,28 @@
 use super::*;
 
 #[test]
-fn radius_sq_is_rounded_up() {
-    for r in [0.1_f64, 1.0 / 3.0, 1e-20, 7.0e10, 0.0] {
-        assert!(f64::from(radius_sq_up(r)) >= r * r, "r = {r}");
+fn radius_sq_is_rounded_down_exactly() {
+    for r in [0.1_f64, 1.0 / 3.0, 1e-20, 7.0e10, 0.0, 1e30, f64::INFINITY] {
+        let r2 = radius_sq_down(r);
+        assert!(f64::from(r2) <= r * r, "r = {r}");
+        if r2 < f32::MAX {
+            assert!(f64::from(r2.next_up()) > r * r, "r = {r}");
+        }
     }
-    assert_eq!(radius_sq_up(1e30), f32::INFINITY);
+    assert_eq!(radius_sq_down(1e30), f32::MAX);
+    assert!(radius_sq_down(-1.0).is_nan());
+    assert!(radius_sq_down(f64::NAN).is_nan());
+}
+
+#[test]
+fn radix_sort_is_stable_by_bucket() {
+    let mut keys: Vec<u64> = [(5_u64, 0_u64), (3, 1), (5, 2), (0, 3), (4095, 4), (3, 5)]
+        .iter()
+        .map(|&(b, i)| b << 32 | i)
+        .collect();
+    radix_sort_by_bucket(&mut keys, 12);
+    let pairs: Vec<(u64, u64)> = keys.iter().map(|&k| (k >> 32, k & 0xFFFF_FFFF)).collect();
+    assert_eq!(pairs, [(0, 3), (3, 1), (3, 5), (5, 0), (5, 2), (4095, 4)]);
 }
 
 #[test]
@@ -16,8 +33,8 @@ fn colliding_cells_list_a_hitpoint_once() {
     let grid = HitPointGrid::build(&positions, &radii, GridParams::DEFAULT);
     assert_eq!(grid.stats().n_buckets, 4);
     for b in 0..4 {
-        let bucket = &grid.entries[grid.cell_start[b] as usize..grid.cell_start[b + 1] as usize];
-        let mut idx: Vec<u32> = bucket.iter().map(|e| e.idx).collect();
+        let mut idx =
+            grid.entry_idx[grid.cell_start[b] as usize..grid.cell_start[b + 1] as usize].to_vec();
         let n = idx.len();
         idx.dedup();
         assert_eq!(idx.len(), n, "bucket {b} lists a hitpoint twice");
@@ -31,6 +48,6 @@ fn huge_radius_goes_to_overflow() {
     let grid = HitPointGrid::build(&positions, &radii, GridParams::DEFAULT);
     assert_eq!(grid.stats().n_overflow, 1);
     let mut found = Vec::new();
-    grid.for_each_containing(Vec3::splat(5e5), &radii, |i| found.push(i));
+    grid.for_each_containing(Vec3::splat(5e5), |i| found.push(i));
     assert_eq!(found, [3]);
 }

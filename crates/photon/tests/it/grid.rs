@@ -34,9 +34,9 @@ fn brute_force(positions: &[Vec3], radii: &[f64], p: Vec3) -> Vec<u32> {
         .collect()
 }
 
-fn grid_query(grid: &HitPointGrid, radii: &[f64], p: Vec3) -> Vec<u32> {
+fn grid_query(grid: &HitPointGrid, p: Vec3) -> Vec<u32> {
     let mut found = Vec::new();
-    grid.for_each_containing(p, radii, |i| found.push(i));
+    grid.for_each_containing(p, |i| found.push(i));
     let n = found.len();
     found.sort_unstable();
     found.dedup();
@@ -51,7 +51,7 @@ fn check(positions: &[Vec3], radii: &[f64], queries: &[Vec3]) {
         let grid = HitPointGrid::build(positions, radii, params);
         for &p in queries {
             assert_eq!(
-                grid_query(&grid, radii, p),
+                grid_query(&grid, p),
                 brute_force(positions, radii, p),
                 "{params:?} at {p}"
             );
@@ -145,7 +145,7 @@ fn single_hitpoint() {
     ];
     check(&positions, &radii, &queries);
     let grid = HitPointGrid::build(&positions, &radii, GridParams::DEFAULT);
-    assert_eq!(grid_query(&grid, &radii, queries[1]), [0]);
+    assert_eq!(grid_query(&grid, queries[1]), [0]);
 }
 
 #[test]
@@ -186,30 +186,50 @@ fn far_from_origin() {
 }
 
 #[test]
-fn shrunk_radii_and_candidates() {
+fn refreshed_radii_match_brute_force() {
     let (positions, radii, queries) = random_case(3, 300);
-    let grid = HitPointGrid::build(&positions, &radii, GridParams::DEFAULT);
-    let shrunk: Vec<f64> = radii.iter().map(|r| r * 0.7).collect();
+    let mut grid = HitPointGrid::build(&positions, &radii, GridParams::DEFAULT);
+    let mut shrunk: Vec<f64> = radii.iter().map(|r| r * 0.7).collect();
+    shrunk[5] = -1.0;
+    shrunk[6] = f64::NAN;
+    shrunk[7] = 0.0;
     assert!(!grid.needs_rebuild(&radii));
     assert!(grid.needs_rebuild(&shrunk));
     assert!(grid.needs_rebuild(&shrunk[1..]));
-    for &p in &queries {
+    assert!(grid.refresh_radii(&shrunk));
+    for &p in queries.iter().chain(&positions) {
         assert_eq!(
-            grid_query(&grid, &shrunk, p),
-            brute_force(&positions, &shrunk, p)
+            grid_query(&grid, p),
+            brute_force(&positions, &shrunk, p),
+            "at {p}"
         );
-        // Candidates: the build-time spheres (R² rounded up to f32), a superset.
-        let mut candidates = Vec::new();
-        grid.for_each_candidate(p, |i| candidates.push(i));
-        let exact = brute_force(&positions, &radii, p);
-        assert!(
-            exact.iter().all(|i| candidates.contains(i)),
-            "{exact:?} ⊄ {candidates:?}"
-        );
-        for &i in &candidates {
-            let r2 = f64::from((radii[i as usize] * radii[i as usize]) as f32) * (1.0 + 1e-6);
-            assert!(within_radius(p, positions[i as usize], r2));
-        }
+    }
+    // Growing back is refused.
+    assert!(!grid.refresh_radii(&radii));
+    assert!(!grid.refresh_radii(&radii[1..]));
+}
+
+#[test]
+fn build_is_independent_of_thread_count() {
+    let (positions, radii, queries) = random_case(8, 3000);
+    let build = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| HitPointGrid::build(&positions, &radii, GridParams::DEFAULT))
+    };
+    let grids = [build(1), build(2), build(5)];
+    for &p in &queries {
+        let orders: Vec<Vec<u32>> = grids
+            .iter()
+            .map(|g| {
+                let mut order = Vec::new();
+                g.for_each_containing(p, |i| order.push(i));
+                order
+            })
+            .collect();
+        assert!(orders.iter().all(|o| *o == orders[0]), "{orders:?}");
     }
 }
 
@@ -225,8 +245,8 @@ fn build_is_deterministic_and_ordered() {
     for &p in &queries {
         let mut order_a = Vec::new();
         let mut order_b = Vec::new();
-        a.for_each_containing(p, &radii, |i| order_a.push(i));
-        b.for_each_containing(p, &radii, |i| order_b.push(i));
+        a.for_each_containing(p, |i| order_a.push(i));
+        b.for_each_containing(p, |i| order_b.push(i));
         assert_eq!(order_a, order_b);
         // Bucket entries come in increasing index (no overflow in this case).
         assert!(order_a.windows(2).all(|w| w[0] < w[1]), "{order_a:?}");
@@ -253,7 +273,7 @@ proptest! {
         for params in ALL_PARAMS {
             let grid = HitPointGrid::build(&positions, &radii, params);
             for &p in &queries {
-                prop_assert_eq!(grid_query(&grid, &radii, p), brute_force(&positions, &radii, p));
+                prop_assert_eq!(grid_query(&grid, p), brute_force(&positions, &radii, p));
             }
         }
     }
