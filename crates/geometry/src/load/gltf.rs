@@ -222,6 +222,16 @@ impl Walker<'_> {
         }
         let reader = prim.reader(|b| self.buffers.get(b.index()).map(|d| &d.0[..]));
         let Some(positions) = reader.read_positions() else {
+            if let Some(accessor) = prim.get(&gltf::Semantic::Positions) {
+                // The attribute exists but its data cannot be read (buffer too short…).
+                return Err(gltf_error(
+                    self.path,
+                    format!(
+                        "cannot read positions of accessor {} (its buffer is too short?)",
+                        accessor.index()
+                    ),
+                ));
+            }
             self.skipped_primitives += 1;
             return Ok(());
         };
@@ -237,9 +247,18 @@ impl Walker<'_> {
             .read_normals()
             .map(|n| n.map(Vec3::from).collect())
             .filter(|n: &Vec<Vec3>| n.len() == positions.len());
-        let indices: Vec<u32> = match reader.read_indices() {
-            Some(i) => i.into_u32().collect(),
-            None => (0..positions.len() as u32).collect(),
+        let indices: Vec<u32> = match (reader.read_indices(), prim.indices()) {
+            (Some(i), _) => i.into_u32().collect(),
+            (None, None) => (0..positions.len() as u32).collect(),
+            (None, Some(accessor)) => {
+                return Err(gltf_error(
+                    self.path,
+                    format!(
+                        "cannot read indices of accessor {} (its buffer is too short?)",
+                        accessor.index()
+                    ),
+                ));
+            }
         };
         if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
             return Err(gltf_error(

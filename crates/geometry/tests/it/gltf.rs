@@ -149,3 +149,42 @@ fn unsupported_required_extension() {
     assert!(matches!(err, LoadError::Gltf { .. }), "{err:?}");
     crate::assert_names_file(&err, &path);
 }
+
+#[test]
+fn accessor_larger_than_its_buffer_is_an_error() {
+    let gltf = GLTF.replace("\"count\": 3", "\"count\": 300");
+    let path = write("gltf_short_buffer", &gltf);
+    let err = load(&path).unwrap_err();
+    assert!(matches!(err, LoadError::Gltf { .. }), "{err:?}");
+    crate::assert_names_file(&err, &path);
+}
+
+#[test]
+fn index_out_of_range_is_an_error() {
+    // A second buffer view holds u16 indices 0, 1, 7 (7 is past the 3 vertices).
+    let dir = crate::temp_dir("gltf_bad_index");
+    let floats: [f32; 9] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let mut bytes: Vec<u8> = floats.iter().flat_map(|f| f.to_le_bytes()).collect();
+    bytes.extend([0u16, 1, 7, 0].iter().flat_map(|i| i.to_le_bytes()));
+    std::fs::write(dir.join("tri.bin"), bytes).unwrap();
+    let gltf = GLTF
+        .replace(
+            "\"attributes\": { \"POSITION\": 0 }, \"material\": 0",
+            "\"attributes\": { \"POSITION\": 0 }, \"indices\": 1, \"material\": 0",
+        )
+        .replace(
+            "\"min\": [0, 0, 0], \"max\": [1, 1, 0] } ]",
+            "\"min\": [0, 0, 0], \"max\": [1, 1, 0] },\n    { \"bufferView\": 1, \"componentType\": 5123, \"count\": 3, \"type\": \"SCALAR\" } ]",
+        )
+        .replace(
+            "\"bufferViews\": [ { \"buffer\": 0, \"byteLength\": 36 } ]",
+            "\"bufferViews\": [ { \"buffer\": 0, \"byteLength\": 36 }, { \"buffer\": 0, \"byteOffset\": 36, \"byteLength\": 6 } ]",
+        )
+        .replace("\"byteLength\": 36 } ]\n}", "\"byteLength\": 44 } ]\n}");
+    let path = dir.join("scene.gltf");
+    std::fs::write(&path, gltf).unwrap();
+    let err = load(&path).unwrap_err();
+    assert!(matches!(err, LoadError::Gltf { .. }), "{err:?}");
+    crate::assert_names_file(&err, &path);
+    assert!(err.to_string().contains("index 7"), "{err}");
+}
