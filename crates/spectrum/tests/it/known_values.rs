@@ -311,3 +311,34 @@ fn emitters() {
     );
     assert_eq!(sun.a(), caps.a_max());
 }
+
+/// The lobe widths of design §7 (σρ² in rad², b_ρ = 2π²σρ²).
+#[test]
+fn lobe_widths() {
+    let cases = [
+        (Lobe::Mirror, 0.0),
+        (Lobe::Phong { exponent: 100.0 }, 0.01),
+        (Lobe::BlinnPhong { exponent: 100.0 }, 0.04),
+        (Lobe::Beckmann { roughness: 0.3 }, 0.18),
+        (Lobe::Ggx { roughness: 0.3 }, 0.09),
+        (Lobe::Gaussian { variance: 0.02 }, 0.02),
+    ];
+    for (lobe, variance) in cases {
+        assert_close!(lobe.angular_variance().unwrap(), variance, 1e-15);
+        assert_close!(lobe.bandwidth().unwrap(), TWO_PI_SQ * variance, 1e-15);
+    }
+    assert_close!(
+        Lobe::Phong { exponent: 100.0 }.bandwidth().unwrap(),
+        0.197_392,
+        1e-6
+    );
+    assert_eq!(Lobe::Lambert.angular_variance(), None);
+    assert_eq!(
+        Lobe::Gaussian { variance: -1.0 }.angular_variance(),
+        Some(0.0)
+    );
+    assert_eq!(
+        Lobe::Gaussian { variance: f64::NAN }.angular_variance(),
+        Some(0.0)
+    );
+}

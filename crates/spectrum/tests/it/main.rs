@@ -41,6 +41,8 @@ mod support;
 mod degenerate;
 /// The hitpoint accumulator and its merge policies.
 mod estimate;
+/// Conventions checked against numerical Fourier transforms (§9.4).
+mod fourier;
 /// Known input → output rows of the design's table (§9.1).
 mod known_values;
 /// Algebraic laws and invariants over random PSD inputs (§9.2).

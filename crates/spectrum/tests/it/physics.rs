@@ -165,3 +165,17 @@ proptest! {
         prop_assert_eq!(bounced.c(), 0.0);
     }
 }
+
+/// A convex glass surface (hit from outside, κ = −1/R) focuses a collimated beam inside
+/// the glass at ηt·R/(ηt − ηi): the surface power (ηt − ηi)/R.
+#[test]
+fn convex_refracting_surface_focuses_inside_the_glass() {
+    let caps = paraxial_caps();
+    for (radius, eta_t) in [(0.5f64, 1.5f64), (2.0, 1.33), (1.0, 2.4)] {
+        let width = 0.2 * radius;
+        let beam = Spectrum::new(TWO_PI_SQ * width * width / 12.0, 1e-10, 0.0, &caps).unwrap();
+        let inside = beam.refract(1.0, eta_t, 1.0, 1.0, -1.0 / radius, &caps);
+        let focus = argmin(|d| inside.travel(d, &caps).a(), 0.0, 20.0 * radius);
+        assert_close!(focus, eta_t * radius / (eta_t - 1.0), 1e-6);
+    }
+}
