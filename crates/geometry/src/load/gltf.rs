@@ -60,7 +60,15 @@ pub(crate) fn load_gltf(path: &Path) -> Result<MeshData, LoadError> {
         {
             textured += 1;
         }
-        data.materials.push(material(&m, i));
+        let converted = material(&m, i);
+        if m.emissive_texture().is_some() && converted.emission.max_element() > 0.0 {
+            data.warnings.push(format!(
+                "material {:?} has an emissive texture, which is ignored: its whole surface emits {}",
+                converted.name,
+                super::fmt_vec(converted.emission)
+            ));
+        }
+        data.materials.push(converted);
     }
     if textured > 0 {
         data.warnings.push(format!(
