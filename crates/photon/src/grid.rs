@@ -325,11 +325,11 @@ impl HitPointGrid {
         }
     }
 
-    /// Integer cell coordinates; `as` saturates, which keeps the map monotone.
+    /// Integer cell coordinates: floor, saturated to the `i32` range (a monotone map).
     #[inline]
     fn cell_of(&self, p: Vec3) -> [i32; 3] {
-        let c = ((p - self.origin) * self.inv_cell).floor();
-        [c.x as i32, c.y as i32, c.z as i32]
+        let c = (p - self.origin) * self.inv_cell;
+        [floor_i32(c.x), floor_i32(c.y), floor_i32(c.z)]
     }
 
     #[inline]
@@ -341,8 +341,8 @@ impl HitPointGrid {
         (h.wrapping_mul(0x9E37_79B1) >> self.hash_shift) as usize
     }
 
-    /// The distinct buckets of the cells overlapped by the padded box of sphere (x, r), sorted,
-    /// in `out[..k]`; `None` if it spans more than `MAX_CELLS_PER_HITPOINT` cells.
+    /// The distinct buckets of the cells overlapped by the padded box of sphere (x, r) in
+    /// `out[..k]`; `None` if it spans more than `MAX_CELLS_PER_HITPOINT` cells.
     fn buckets_of(
         &self,
         x: Vec3,
@@ -359,26 +359,21 @@ impl HitPointGrid {
         if n_cells > Self::MAX_CELLS_PER_HITPOINT as u64 {
             return None;
         }
+        // Cells that collide in the table must not list the hitpoint twice: a linear scan, as
+        // k is small (8 for most hitpoints).
         let mut k = 0;
         for cz in lo[2]..=hi[2] {
             for cy in lo[1]..=hi[1] {
                 for cx in lo[0]..=hi[0] {
-                    out[k] = self.bucket(cx, cy, cz) as u32;
-                    k += 1;
+                    let b = self.bucket(cx, cy, cz) as u32;
+                    if !out[..k].contains(&b) {
+                        out[k] = b;
+                        k += 1;
+                    }
                 }
             }
         }
-        // Cells that collide in the table must not list the hitpoint twice.
-        let cells = &mut out[..k];
-        cells.sort_unstable();
-        let mut n_distinct = 0;
-        for j in 0..k {
-            if j == 0 || cells[j] != cells[n_distinct - 1] {
-                cells[n_distinct] = cells[j];
-                n_distinct += 1;
-            }
-        }
-        Some(n_distinct)
+        Some(k)
     }
 }
 
@@ -403,6 +398,17 @@ fn radix_sort_by_bucket(keys: &mut Vec<u64>, bucket_bits: u32) {
         }
         std::mem::swap(keys, &mut scratch);
         shift += DIGIT;
+    }
+}
+
+/// `floor(v)` saturated to `i32` (NaN → 0). `f32::floor` is a libm call on baseline x86-64.
+#[inline]
+fn floor_i32(v: f32) -> i32 {
+    let t = v as i32;
+    if (t as f32) > v {
+        t.saturating_sub(1)
+    } else {
+        t
     }
 }
 

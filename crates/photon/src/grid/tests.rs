@@ -51,3 +51,26 @@ fn huge_radius_goes_to_overflow() {
     grid.for_each_containing(Vec3::splat(5e5), |i| found.push(i));
     assert_eq!(found, [3]);
 }
+
+#[test]
+fn floor_i32_matches_floor_and_saturates() {
+    for v in [
+        0.0_f32,
+        -0.0,
+        0.5,
+        -0.5,
+        1.0,
+        -1.0,
+        2.999_999_8,
+        -3.000_000_2,
+        1e9,
+        -1e9,
+        16_777_217.0,
+    ] {
+        assert_eq!(floor_i32(v), v.floor() as i32, "{v}");
+    }
+    assert_eq!(floor_i32(1e20), i32::MAX);
+    assert_eq!(floor_i32(-1e20), i32::MIN);
+    assert_eq!(floor_i32(f32::NEG_INFINITY), i32::MIN);
+    assert_eq!(floor_i32(f32::NAN), 0);
+}
