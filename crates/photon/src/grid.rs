@@ -9,12 +9,12 @@ mod tests;
 /// How the grid picks its cell edge from the hitpoint radii at build time.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum CellSize {
-    /// Cell edge = factor × largest radius (pbrt and smallppm use 2 × max). Every hitpoint spans
-    /// at most 2 cells per axis, but one large radius makes every cell large.
+    /// Base cell edge = factor × largest radius (pbrt and smallppm use 2 × max). With factor ≥ 2
+    /// every hitpoint is on level 0, but one large radius makes every cell large.
     MaxRadius(f64),
-    /// Cell edge = factor × mean radius. Robust to a few large radii: a hitpoint that would span
-    /// more than [`HitPointGrid::MAX_CELLS_PER_HITPOINT`] cells goes to an overflow list that every
-    /// query scans.
+    /// Base cell edge = factor × mean radius. Hitpoints with R > edge/2 go to coarser levels, so
+    /// a spread of radii (dark regions that never shrink next to bright ones that do) costs one
+    /// extra bucket per level and query.
     MeanRadius(f64),
 }
 
@@ -29,10 +29,10 @@ pub struct GridParams {
 }
 
 impl GridParams {
-    /// The measured default: cell edge 2 × mean radius, rebuild when the mean radius has shrunk
-    /// to 0.8 of its build value (see `benches/gather.rs`).
+    /// The measured default: base cell edge 4 × mean radius, rebuild when the mean radius has
+    /// shrunk to 0.8 of its build value (see `benches/gather.rs`).
     pub const DEFAULT: Self = Self {
-        cell_size: CellSize::MeanRadius(2.0),
+        cell_size: CellSize::MeanRadius(4.0),
         rebuild_below: 0.8,
     };
 }
@@ -40,9 +40,12 @@ impl GridParams {
 /// A hash grid over hitpoint spheres (centre x, radius R), in compressed sparse row form.
 ///
 /// Every hitpoint is inserted into each grid cell that its bounding box (slightly inflated to
-/// absorb rounding) overlaps, so a query looks in exactly one cell: the one containing the query
-/// point. Cells are hashed into a power-of-two table of about 2 × the number of hitpoints;
-/// `cell_start[b]..cell_start[b + 1]` indexes bucket b's entries. Each entry copies the
+/// absorb rounding) overlaps, so a query looks in exactly one cell per level: the one containing
+/// the query point. Level L has cell edge e·2^L and holds the hitpoints with
+/// e·2^(L−2) < R ≤ e·2^(L−1) (level 0: all R ≤ e/2), so a hitpoint spans at most 2–3 cells per
+/// axis; e comes from [`CellSize`]. Cells of all levels are hashed into one power-of-two table
+/// of about 2 × the number of hitpoints; `cell_start[b]..cell_start[b + 1]` indexes bucket b's
+/// entries. Only infinite radii (or R > e·2^47) go to an overflow list scanned by every query. Each entry copies the
 /// hitpoint's position and R² (16 bytes, one quarter of a cache line) and a query scans one
 /// contiguous run of them; the hitpoint index sits in a parallel array read only on a hit.
 ///
@@ -60,14 +63,21 @@ impl GridParams {
 #[derive(Clone, Debug)]
 pub struct HitPointGrid {
     origin: Vec3,
-    inv_cell: f32,
+    /// Level-0 cell edge e.
     cell_edge: f32,
+    /// 1 / (e·2^L) for every level L.
+    level_inv_cell: Vec<f32>,
+    /// Levels holding at least one hitpoint, in increasing order.
+    occupied_levels: Vec<u32>,
     hash_shift: u32,
     cell_start: Vec<u32>,
     /// Per entry: position and R² (rounded down to `f32`).
     entries: Vec<Vec4>,
     /// Per entry: hitpoint index.
     entry_idx: Vec<u32>,
+    /// Per entry: the hitpoint's level. A bucket holds entries of several levels when cells of
+    /// different levels collide in the table; a query reports only those of the level it looks up.
+    entry_level: Vec<u8>,
     /// Hitpoints spanning too many cells, scanned by every query; same layout.
     overflow: Vec<Vec4>,
     overflow_idx: Vec<u32>,
@@ -87,7 +97,9 @@ pub struct GridStats {
     pub n_entries: usize,
     /// Hitpoints too large for the cells, scanned by every query.
     pub n_overflow: usize,
-    /// Cell edge length.
+    /// Number of occupied levels.
+    pub n_levels: usize,
+    /// Level-0 cell edge length.
     pub cell_edge: f32,
     /// Heap bytes of the grid.
     pub bytes: usize,
@@ -97,8 +109,12 @@ pub struct GridStats {
 const BUILD_CHUNK: usize = 1 << 14;
 
 impl HitPointGrid {
-    /// A hitpoint whose bounding box overlaps more cells than this goes to the overflow list.
+    /// A hitpoint whose bounding box overlaps more cells than this goes to the overflow list
+    /// (never happens for finite radii: at most 27 cells plus rounding).
     pub const MAX_CELLS_PER_HITPOINT: usize = 64;
+
+    /// Number of levels; larger radii go to the overflow list.
+    const N_LEVELS: u32 = 48;
 
     /// Builds the grid over hitpoints `positions[i]` with radii `radii[i]`.
     ///
@@ -148,16 +164,21 @@ impl HitPointGrid {
         };
         // Keep the cell edge positive and not absurdly small next to the scene.
         let min_edge = (extent * 2.0_f32.powi(-20)).max(f32::MIN_POSITIVE.sqrt());
-        let cell_edge = ((reference_radius * factor) as f32).max(min_edge);
+        // Rounded up, so that the largest radius of `MaxRadius(2.0)` stays on level 0.
+        let cell_edge = f32_at_least(reference_radius * factor).max(min_edge);
         let n_buckets = (2 * n).max(2).next_power_of_two();
         let mut grid = Self {
             origin: lo,
-            inv_cell: 1.0 / cell_edge,
             cell_edge,
+            level_inv_cell: (0..Self::N_LEVELS)
+                .map(|level| 1.0 / cell_edge * 0.5_f32.powi(level as i32))
+                .collect(),
+            occupied_levels: Vec::new(),
             hash_shift: 32 - n_buckets.trailing_zeros(),
             cell_start: Vec::new(),
             entries: Vec::new(),
             entry_idx: Vec::new(),
+            entry_level: Vec::new(),
             overflow: Vec::new(),
             overflow_idx: Vec::new(),
             reference_radius,
@@ -169,20 +190,25 @@ impl HitPointGrid {
         let pad = extent * 2.0_f32.powi(-21);
 
         // (bucket << 32 | hitpoint) keys in hitpoint order, and the overflow hitpoints.
-        let chunks: Vec<(Vec<u64>, Vec<u32>)> = positions
+        let chunks: Vec<(Vec<u64>, Vec<u32>, u64)> = positions
             .par_chunks(BUILD_CHUNK)
             .zip(radii.par_chunks(BUILD_CHUNK))
             .enumerate()
             .map(|(chunk_idx, (xs, rs))| {
                 let mut keys = Vec::with_capacity(xs.len() * 4);
                 let mut overflow = Vec::new();
+                let mut level_mask = 0_u64;
                 let mut buckets = [0_u32; Self::MAX_CELLS_PER_HITPOINT];
                 for (j, (&x, &r)) in xs.iter().zip(rs).enumerate() {
                     let idx = (chunk_idx * BUILD_CHUNK + j) as u32;
                     if !is_valid(x, r) {
                         continue;
                     }
-                    match grid.buckets_of(x, r, pad, &mut buckets) {
+                    let cells = grid.level_of(r).and_then(|level| {
+                        level_mask |= 1 << level;
+                        grid.buckets_of(x, r, level, pad, &mut buckets)
+                    });
+                    match cells {
                         Some(k) => keys.extend(
                             buckets[..k]
                                 .iter()
@@ -191,14 +217,19 @@ impl HitPointGrid {
                         None => overflow.push(idx),
                     }
                 }
-                (keys, overflow)
+                (keys, overflow, level_mask)
             })
             .collect();
         let mut keys = Vec::with_capacity(chunks.iter().map(|c| c.0.len()).sum());
-        for (chunk_keys, chunk_overflow) in &chunks {
+        let mut level_mask = 0;
+        for (chunk_keys, chunk_overflow, chunk_levels) in &chunks {
             keys.extend_from_slice(chunk_keys);
             grid.overflow_idx.extend_from_slice(chunk_overflow);
+            level_mask |= chunk_levels;
         }
+        grid.occupied_levels = (0..Self::N_LEVELS)
+            .filter(|l| level_mask >> l & 1 == 1)
+            .collect();
         drop(chunks);
         radix_sort_by_bucket(&mut keys, 32 - grid.hash_shift);
 
@@ -218,6 +249,14 @@ impl HitPointGrid {
             x.extend(radius_sq_down(radii[idx as usize]))
         };
         grid.entry_idx = keys.par_iter().map(|&k| k as u32).collect();
+        grid.entry_level = grid
+            .entry_idx
+            .par_iter()
+            .map(|&idx| {
+                grid.level_of(radii[idx as usize])
+                    .map_or(u8::MAX, |l| l as u8)
+            })
+            .collect();
         grid.entries = grid.entry_idx.par_iter().map(|&idx| entry(idx)).collect();
         grid.overflow = grid.overflow_idx.iter().map(|&idx| entry(idx)).collect();
         grid
@@ -225,19 +264,21 @@ impl HitPointGrid {
 
     /// Calls `f(idx)` for exactly the hitpoints with `|p − x_idx|² ≤ R_idx²` (the predicate of
     /// [`crate::within_radius`]), R being the radius of the last build or
-    /// [`Self::refresh_radii`]. Each hitpoint is reported once; the order is fixed: bucket order
-    /// (increasing index), then the overflow list (increasing index).
+    /// [`Self::refresh_radii`]. Each hitpoint is reported once; the order is fixed: level by
+    /// level, increasing hitpoint index within a level, then the overflow list.
     #[inline]
     pub fn for_each_containing(&self, p: Vec3, mut f: impl FnMut(u32)) {
-        let [x, y, z] = self.cell_of(p);
-        let b = self.bucket(x, y, z);
-        let range = self.cell_start[b] as usize..self.cell_start[b + 1] as usize;
-        for (e, &idx) in self.entries[range.clone()]
-            .iter()
-            .zip(&self.entry_idx[range])
-        {
-            if distance_sq(p, e.truncate()) <= e.w {
-                f(idx);
+        for &level in &self.occupied_levels {
+            let [x, y, z] = self.cell_of(p, level);
+            let b = self.bucket(x, y, z, level);
+            let range = self.cell_start[b] as usize..self.cell_start[b + 1] as usize;
+            let entries = &self.entries[range.clone()];
+            let entry_idx = &self.entry_idx[range.clone()];
+            let entry_level = &self.entry_level[range];
+            for (j, e) in entries.iter().enumerate() {
+                if distance_sq(p, e.truncate()) <= e.w && u32::from(entry_level[j]) == level {
+                    f(entry_idx[j]);
+                }
             }
         }
         for (e, &idx) in self.overflow.iter().zip(&self.overflow_idx) {
@@ -319,26 +360,42 @@ impl HitPointGrid {
             n_buckets: self.cell_start.len() - 1,
             n_entries: self.entries.len(),
             n_overflow: self.overflow.len(),
+            n_levels: self.occupied_levels.len(),
             cell_edge: self.cell_edge,
             bytes: self.cell_start.len() * size_of::<u32>()
-                + n_entries * (size_of::<Vec4>() + size_of::<u32>()),
+                + n_entries * (size_of::<Vec4>() + size_of::<u32>())
+                + self.entry_level.len(),
         }
     }
 
     /// Integer cell coordinates: floor, saturated to the `i32` range (a monotone map).
     #[inline]
-    fn cell_of(&self, p: Vec3) -> [i32; 3] {
-        let c = (p - self.origin) * self.inv_cell;
+    fn cell_of(&self, p: Vec3, level: u32) -> [i32; 3] {
+        let c = (p - self.origin) * self.level_inv_cell[level as usize];
         [floor_i32(c.x), floor_i32(c.y), floor_i32(c.z)]
     }
 
     #[inline]
-    fn bucket(&self, x: i32, y: i32, z: i32) -> usize {
+    fn bucket(&self, x: i32, y: i32, z: i32, level: u32) -> usize {
         // Teschner et al. 2003 primes, then a Fibonacci multiply keeps the high bits.
         let h = (x as u32).wrapping_mul(73_856_093)
             ^ (y as u32).wrapping_mul(19_349_663)
-            ^ (z as u32).wrapping_mul(83_492_791);
+            ^ (z as u32).wrapping_mul(83_492_791)
+            ^ level.wrapping_mul(0x2545_F491);
         (h.wrapping_mul(0x9E37_79B1) >> self.hash_shift) as usize
+    }
+
+    /// The level of a hitpoint of radius `r`: the smallest L with 2r ≤ e·2^L; `None` (overflow
+    /// list) past the last level.
+    fn level_of(&self, r: f64) -> Option<u32> {
+        let mut edge = f64::from(self.cell_edge);
+        for level in 0..Self::N_LEVELS {
+            if 2.0 * r <= edge {
+                return Some(level);
+            }
+            edge *= 2.0;
+        }
+        None
     }
 
     /// The distinct buckets of the cells overlapped by the padded box of sphere (x, r) in
@@ -347,13 +404,14 @@ impl HitPointGrid {
         &self,
         x: Vec3,
         r: f64,
+        level: u32,
         pad: f32,
         out: &mut [u32; Self::MAX_CELLS_PER_HITPOINT],
     ) -> Option<usize> {
         // Relative padding covers the f32 distance test, absolute padding the coordinates.
         let half = (r * (1.0 + 1e-5)) as f32 + pad;
-        let lo = self.cell_of(x - Vec3::splat(half));
-        let hi = self.cell_of(x + Vec3::splat(half));
+        let lo = self.cell_of(x - Vec3::splat(half), level);
+        let hi = self.cell_of(x + Vec3::splat(half), level);
         let span = |a: usize| (i64::from(hi[a]) - i64::from(lo[a]) + 1) as u64;
         let n_cells = span(0).saturating_mul(span(1)).saturating_mul(span(2));
         if n_cells > Self::MAX_CELLS_PER_HITPOINT as u64 {
@@ -365,7 +423,7 @@ impl HitPointGrid {
         for cz in lo[2]..=hi[2] {
             for cy in lo[1]..=hi[1] {
                 for cx in lo[0]..=hi[0] {
-                    let b = self.bucket(cx, cy, cz) as u32;
+                    let b = self.bucket(cx, cy, cz, level) as u32;
                     if !out[..k].contains(&b) {
                         out[k] = b;
                         k += 1;
@@ -398,6 +456,16 @@ fn radix_sort_by_bucket(keys: &mut Vec<u64>, bucket_bits: u32) {
         }
         std::mem::swap(keys, &mut scratch);
         shift += DIGIT;
+    }
+}
+
+/// The smallest `f32` not below `v`.
+fn f32_at_least(v: f64) -> f32 {
+    let v32 = v as f32;
+    if f64::from(v32) < v {
+        v32.next_up()
+    } else {
+        v32
     }
 }
 

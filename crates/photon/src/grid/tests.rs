@@ -42,14 +42,15 @@ fn colliding_cells_list_a_hitpoint_once() {
 }
 
 #[test]
-fn huge_radius_goes_to_overflow() {
-    let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
-    let radii = [0.01, 0.01, 0.01, 1e6];
+fn large_radii_go_to_coarser_levels_and_infinite_ones_to_overflow() {
+    let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z, Vec3::ONE];
+    let radii = [0.01, 0.01, 0.01, 1e6, f64::INFINITY];
     let grid = HitPointGrid::build(&positions, &radii, GridParams::DEFAULT);
-    assert_eq!(grid.stats().n_overflow, 1);
+    let stats = grid.stats();
+    assert_eq!((stats.n_levels, stats.n_overflow), (2, 1));
     let mut found = Vec::new();
     grid.for_each_containing(Vec3::splat(5e5), |i| found.push(i));
-    assert_eq!(found, [3]);
+    assert_eq!(found, [3, 4]);
 }
 
 #[test]

@@ -129,6 +129,24 @@ fn huge_radius_among_small_ones() {
 }
 
 #[test]
+fn dark_and_bright_regions() {
+    // Most radii shrank to 1e-3 (bright), a tenth stayed at 0.05 and a few at 0.3 (dark): the
+    // mean-radius cells put the large ones on coarser levels.
+    let (positions, mut radii, queries) = random_case(21, 2000);
+    for (i, r) in radii.iter_mut().enumerate() {
+        *r = match i % 50 {
+            0 => 0.3,
+            1..=5 => 0.05,
+            _ => 1e-3,
+        };
+    }
+    let grid = HitPointGrid::build(&positions, &radii, GridParams::DEFAULT);
+    assert!(grid.stats().n_levels >= 3, "{:?}", grid.stats());
+    assert_eq!(grid.stats().n_overflow, 0);
+    check(&positions, &radii, &queries);
+}
+
+#[test]
 fn empty_grid_finds_nothing() {
     check(&[], &[], &[Vec3::ZERO, Vec3::ONE, Vec3::NAN]);
 }
