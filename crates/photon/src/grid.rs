@@ -268,16 +268,24 @@ impl HitPointGrid {
     /// level, increasing hitpoint index within a level, then the overflow list.
     #[inline]
     pub fn for_each_containing(&self, p: Vec3, mut f: impl FnMut(u32)) {
-        for &level in &self.occupied_levels {
-            let [x, y, z] = self.cell_of(p, level);
-            let b = self.bucket(x, y, z, level);
-            let range = self.cell_start[b] as usize..self.cell_start[b + 1] as usize;
-            let entries = &self.entries[range.clone()];
+        if let [level] = self.occupied_levels[..] {
+            // One level (the common case): every entry of the bucket is of this level.
+            let range = self.bucket_range(p, level);
             let entry_idx = &self.entry_idx[range.clone()];
-            let entry_level = &self.entry_level[range];
-            for (j, e) in entries.iter().enumerate() {
-                if distance_sq(p, e.truncate()) <= e.w && u32::from(entry_level[j]) == level {
+            for (j, e) in self.entries[range].iter().enumerate() {
+                if distance_sq(p, e.truncate()) <= e.w {
                     f(entry_idx[j]);
+                }
+            }
+        } else {
+            for &level in &self.occupied_levels {
+                let range = self.bucket_range(p, level);
+                let entry_idx = &self.entry_idx[range.clone()];
+                let entry_level = &self.entry_level[range.clone()];
+                for (j, e) in self.entries[range].iter().enumerate() {
+                    if distance_sq(p, e.truncate()) <= e.w && u32::from(entry_level[j]) == level {
+                        f(entry_idx[j]);
+                    }
                 }
             }
         }
@@ -366,6 +374,14 @@ impl HitPointGrid {
                 + n_entries * (size_of::<Vec4>() + size_of::<u32>())
                 + self.entry_level.len(),
         }
+    }
+
+    /// The entry range of the bucket of `p`'s cell on `level`.
+    #[inline]
+    fn bucket_range(&self, p: Vec3, level: u32) -> std::ops::Range<usize> {
+        let [x, y, z] = self.cell_of(p, level);
+        let b = self.bucket(x, y, z, level);
+        self.cell_start[b] as usize..self.cell_start[b + 1] as usize
     }
 
     /// Integer cell coordinates: floor, saturated to the `i32` range (a monotone map).
