@@ -5,7 +5,9 @@
 //! and in a deterministic order. Hitpoints live in [`HitPoints`], a structure of arrays whose
 //! progressive statistics (radius R, photon count N, flux τ) are `f64` and whose frequency state
 //! is a generic column the integrator chooses. [`accepts`] adds the side and normal tests that
-//! keep photons from the back of a thin wall out of a hitpoint's estimate.
+//! keep photons from the back of a thin wall out of a hitpoint's estimate, and [`gather`] runs a
+//! photon pass in parallel while summing every hitpoint's contributions in photon order, so the
+//! result is bit-identical for any thread count.
 //!
 //! The crate knows nothing about passes, BSDFs or scenes: the `ppm` crate drives it.
 //!
@@ -21,11 +23,13 @@
 //! assert_eq!(found, [1]);
 //! ```
 
+mod gather;
 mod grid;
 mod hitpoints;
 mod morton;
 mod photon;
 
+pub use crate::gather::gather;
 pub use crate::grid::{CellSize, GridParams, GridStats, HitPointGrid};
 pub use crate::hitpoints::{HitPointColumnsMut, HitPoints, NewHitPoint};
 pub use crate::morton::morton_order;
