@@ -12,7 +12,7 @@ use std::sync::LazyLock;
 
 use divan::{Bencher, black_box, counter::ItemsCount};
 use glam::Vec3;
-use photon::{CellSize, GridParams, HitPointGrid, morton_order};
+use photon::{CellSize, GridParams, HitPointGrid, Photon, gather, morton_order};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
 use rayon::prelude::*;
@@ -214,7 +214,7 @@ fn build_jittered(bencher: Bencher, name: &str) {
         .bench(|| HitPointGrid::build(&data.positions, &data.jittered_radii, params(name)));
 }
 
-fn gather(bencher: Bencher, name: &str, sorted: bool, threads: usize) {
+fn queries(bencher: Bencher, name: &str, sorted: bool, threads: usize) {
     let data = &*DATA;
     let grid = grid(name);
     let photons = if sorted {
@@ -236,22 +236,22 @@ fn gather(bencher: Bencher, name: &str, sorted: bool, threads: usize) {
 
 #[divan::bench(args = ["mean x4", "max x2"], sample_count = 5)]
 fn gather_sorted_1_thread(bencher: Bencher, name: &str) {
-    gather(bencher, name, true, 1);
+    queries(bencher, name, true, 1);
 }
 
 #[divan::bench(args = ["mean x4", "max x2"], sample_count = 5)]
 fn gather_random_1_thread(bencher: Bencher, name: &str) {
-    gather(bencher, name, false, 1);
+    queries(bencher, name, false, 1);
 }
 
 #[divan::bench(args = ["mean x4", "max x2"], sample_count = 5)]
 fn gather_sorted_2_threads(bencher: Bencher, name: &str) {
-    gather(bencher, name, true, 2);
+    queries(bencher, name, true, 2);
 }
 
 #[divan::bench(args = ["mean x4", "max x2"], sample_count = 5)]
 fn gather_random_2_threads(bencher: Bencher, name: &str) {
-    gather(bencher, name, false, 2);
+    queries(bencher, name, false, 2);
 }
 
 #[divan::bench(sample_count = 5)]
@@ -260,4 +260,38 @@ fn morton_sort_photons(bencher: Bencher) {
     bencher
         .counter(ItemsCount::new(N_PHOTONS))
         .bench(|| morton_order(&data.photons));
+}
+
+/// The full deterministic pass: `photon::gather` with an (n, Φ) accumulator, sorted photons.
+#[divan::bench(args = [1, 2], sample_count = 5)]
+fn gather_pass_sorted(bencher: Bencher, threads: usize) {
+    let data = &*DATA;
+    let grid = grid("mean x4");
+    let photons: Vec<Photon> = data
+        .photons_sorted
+        .iter()
+        .map(|&position| Photon {
+            position,
+            incoming: position,
+            power: Vec3::ONE,
+            normal: position,
+        })
+        .collect();
+    let pool = pool(threads);
+    bencher.counter(ItemsCount::new(N_PHOTONS)).bench(|| {
+        pool.install(|| {
+            gather(
+                grid,
+                &photons,
+                N_HITPOINTS,
+                |photon, _| Some(photon.power),
+                |acc: &mut (u32, [f64; 3]), power| {
+                    acc.0 += 1;
+                    acc.1[0] += f64::from(power.x);
+                    acc.1[1] += f64::from(power.y);
+                    acc.1[2] += f64::from(power.z);
+                },
+            )
+        })
+    });
 }
