@@ -23,7 +23,7 @@ pub enum FrequencyFloor {
     /// (the update of α = 1). The last shrink may step below r_freq.
     #[default]
     Keep,
-    /// Variant [UNV] of §8.3: as `Keep`, but a shrink never goes below r_freq:
+    /// Variant \[UNV\] of §8.3: as `Keep`, but a shrink never goes below r_freq:
     /// R′ = max(R_PPM′, r_freq) and N′ = (N + M)·R′²/R², which keeps the photon density N/R²
     /// consistent.
     Clamp,

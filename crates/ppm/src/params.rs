@@ -1,0 +1,180 @@
+//! Render parameters: plain typed values, validated once.
+
+use std::fmt;
+
+use spectrum::{K_POSTER, MergePolicy};
+
+use crate::update::FrequencyFloor;
+
+/// The integrators.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Progressive photon mapping (Hachisuka, Ogaki & Jensen 2008): hitpoints traced once.
+    Ppm,
+    /// Stochastic progressive photon mapping (Hachisuka & Jensen 2009): hitpoints re-traced
+    /// every pass, statistics kept per hitpoint slot.
+    Sppm,
+    /// PPM with frequency-guided kernels (Belcour & Soler 2011).
+    FreqPpm,
+    /// SPPM with frequency-guided kernels.
+    FreqSppm,
+}
+
+impl Method {
+    /// Every method, in the order reports list them.
+    pub const ALL: [Method; 4] = [Method::Ppm, Method::Sppm, Method::FreqPpm, Method::FreqSppm];
+
+    /// The name used on the command line and in scene files.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Ppm => "ppm",
+            Method::Sppm => "sppm",
+            Method::FreqPpm => "freq",
+            Method::FreqSppm => "freq-sppm",
+        }
+    }
+
+    /// The method called `name` (see [`Method::name`]).
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Method> {
+        Method::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// Whether frequency photons guide the kernel radius.
+    #[must_use]
+    pub fn uses_frequency(self) -> bool {
+        matches!(self, Method::FreqPpm | Method::FreqSppm)
+    }
+
+    /// Whether hitpoints are re-traced every pass (SPPM).
+    #[must_use]
+    pub fn is_stochastic(self) -> bool {
+        matches!(self, Method::Sppm | Method::FreqSppm)
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Everything an integrator needs besides the scene. Plain data, no `Default`: start from a
+/// preset ([`RenderParams::preview`]) and change fields.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderParams {
+    /// Which integrator.
+    pub method: Method,
+    /// Photons traced per pass (> 0).
+    pub photons_per_pass: u32,
+    /// Radius reduction α ∈ (0, 1]: the fraction of new photons kept (0.7 in smallppm,
+    /// 2/3 in pbrt-v4).
+    pub alpha: f64,
+    /// Initial gather radius in scene units; `None` picks it from the scene (see
+    /// [`crate::auto_initial_radius`]).
+    pub initial_radius: Option<f64>,
+    /// Maximum number of path segments for camera and photon paths (≥ 1).
+    pub max_depth: u32,
+    /// Hitpoint slots per pixel (jittered; ≥ 1).
+    pub samples_per_pixel: u32,
+    /// Seed of every random number.
+    pub seed: u64,
+    /// Share of photons that are frequency photons, in [0, 1] (frequency methods only).
+    pub freq_fraction: f64,
+    /// How a hitpoint merges frequency deposits.
+    pub freq_merge: MergePolicy,
+    /// The kernel radius constant K (poster: [`spectrum::K_POSTER`]).
+    pub kernel_k: f64,
+    /// What happens once the PPM radius reaches the frequency radius.
+    pub freq_floor: FrequencyFloor,
+    /// Add direct lighting by light sampling at hitpoints instead of gathering photons that
+    /// arrive straight from an emitter.
+    pub direct_lighting: bool,
+}
+
+/// A parameter outside its domain.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ParamError {
+    /// A parameter is outside its allowed range.
+    #[error("{name} = {value} is outside {range}")]
+    OutOfRange {
+        /// Parameter name as on the command line.
+        name: &'static str,
+        /// The value given.
+        value: String,
+        /// The allowed range, as text.
+        range: &'static str,
+    },
+    /// The film has no pixels or more than the renderer can index.
+    #[error("film of {width}x{height} pixels with {samples_per_pixel} samples per pixel is too large")]
+    TooManyHitpoints {
+        /// Film width.
+        width: u32,
+        /// Film height.
+        height: u32,
+        /// Samples per pixel.
+        samples_per_pixel: u32,
+    },
+}
+
+impl RenderParams {
+    /// A quick preview: classical PPM, 100 000 photons per pass, α = 0.7, one hitpoint per pixel.
+    #[must_use]
+    pub fn preview() -> Self {
+        Self {
+            method: Method::Ppm,
+            photons_per_pass: 100_000,
+            alpha: 0.7,
+            initial_radius: None,
+            max_depth: 8,
+            samples_per_pixel: 1,
+            seed: 0,
+            freq_fraction: 0.1,
+            freq_merge: MergePolicy::MinRadius,
+            kernel_k: K_POSTER,
+            freq_floor: FrequencyFloor::Keep,
+            direct_lighting: false,
+        }
+    }
+
+    /// Checks every field's domain.
+    ///
+    /// # Errors
+    ///
+    /// [`ParamError::OutOfRange`] naming the first parameter outside its domain.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        fn out(name: &'static str, value: impl fmt::Display, range: &'static str) -> ParamError {
+            ParamError::OutOfRange {
+                name,
+                value: value.to_string(),
+                range,
+            }
+        }
+        if self.photons_per_pass == 0 {
+            return Err(out("photons-per-pass", self.photons_per_pass, "[1, 2^32)"));
+        }
+        if !(self.alpha > 0.0 && self.alpha <= 1.0) {
+            return Err(out("alpha", self.alpha, "(0, 1]"));
+        }
+        if let Some(r) = self.initial_radius
+            && !(r > 0.0 && r.is_finite())
+        {
+            return Err(out("initial-radius", r, "(0, inf)"));
+        }
+        if self.max_depth == 0 || self.max_depth > 1024 {
+            return Err(out("max-depth", self.max_depth, "[1, 1024]"));
+        }
+        if self.samples_per_pixel == 0 || self.samples_per_pixel > 1024 {
+            return Err(out("spp", self.samples_per_pixel, "[1, 1024]"));
+        }
+        if !(0.0..=1.0).contains(&self.freq_fraction) {
+            return Err(out("freq-fraction", self.freq_fraction, "[0, 1]"));
+        }
+        if !(self.kernel_k > 0.0 && self.kernel_k.is_finite()) {
+            return Err(out("kernel-k", self.kernel_k, "(0, inf)"));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,726 @@
+//! The progressive loop shared by PPM, SPPM and their frequency-guided variants.
+//!
+//! One pass = four phases, each a private function that can be tested alone:
+//! `camera_pass` (trace or re-trace the visible points), `build_index` (hash grid over the
+//! hitpoint spheres), `photon_pass` (trace photons in fixed chunks, collect deposits) and
+//! `update_hitpoints` (fold the deposits into R, N, τ with the keep-or-shrink rule).
+
+use geometry::{Bsdf, EmitterShape, Hit, Lobe as MaterialLobe, Rgb, Scene, TransportMode};
+use glam::{Vec2, Vec3};
+use photon::{AcceptParams, GridParams, HitPointGrid, HitPoints, NewHitPoint, Photon};
+use rayon::prelude::*;
+use spectrum::{Caps, FrequencyEstimate, Lobe, Spectrum};
+
+use crate::params::{ParamError, RenderParams};
+use crate::rng::Sampler;
+use crate::update::{FrequencyRadius, GatherStats};
+
+/// Photons per parallel work item. Fixed (not derived from the thread count) so that the
+/// reduction order, hence the image, does not depend on the number of threads.
+const PHOTON_CHUNK: u64 = 2048;
+/// Hitpoint slots per parallel work item of the camera pass.
+const SLOT_CHUNK: usize = 1024;
+/// Camera streams live in their own half of the sampler's index space.
+const CAMERA_STREAM: u64 = 1 << 63;
+/// Path depth from which Russian roulette may end a photon path.
+const ROULETTE_DEPTH: u32 = 3;
+
+/// Per-pass statistics returned by [`Renderer::iterate`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PassStats {
+    /// Index of the pass just finished (0-based).
+    pub pass: u32,
+    /// Photon paths started in this pass.
+    pub photons_traced: u64,
+    /// Of which frequency photons.
+    pub frequency_photons: u64,
+    /// Photon-hitpoint contributions accepted in this pass.
+    pub photons_deposited: u64,
+    /// Hitpoint slots that received at least one photon in this pass.
+    pub hitpoints_hit: u64,
+    /// Hitpoint slots with a visible point this pass.
+    pub hitpoints_valid: u64,
+    /// Mean gather radius over valid slots after the update.
+    pub mean_radius: f64,
+    /// Smallest gather radius over valid slots.
+    pub min_radius: f64,
+    /// Largest gather radius over valid slots.
+    pub max_radius: f64,
+    /// Share of valid slots whose radius is held by the frequency floor (R ≤ r_freq).
+    pub frequency_held: f64,
+}
+
+/// Frequency state of one hitpoint slot: the merged estimate plus what a deposit needs to
+/// turn a photon's spectrum into the field seen by the camera.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SlotFrequency {
+    estimate: FrequencyEstimate,
+    /// Distance to the camera (or last specular vertex) projected on the normal, z of §8.2.
+    normal_distance: f32,
+}
+
+/// A progressive render in progress: create it, call [`Renderer::iterate`] as often as the
+/// budget allows, read [`Renderer::image`] at any time.
+pub struct Renderer<'s> {
+    scene: &'s Scene,
+    params: RenderParams,
+    caps: Caps,
+    width: u32,
+    height: u32,
+    pass: u32,
+    n_emitted: u64,
+    slots: HitPoints<SlotFrequency>,
+    /// Whether a slot holds a visible point in the current pass.
+    valid: Vec<bool>,
+    /// Per slot: sum of directly seen emission (and direct lighting) over camera passes.
+    direct: Vec<[f64; 3]>,
+    camera_passes: u32,
+    grid: Option<HitPointGrid>,
+    /// Slot index of each grid entry (the grid indexes the valid slots only).
+    grid_slots: Vec<u32>,
+}
+
+/// The smallppm choice of initial radius: twice the mean extent of the scene's bounding box
+/// divided by the mean film size in pixels, about a two-pixel footprint.
+#[must_use]
+pub fn auto_initial_radius(scene: &Scene) -> f64 {
+    let bounds = scene.bounds();
+    let extent = bounds.max - bounds.min;
+    let mean_extent = f64::from(extent.x + extent.y + extent.z) / 3.0;
+    let film = scene.description().film;
+    let mean_pixels = (f64::from(film.width) + f64::from(film.height)) / 2.0;
+    let r = 2.0 * mean_extent / mean_pixels;
+    if r > 0.0 && r.is_finite() { r } else { 1e-3 }
+}
+
+impl<'s> Renderer<'s> {
+    /// A renderer for `scene` with `params`; nothing is traced until the first
+    /// [`Renderer::iterate`].
+    ///
+    /// # Errors
+    ///
+    /// [`ParamError`] if a parameter is outside its domain or the film is too large.
+    pub fn new(scene: &'s Scene, params: RenderParams) -> Result<Self, ParamError> {
+        params.validate()?;
+        let film = scene.description().film;
+        let n_slots = u64::from(film.width)
+            * u64::from(film.height)
+            * u64::from(params.samples_per_pixel);
+        if n_slots == 0 || n_slots > u64::from(u32::MAX) {
+            return Err(ParamError::TooManyHitpoints {
+                width: film.width,
+                height: film.height,
+                samples_per_pixel: params.samples_per_pixel,
+            });
+        }
+        let bounds = scene.bounds();
+        let scene_size = f64::from((bounds.max - bounds.min).length()).max(1e-6);
+        Ok(Self {
+            scene,
+            params,
+            caps: Caps::for_scene_size(scene_size),
+            width: film.width,
+            height: film.height,
+            pass: 0,
+            n_emitted: 0,
+            slots: HitPoints::with_capacity(0),
+            valid: Vec::new(),
+            direct: Vec::new(),
+            camera_passes: 0,
+            grid: None,
+            grid_slots: Vec::new(),
+        })
+    }
+
+    /// The parameters this renderer runs with.
+    #[must_use]
+    pub fn params(&self) -> &RenderParams {
+        &self.params
+    }
+
+    /// Passes completed so far.
+    #[must_use]
+    pub fn passes(&self) -> u32 {
+        self.pass
+    }
+
+    /// Photons emitted over all passes so far.
+    #[must_use]
+    pub fn photons_emitted(&self) -> u64 {
+        self.n_emitted
+    }
+
+    /// Runs one pass: camera pass (the first time, or every time for SPPM), hash grid,
+    /// photon pass, hitpoint update.
+    pub fn iterate(&mut self) -> PassStats {
+        if self.pass == 0 || self.params.method.is_stochastic() {
+            self.camera_pass();
+        }
+        self.build_index();
+        let deposits = self.photon_pass();
+        let stats = self.update_hitpoints(&deposits);
+        self.pass += 1;
+        stats
+    }
+
+    /// The current estimate: linear RGB radiance per pixel, row-major from the top-left,
+    /// `width × height` entries.
+    #[must_use]
+    pub fn image(&self) -> Vec<[f32; 3]> {
+        let spp = self.params.samples_per_pixel as usize;
+        let n_pixels = self.width as usize * self.height as usize;
+        let mut image = vec![[0.0f32; 3]; n_pixels];
+        if self.slots.is_empty() {
+            return image;
+        }
+        let radius = self.slots.radius();
+        let count = self.slots.photon_count();
+        let flux = self.slots.flux();
+        let n_emitted = self.n_emitted as f64;
+        let camera_passes = f64::from(self.camera_passes.max(1));
+        image
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(pixel, out)| {
+                let mut sum = [0.0f64; 3];
+                for slot in pixel * spp..(pixel + 1) * spp {
+                    let stats = GatherStats {
+                        radius: radius[slot],
+                        photon_count: count[slot],
+                        flux: flux[slot],
+                    };
+                    let photons = stats.radiance(n_emitted).unwrap_or([0.0; 3]);
+                    for c in 0..3 {
+                        sum[c] += photons[c] + self.direct[slot][c] / camera_passes;
+                    }
+                }
+                *out = sum.map(|v| v as f32);
+            });
+        image
+    }
+
+    /// Film width and height in pixels.
+    #[must_use]
+    pub fn resolution(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// Current gather radius per pixel (mean over the pixel's slots), for AOVs.
+    #[must_use]
+    pub fn radius_image(&self) -> Vec<f32> {
+        let spp = self.params.samples_per_pixel as usize;
+        let radius = self.slots.radius();
+        (0..self.width as usize * self.height as usize)
+            .map(|pixel| {
+                if radius.is_empty() {
+                    return 0.0;
+                }
+                let sum: f64 = radius[pixel * spp..(pixel + 1) * spp].iter().sum();
+                (sum / spp as f64) as f32
+            })
+            .collect()
+    }
+
+    // ------------------------------------------------------------------------------------
+    // Phase 1: camera pass.
+
+    fn camera_pass(&mut self) {
+        let spp = self.params.samples_per_pixel;
+        let n_slots = self.width as usize * self.height as usize * spp as usize;
+        let initial_radius = self
+            .params
+            .initial_radius
+            .unwrap_or_else(|| auto_initial_radius(self.scene));
+        let first = self.slots.is_empty();
+        // For PPM the only camera pass is pass 0; SPPM re-traces with the pass index.
+        let pass = self.pass;
+        let traced: Vec<CameraSample> = (0..n_slots)
+            .into_par_iter()
+            .with_min_len(SLOT_CHUNK)
+            .map(|slot| self.trace_camera_path(slot as u32, pass))
+            .collect();
+        if first {
+            self.slots = HitPoints::with_capacity(n_slots);
+            self.direct = vec![[0.0; 3]; n_slots];
+            self.valid = vec![false; n_slots];
+        }
+        for (slot, sample) in traced.into_iter().enumerate() {
+            for c in 0..3 {
+                self.direct[slot][c] += f64::from(sample.direct[c]);
+            }
+            let point = sample.visible.unwrap_or(VisiblePoint {
+                position: Vec3::ZERO,
+                shading_normal: Vec3::Z,
+                geometric_normal: Vec3::Z,
+                outgoing: Vec3::Z,
+                material: 0,
+                weight: Vec3::ZERO,
+                normal_distance: 0.0,
+            });
+            self.valid[slot] = sample.visible.is_some();
+            let freq = SlotFrequency {
+                estimate: FrequencyEstimate::EMPTY,
+                normal_distance: point.normal_distance,
+            };
+            let new = NewHitPoint {
+                position: point.position,
+                shading_normal: point.shading_normal,
+                geometric_normal: point.geometric_normal,
+                outgoing: point.outgoing,
+                material_idx: point.material,
+                pixel_idx: slot as u32 / spp,
+                weight: point.weight,
+                radius: initial_radius,
+                freq,
+            };
+            if first {
+                self.slots.push(new);
+            } else {
+                self.slots.replace_visible_point(slot, new);
+            }
+        }
+        self.camera_passes += 1;
+    }
+
+    fn trace_camera_path(&self, slot: u32, pass: u32) -> CameraSample {
+        let spp = self.params.samples_per_pixel;
+        let pixel = slot / spp;
+        let (x, y) = (pixel % self.width, pixel / self.width);
+        let mut sampler = Sampler::new(self.params.seed, pass, CAMERA_STREAM | u64::from(slot));
+        let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+        let mut ray = self.scene.camera().generate_ray(film, sampler.next_2d());
+        let weight_scale = 1.0 / spp as f32;
+        let mut throughput = Rgb::ONE;
+        let mut direct = Rgb::ZERO;
+        for _depth in 0..self.params.max_depth {
+            let Some(hit) = self.scene.intersect(&ray) else {
+                break;
+            };
+            direct += throughput * self.scene.emitted(&hit);
+            let Some(material) = self.scene.material(hit.material) else {
+                break;
+            };
+            let bsdf = Bsdf::new(material, &hit);
+            let outgoing = -ray.direction;
+            if bsdf.is_specular() {
+                let u_lobe = sampler.next_f32();
+                let u = sampler.next_2d();
+                let Some(sample) = bsdf.sample(outgoing, u_lobe, u, TransportMode::Radiance)
+                else {
+                    break;
+                };
+                throughput *= sample.weight;
+                if throughput == Rgb::ZERO {
+                    break;
+                }
+                ray = hit.spawn_ray(sample.incoming);
+                continue;
+            }
+            if self.params.direct_lighting {
+                direct += throughput * self.direct_lighting(&hit, &bsdf, outgoing, &mut sampler);
+            }
+            let mu = outgoing.dot(hit.shading_normal).abs();
+            return CameraSample {
+                direct: direct * weight_scale,
+                visible: Some(VisiblePoint {
+                    position: hit.position,
+                    shading_normal: hit.shading_normal,
+                    geometric_normal: hit.geometric_normal,
+                    outgoing,
+                    material: hit.material,
+                    weight: throughput * weight_scale,
+                    normal_distance: hit.t * mu,
+                }),
+            };
+        }
+        CameraSample {
+            direct: direct * weight_scale,
+            visible: None,
+        }
+    }
+
+    /// One light sample of next-event estimation at a non-specular camera hit.
+    fn direct_lighting(
+        &self,
+        hit: &Hit,
+        bsdf: &Bsdf,
+        outgoing: Vec3,
+        sampler: &mut Sampler,
+    ) -> Rgb {
+        let u_light = sampler.next_f32();
+        let u = sampler.next_2d();
+        let Some(sample) = self.scene.lights().sample_direct(hit.position, u_light, u) else {
+            return Rgb::ZERO;
+        };
+        if sample.pdf <= 0.0 || !self.scene.light_visible(hit, &sample) {
+            return Rgb::ZERO;
+        }
+        let cos = sample.incoming.dot(hit.shading_normal).abs();
+        bsdf.eval(outgoing, sample.incoming) * sample.radiance * (cos / sample.pdf)
+    }
+
+    // ------------------------------------------------------------------------------------
+    // Phase 2: spatial index.
+
+    fn build_index(&mut self) {
+        let rebuild = self.params.method.is_stochastic()
+            || match &self.grid {
+                None => true,
+                Some(grid) => grid.needs_rebuild(&self.grid_radii()),
+            };
+        if !rebuild {
+            return;
+        }
+        self.grid_slots = (0..self.slots.len() as u32)
+            .filter(|&s| self.valid[s as usize])
+            .collect();
+        let positions: Vec<Vec3> = self
+            .grid_slots
+            .iter()
+            .map(|&s| self.slots.position()[s as usize])
+            .collect();
+        let radii = self.grid_radii();
+        self.grid = Some(HitPointGrid::build(&positions, &radii, GridParams::DEFAULT));
+    }
+
+    fn grid_radii(&self) -> Vec<f64> {
+        self.grid_slots
+            .iter()
+            .map(|&s| self.slots.radius()[s as usize])
+            .collect()
+    }
+
+    // ------------------------------------------------------------------------------------
+    // Phase 3: photon pass.
+
+    fn photon_pass(&mut self) -> PassDeposits {
+        let n = u64::from(self.params.photons_per_pass);
+        let radii = self.grid_radii();
+        let chunks: Vec<ChunkDeposits> = (0..n.div_ceil(PHOTON_CHUNK))
+            .into_par_iter()
+            .map(|chunk| {
+                let start = chunk * PHOTON_CHUNK;
+                let end = (start + PHOTON_CHUNK).min(n);
+                let mut out = ChunkDeposits::default();
+                for idx in start..end {
+                    self.trace_photon(self.n_emitted + idx, &radii, &mut out);
+                }
+                out
+            })
+            .collect();
+        self.n_emitted += n;
+        PassDeposits { chunks }
+    }
+
+    fn is_frequency_photon(&self, index: u64) -> bool {
+        if !self.params.method.uses_frequency() || self.params.freq_fraction <= 0.0 {
+            return false;
+        }
+        // Evenly spaced in the global photon index: exactly the requested share per pass
+        // (up to rounding), with no random draw.
+        let f = self.params.freq_fraction;
+        ((index + 1) as f64 * f).floor() > (index as f64 * f).floor()
+    }
+
+    fn trace_photon(&self, index: u64, radii: &[f64], out: &mut ChunkDeposits) {
+        let Some(grid) = &self.grid else {
+            return;
+        };
+        let mut sampler = Sampler::new(self.params.seed, self.pass, index);
+        let u_light = sampler.next_f32();
+        let u_pos = sampler.next_2d();
+        let u_dir = sampler.next_2d();
+        let Some(emission) = self
+            .scene
+            .lights()
+            .sample_emission(u_light, u_pos, u_dir)
+        else {
+            return;
+        };
+        let mut power = emission.power;
+        let mut ray = emission.ray();
+        let mut spectrum = self
+            .is_frequency_photon(index)
+            .then(|| emitter_spectrum(emission.emitter, &self.caps));
+        if spectrum.is_some() {
+            out.frequency_photons += 1;
+        }
+        for depth in 0..self.params.max_depth {
+            let Some(hit) = self.scene.intersect(&ray) else {
+                break;
+            };
+            let Some(material) = self.scene.material(hit.material) else {
+                break;
+            };
+            let incoming = -ray.direction;
+            if let Some(s) = spectrum.as_mut() {
+                *s = s.travel(f64::from(hit.t), &self.caps);
+            }
+            let bsdf = Bsdf::new(material, &hit);
+            if !bsdf.is_specular() && !(self.params.direct_lighting && depth == 0) {
+                let photon = Photon {
+                    position: hit.position,
+                    incoming,
+                    power,
+                    normal: hit.geometric_normal,
+                };
+                self.deposit(grid, radii, &photon, &hit, spectrum.as_ref(), out);
+            }
+            // Scatter.
+            let u_lobe = sampler.next_f32();
+            let u = sampler.next_2d();
+            let u_roulette = sampler.next_f32();
+            let Some(sample) = bsdf.sample(incoming, u_lobe, u, TransportMode::Importance) else {
+                break;
+            };
+            let new_power = power * sample.weight;
+            // Russian roulette (pbrt-v4 SPPM): keep the photon's power roughly constant.
+            let mut survive = 1.0f32;
+            if depth + 1 >= ROULETTE_DEPTH {
+                let ratio = luminance(new_power) / luminance(power).max(f32::MIN_POSITIVE);
+                let q = (1.0 - ratio).max(0.0);
+                if u_roulette < q {
+                    break;
+                }
+                survive = 1.0 - q;
+            }
+            power = new_power / survive;
+            if power == Rgb::ZERO || !power.is_finite() {
+                break;
+            }
+            if let Some(s) = spectrum.as_mut() {
+                *s = scatter_spectrum(*s, &hit, incoming, &sample, &bsdf, material, &self.caps);
+            }
+            ray = hit.spawn_ray(sample.incoming);
+        }
+    }
+
+    fn deposit(
+        &self,
+        grid: &HitPointGrid,
+        radii: &[f64],
+        photon: &Photon,
+        hit: &Hit,
+        spectrum: Option<&Spectrum>,
+        out: &mut ChunkDeposits,
+    ) {
+        let positions = self.slots.position();
+        let geometric_normals = self.slots.geometric_normal();
+        grid.for_each_containing(photon.position, radii, |entry| {
+            let slot = self.grid_slots[entry as usize] as usize;
+            if !photon::accepts(
+                photon,
+                positions[slot],
+                geometric_normals[slot],
+                radii[entry as usize],
+                AcceptParams::COS_60,
+            ) {
+                return;
+            }
+            let Some(material) = self.scene.material(self.slots.material_idx()[slot]) else {
+                return;
+            };
+            let bsdf = Bsdf::from_normal(material.kind, self.slots.shading_normal()[slot], true);
+            let f = bsdf.eval(self.slots.outgoing()[slot], photon.incoming);
+            let flux = f * photon.power * self.slots.weight()[slot];
+            out.flux.push((slot as u32, flux.to_array()));
+            if let Some(s) = spectrum {
+                // The field the hitpoint's radius reads (design §8.1): the photon's spectrum
+                // reflected by the hitpoint's lobe, with μo = 1 so that a stays in surface
+                // units (b does not depend on μo) and μi = 1 for the conservative 3D collapse
+                // (§8.5: the out-of-plane axis is not stretched).
+                let lobe = spectrum_lobe(material.kind.lobe());
+                let toward_camera =
+                    s.reflect_isotropic(1.0, f64::from(hit.curvature), lobe, &self.caps);
+                out.spectra.push((slot as u32, toward_camera));
+            }
+        });
+    }
+
+    // ------------------------------------------------------------------------------------
+    // Phase 4: hitpoint update.
+
+    fn update_hitpoints(&mut self, deposits: &PassDeposits) -> PassStats {
+        let n = self.slots.len();
+        let mut count = vec![0u32; n];
+        let mut flux = vec![[0.0f64; 3]; n];
+        let mut photons_deposited = 0u64;
+        let mut frequency_photons = 0u64;
+        let policy = self.params.freq_merge;
+        {
+            let columns = self.slots.columns_mut();
+            // Fixed order: chunks in photon order, deposits in trace order.
+            for chunk in &deposits.chunks {
+                frequency_photons += chunk.frequency_photons;
+                for &(slot, f) in &chunk.flux {
+                    let slot = slot as usize;
+                    count[slot] += 1;
+                    for c in 0..3 {
+                        flux[slot][c] += f64::from(f[c]);
+                    }
+                }
+                photons_deposited += chunk.flux.len() as u64;
+                for &(slot, spectrum) in &chunk.spectra {
+                    let slot = slot as usize;
+                    columns.freq[slot].estimate.deposit(spectrum, policy);
+                    columns.has_freq[slot] = true;
+                }
+            }
+        }
+        let alpha = self.params.alpha;
+        let k = self.params.kernel_k;
+        let floor = self.params.freq_floor;
+        let uses_frequency = self.params.method.uses_frequency();
+        let columns = self.slots.columns_mut();
+        let held: Vec<bool> = columns
+            .radius
+            .par_iter_mut()
+            .zip(columns.photon_count.par_iter_mut())
+            .zip(columns.flux.par_iter_mut())
+            .zip(columns.freq.par_iter())
+            .zip(count.par_iter().zip(flux.par_iter()))
+            .map(|((((radius, photon_count), tau), freq), (&m, &phi))| {
+                let r_freq = if uses_frequency {
+                    freq.estimate
+                        .radius(f64::from(freq.normal_distance), k)
+                        .map_or(FrequencyRadius::None, FrequencyRadius::Predicted)
+                } else {
+                    FrequencyRadius::None
+                };
+                let held = matches!(r_freq, FrequencyRadius::Predicted(r) if *radius <= r);
+                let mut stats = GatherStats {
+                    radius: *radius,
+                    photon_count: *photon_count,
+                    flux: *tau,
+                };
+                stats.update(m, phi, alpha, r_freq, floor);
+                *radius = stats.radius;
+                *photon_count = stats.photon_count;
+                *tau = stats.flux;
+                held
+            })
+            .collect();
+
+        let mut stats = PassStats {
+            pass: self.pass,
+            photons_traced: u64::from(self.params.photons_per_pass),
+            frequency_photons,
+            photons_deposited,
+            hitpoints_hit: count.iter().filter(|&&m| m > 0).count() as u64,
+            hitpoints_valid: 0,
+            mean_radius: 0.0,
+            min_radius: f64::INFINITY,
+            max_radius: 0.0,
+            frequency_held: 0.0,
+        };
+        let mut sum = 0.0;
+        let mut n_held = 0u64;
+        for (slot, &r) in self.slots.radius().iter().enumerate() {
+            if !self.valid[slot] {
+                continue;
+            }
+            stats.hitpoints_valid += 1;
+            sum += r;
+            stats.min_radius = stats.min_radius.min(r);
+            stats.max_radius = stats.max_radius.max(r);
+            n_held += u64::from(held[slot]);
+        }
+        if stats.hitpoints_valid > 0 {
+            stats.mean_radius = sum / stats.hitpoints_valid as f64;
+            stats.frequency_held = n_held as f64 / stats.hitpoints_valid as f64;
+        } else {
+            stats.min_radius = 0.0;
+        }
+        stats
+    }
+}
+
+/// What one camera path produced.
+#[derive(Clone, Copy, Debug)]
+struct CameraSample {
+    /// Emission seen along the path (and direct lighting), already weighted by 1/spp.
+    direct: Rgb,
+    visible: Option<VisiblePoint>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct VisiblePoint {
+    position: Vec3,
+    shading_normal: Vec3,
+    geometric_normal: Vec3,
+    outgoing: Vec3,
+    material: u32,
+    weight: Rgb,
+    normal_distance: f32,
+}
+
+/// Deposits of one chunk of photons, in trace order.
+#[derive(Default)]
+struct ChunkDeposits {
+    flux: Vec<(u32, [f32; 3])>,
+    spectra: Vec<(u32, Spectrum)>,
+    frequency_photons: u64,
+}
+
+struct PassDeposits {
+    chunks: Vec<ChunkDeposits>,
+}
+
+fn luminance(c: Rgb) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+/// The lobe of a material as the frequency operators see it (design §7).
+fn spectrum_lobe(lobe: MaterialLobe) -> Lobe {
+    match lobe {
+        MaterialLobe::Specular => Lobe::Mirror,
+        MaterialLobe::Lambert => Lobe::Lambert,
+        MaterialLobe::Ggx { alpha } => Lobe::Ggx {
+            roughness: f64::from(alpha),
+        },
+    }
+}
+
+/// The spectrum of the light field leaving an emitter (design §6).
+fn emitter_spectrum(shape: EmitterShape, caps: &Caps) -> Spectrum {
+    match shape {
+        EmitterShape::Area { size, cos_theta } => {
+            Spectrum::area_light(f64::from(size), f64::from(cos_theta), caps)
+        }
+        EmitterShape::Point => Spectrum::point_light(caps),
+        // A smooth falloff only lowers the angular frequency: the hard cone is conservative.
+        EmitterShape::Spot { cone_angle, .. } => Spectrum::spot_light(f64::from(cone_angle), caps),
+        EmitterShape::Directional => Spectrum::directional_light(caps),
+    }
+}
+
+/// The photon's spectrum after scattering at `hit` into `sample.incoming` (the new travel
+/// direction), under the conservative isotropic 3D collapse of design §8.5.
+fn scatter_spectrum(
+    spectrum: Spectrum,
+    hit: &Hit,
+    arrived_from: Vec3,
+    sample: &geometry::BsdfSample,
+    bsdf: &Bsdf,
+    material: &geometry::Material,
+    caps: &Caps,
+) -> Spectrum {
+    let normal = hit.shading_normal;
+    let mu_i = f64::from(arrived_from.dot(normal).abs());
+    let mu_o = f64::from(sample.incoming.dot(normal).abs());
+    let curvature = f64::from(hit.curvature);
+    if sample.is_transmission {
+        let ior = match material.kind {
+            geometry::MaterialKind::Dielectric { ior } => f64::from(ior),
+            _ => 1.0,
+        };
+        let (eta_i, eta_t) = if hit.front_face { (1.0, ior) } else { (ior, 1.0) };
+        return spectrum.refract(eta_i, eta_t, mu_i, mu_o, curvature, caps);
+    }
+    let lobe = if sample.is_specular {
+        Lobe::Mirror
+    } else {
+        spectrum_lobe(bsdf.lobe())
+    };
+    spectrum.reflect_isotropic(mu_o, curvature, lobe, caps)
+}
