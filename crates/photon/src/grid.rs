@@ -240,7 +240,7 @@ impl HitPointGrid {
             while j < keys.len() && (keys[j] >> 32) < b as u64 {
                 j += 1;
             }
-            *start = j as u32;
+            *start = u32::try_from(j).expect("fewer than 2³² grid entries");
         }
 
         // Entries, in parallel (a pure map of the sorted keys).
