@@ -268,12 +268,13 @@ impl HitPointGrid {
     /// level, increasing hitpoint index within a level, then the overflow list.
     #[inline]
     pub fn for_each_containing(&self, p: Vec3, mut f: impl FnMut(u32)) {
+        let p4 = p.extend(0.0);
         if let [level] = self.occupied_levels[..] {
             // One level (the common case): every entry of the bucket is of this level.
             let range = self.bucket_range(p, level);
             let entry_idx = &self.entry_idx[range.clone()];
             for (j, e) in self.entries[range].iter().enumerate() {
-                if distance_sq(p, e.truncate()) <= e.w {
+                if contains(p4, *e) {
                     f(entry_idx[j]);
                 }
             }
@@ -283,14 +284,14 @@ impl HitPointGrid {
                 let entry_idx = &self.entry_idx[range.clone()];
                 let entry_level = &self.entry_level[range.clone()];
                 for (j, e) in self.entries[range].iter().enumerate() {
-                    if distance_sq(p, e.truncate()) <= e.w && u32::from(entry_level[j]) == level {
+                    if contains(p4, *e) && u32::from(entry_level[j]) == level {
                         f(entry_idx[j]);
                     }
                 }
             }
         }
         for (e, &idx) in self.overflow.iter().zip(&self.overflow_idx) {
-            if distance_sq(p, e.truncate()) <= e.w {
+            if contains(p4, *e) {
                 f(idx);
             }
         }
@@ -494,6 +495,15 @@ fn floor_i32(v: f32) -> i32 {
     } else {
         t
     }
+}
+
+/// `|p − x|² ≤ R²` for an entry (x, R²), with the rounding of [`distance_sq`]: the lanes
+/// compute x − p (the negation of p − x, exactly) and its squares, summed as (x² + y²) + z².
+#[inline]
+fn contains(p4: Vec4, entry: Vec4) -> bool {
+    let d = entry - p4;
+    let sq = d * d;
+    sq.x + sq.y + sq.z <= entry.w
 }
 
 /// The squared distance of [`crate::within_radius`], shared so both round identically.

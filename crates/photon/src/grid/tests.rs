@@ -75,3 +75,27 @@ fn floor_i32_matches_floor_and_saturates() {
     assert_eq!(floor_i32(f32::NEG_INFINITY), i32::MIN);
     assert_eq!(floor_i32(f32::NAN), 0);
 }
+
+#[test]
+fn simd_containment_matches_within_radius() {
+    // A small xorshift, to keep the unit tests free of dev-dependencies.
+    let mut state = 0x9E37_79B9_7F4A_7C15_u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1 << 24) as f32 * 2.0 - 1.0
+    };
+    for _ in 0..100_000 {
+        let p = Vec3::new(next(), next(), next()) * 10.0;
+        let x = p + Vec3::new(next(), next(), next()) * 0.1;
+        // Radii right at the distance, so the comparisons sit on the rounding boundary.
+        let r = f64::from(distance_sq(p, x)).sqrt() * (1.0 + f64::from(next()) * 1e-7);
+        let r2 = radius_sq_down(r);
+        assert_eq!(
+            contains(p.extend(0.0), x.extend(r2)),
+            crate::within_radius(p, x, r * r),
+            "{p} {x} {r}"
+        );
+    }
+}
