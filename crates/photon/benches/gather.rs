@@ -12,8 +12,7 @@
 //! (`MeanRadius(4.0)`): 79 grid bytes per hitpoint (3.37 entries), build 0.30–0.33 s CPU single
 //! thread (0.15–0.28 s wall on 2 threads); gather 3.7–4.5 M queries/s per thread Morton-sorted,
 //! 1.3–1.5 M/s random order (CPU time); 2 threads sorted 7.2 M/s when the machine was quiet.
-//! obvhs `Bvh2` on the
-//! same setup (`crates.md`): 2.1–2.2 M/s sorted, 0.23–0.39 M/s random.
+//! obvhs `Bvh2` on the same setup (`crates.md`): 2.1–2.2 M/s sorted, 0.23–0.39 M/s random.
 #![allow(clippy::unwrap_used, clippy::print_stdout, missing_docs)]
 
 use std::sync::LazyLock;
