@@ -6,6 +6,13 @@
 //! paths, toward the light for photon paths). [`Bsdf::eval`] returns f without the cosine.
 //! All materials scatter on both sides: a reflection needs `outgoing` and `incoming` on the same
 //! side of the shading normal, whichever side that is.
+//!
+//! The glossy model is additive, like the MTL `Kd` + `Ks` it comes from:
+//! f = diffuse/π + D·G₂·F/(4 cos θₒ cos θᵢ), with GGX D, height-correlated Smith G₂ and Schlick's
+//! F = F₀ + (1 − F₀)(1 − cos θ_d)⁵ with F₀ = `reflectance`. It conserves energy when
+//! `reflectance` = 1 and `diffuse` = 0, but `diffuse + reflectance` close to 1 reflects up to ≈ 15 %
+//! more than it receives near grazing angles (Schlick grows there). Single-scattering GGX
+//! loses energy at high roughness (≈ 0.69 albedo at α = 0.5, 0.31 at α = 1, normal incidence).
 
 use std::f32::consts::{FRAC_1_PI, PI};
 
