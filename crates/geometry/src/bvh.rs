@@ -19,7 +19,7 @@ const SPHERE_BIT: u32 = 1 << 31;
 ///
 /// Triangles use the layout of obvhs' `RtTriangle` (e1 = v0 − v1, e2 = v2 − v0, ng = e1 × e2).
 /// Spheres are tagged by `ng == 0` (degenerate triangles never enter the BVH):
-/// `v0` is the centre and `e1.x` the radius.
+/// `v0` is the centre, `e1.x` the radius and `e1.y` its square.
 #[derive(Clone, Copy, Debug)]
 struct PrimGeom {
     v0: Vec3A,
@@ -59,7 +59,7 @@ impl PrimGeom {
     #[inline(always)]
     fn intersect(&self, ray: &BvhRay) -> f32 {
         if self.is_sphere() {
-            intersect_sphere(self.v0, self.e1.x, self.e1.y, ray)
+            intersect_sphere(self.v0, self.e1.y, ray)
         } else {
             self.intersect_triangle(ray)
         }
@@ -96,7 +96,7 @@ impl PrimGeom {
 
 /// Closest root in (0, tmax) of |o + t·d − c|² = r² for a unit `d` (the Ray Tracing Gems ch. 7 form).
 #[inline(always)]
-fn intersect_sphere(center: Vec3A, radius: f32, radius2: f32, ray: &BvhRay) -> f32 {
+fn intersect_sphere(center: Vec3A, radius2: f32, ray: &BvhRay) -> f32 {
     let f = ray.origin - center;
     let b = -f.dot(ray.direction);
     let l = f + b * ray.direction;
@@ -104,7 +104,6 @@ fn intersect_sphere(center: Vec3A, radius: f32, radius2: f32, ray: &BvhRay) -> f
     if disc < 0.0 {
         return f32::INFINITY;
     }
-    let _ = radius;
     let c = f.length_squared() - radius2;
     let q = b + disc.sqrt().copysign(b);
     if q == 0.0 {

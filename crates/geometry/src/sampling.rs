@@ -64,7 +64,7 @@ impl Distribution1D {
             .map(|&w| if w.is_finite() && w > 0.0 { w } else { 0.0 })
             .collect();
         let total: f64 = clean.iter().sum();
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             return None;
         }
         let mut acc = 0.0f64;

@@ -243,7 +243,7 @@ impl Bsdf {
                 let f = diffuse * FRAC_1_PI + ggx_eval(wo_up, wi_up, roughness, reflectance);
                 let pdf = p_spec * ggx_pdf(wo_up, wi_up, roughness)
                     + (1.0 - p_spec) * wi_up.z * FRAC_1_PI;
-                if !(pdf > 0.0) {
+                if pdf.is_nan() || pdf <= 0.0 {
                     return None;
                 }
                 let wi = if flip { -wi_up } else { wi_up };

@@ -87,7 +87,7 @@ impl CameraModel {
     pub fn project(&self, point: Vec3) -> Option<Vec2> {
         let v = point - self.position;
         let z = v.dot(self.forward);
-        if !(z > 0.0) {
+        if z.is_nan() || z <= 0.0 {
             return None;
         }
         let sx = v.dot(self.right) / z / (self.tan_half_fov_y * self.aspect);

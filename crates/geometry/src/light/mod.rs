@@ -400,7 +400,7 @@ impl LightSampler {
         let d = hit.position - point;
         let d2 = d.length_squared();
         let cos_light = hit.geometric_normal.dot(d).abs() / d2.sqrt();
-        if !(cos_light > 0.0) {
+        if cos_light.is_nan() || cos_light <= 0.0 {
             return 0.0;
         }
         self.distribution.pmf(idx as usize) * d2 / (cos_light * area)
@@ -416,7 +416,7 @@ impl LightSampler {
         u_dir: Vec2,
     ) -> Option<EmissionSample> {
         let (idx, p_light) = self.distribution.sample(u_light);
-        if !(p_light > 0.0) {
+        if p_light.is_nan() || p_light <= 0.0 {
             return None;
         }
         let sample = match self.emitters[idx] {
