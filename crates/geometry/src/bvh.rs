@@ -12,6 +12,10 @@ use obvhs::{
 
 use crate::{Ray, Sphere, Triangle};
 
+/// obvhs' CwBvh skips child boxes that the ray leaves before this distance (`EPSILON` in
+/// `cwbvh/node.rs`); see [`Accel::near_ray`].
+const CWBVH_CULL: f32 = 1e-4;
+
 /// Marks sphere ids in [`Accel::ids`]; the low bits hold the sphere index.
 const SPHERE_BIT: u32 = 1 << 31;
 
@@ -55,7 +59,7 @@ impl PrimGeom {
         self.ng.cmpeq(Vec3A::ZERO).all()
     }
 
-    /// Ray parameter of the closest intersection in [0, ray.tmax) (triangles) or (0, ray.tmax) (spheres), or ∞.
+    /// Ray parameter of the closest intersection in [tmin, tmax) (triangles) or (tmin, tmax) (spheres), or ∞.
     #[inline(always)]
     fn intersect(&self, ray: &BvhRay) -> f32 {
         if self.is_sphere() {
@@ -76,9 +80,9 @@ impl PrimGeom {
         let w = 1.0 - u - v;
         if u >= 0.0 && v >= 0.0 && w >= 0.0 && inv_det.is_finite() {
             let t = self.ng.dot(c) * inv_det;
-            // t = 0 counts: spawned origins sit strictly off their own surface, but may lie exactly
-            // on an adjacent wall at a corner, and must not slip through it.
-            if t >= 0.0 && t < ray.tmax {
+            // t = tmin counts: spawned origins sit strictly off their own surface, but may lie
+            // exactly on an adjacent wall at a corner, and must not slip through it.
+            if t >= ray.tmin && t < ray.tmax {
                 return t;
             }
         }
@@ -94,7 +98,7 @@ impl PrimGeom {
     }
 }
 
-/// Closest root in (0, tmax) of |o + t·d − c|² = r² for a unit `d` (the Ray Tracing Gems ch. 7 form).
+/// Closest root in (tmin, tmax) of |o + t·d − c|² = r² for a unit `d` (the Ray Tracing Gems ch. 7 form).
 #[inline(always)]
 fn intersect_sphere(center: Vec3A, radius2: f32, ray: &BvhRay) -> f32 {
     let f = ray.origin - center;
@@ -113,9 +117,9 @@ fn intersect_sphere(center: Vec3A, radius2: f32, ray: &BvhRay) -> f32 {
         let a = c / q;
         if a < q { (a, q) } else { (q, a) }
     };
-    if t0 > 0.0 && t0 < ray.tmax {
+    if t0 > ray.tmin && t0 < ray.tmax {
         t0
-    } else if t1 > 0.0 && t1 < ray.tmax {
+    } else if t1 > ray.tmin && t1 < ray.tmax {
         t1
     } else {
         f32::INFINITY
@@ -203,23 +207,61 @@ impl Accel {
         }
     }
 
-    fn to_bvh_ray(ray: &Ray) -> BvhRay {
-        // `+ 0.0` turns -0.0 into +0.0 (crates.md G1).
+    /// The ray for obvhs (`-0.0` direction components become +0.0, crates.md G1).
+    #[inline(always)]
+    fn bvh_ray(ray: &Ray) -> BvhRay {
         let direction = Vec3A::from(ray.direction) + Vec3A::ZERO;
         BvhRay::new(Vec3A::from(ray.origin), direction, 0.0, ray.t_max)
     }
 
-    /// The closest hit with 0 < t < `ray.t_max`.
+    /// The ray for the near query, its origin moved back by `shift` > [`CWBVH_CULL`] along the
+    /// direction, covering t ∈ [0, min(`CWBVH_CULL`, t_max)) as t′ ∈ [shift, …); and the shift as rounded.
+    ///
+    /// obvhs' CwBvh culls every child box whose exit distance is below `EPSILON = 1e-4` (absolute,
+    /// in `cwbvh/node.rs`), so the main query misses hits closer than that when their (flat) leaf box
+    /// ends within 1e-4: a ray spawned next to a corner would slip through the adjacent wall.
+    /// From the moved origin those hits lie beyond the culled range. Node and primitive tests see the
+    /// same (rounded) ray, so they agree; the rounding costs an error of about an ulp of the coordinates
+    /// divided by the sine of the hit angle in the returned t, which only the near query pays.
+    #[inline(always)]
+    fn near_ray(ray: &BvhRay, t_max: f32) -> (BvhRay, f32) {
+        let shift = 2.0 * CWBVH_CULL + 16.0 * f32::EPSILON * ray.origin.abs().max_element();
+        let moved = ray.origin - shift * ray.direction;
+        // The shift actually applied, after rounding of the moved origin.
+        let shift = (ray.origin - moved).dot(ray.direction);
+        let t_max = t_max.min(1.01 * CWBVH_CULL);
+        (
+            BvhRay::new(moved, ray.direction, shift, t_max + shift),
+            shift,
+        )
+    }
+
+    /// The closest hit with 0 ≤ t < `ray.t_max` (t > 0 for spheres).
     #[inline]
     pub(crate) fn intersect(&self, ray: &Ray) -> Option<RawHit> {
         let bvh = self.bvh.as_ref()?;
         if !(ray.direction.is_finite() && ray.origin.is_finite()) {
             return None;
         }
-        let bray = Self::to_bvh_ray(ray);
-        let mut hit = RayHit::none();
+        let bray = Self::bvh_ray(ray);
         let prims = &self.prims;
-        if !bvh.ray_traverse(bray, &mut hit, |r, id| prims[id].intersect(r)) {
+        let mut hit = RayHit::none();
+        let mut t = f32::INFINITY;
+        let mut hit_ray = bray;
+        if bvh.ray_traverse(bray, &mut hit, |r, id| prims[id].intersect(r)) {
+            t = hit.t;
+        }
+        if t >= CWBVH_CULL {
+            // Look for hits the main query culled.
+            let (near, shift) = Self::near_ray(&bray, ray.t_max);
+            let mut near_hit = RayHit::none();
+            if bvh.ray_traverse(near, &mut near_hit, |r, id| prims[id].intersect(r)) {
+                hit = near_hit;
+                t = (near_hit.t - shift).max(0.0);
+                hit_ray = near;
+            }
+        }
+        if !t.is_finite() {
             return None;
         }
         let slot = hit.primitive_id as usize;
@@ -227,20 +269,20 @@ impl Accel {
         if id & SPHERE_BIT != 0 {
             Some(RawHit::Sphere {
                 index: id & !SPHERE_BIT,
-                t: hit.t,
+                t,
             })
         } else {
-            let (b1, b2) = prims[slot].barycentrics(bray.origin, bray.direction);
+            let (b1, b2) = prims[slot].barycentrics(hit_ray.origin, hit_ray.direction);
             Some(RawHit::Triangle {
                 index: id,
-                t: hit.t,
+                t,
                 b1,
                 b2,
             })
         }
     }
 
-    /// Whether anything is hit with 0 < t < `ray.t_max`.
+    /// Whether anything is hit with 0 ≤ t < `ray.t_max` (t > 0 for spheres).
     #[inline]
     pub(crate) fn occluded(&self, ray: &Ray) -> bool {
         let Some(bvh) = self.bvh.as_ref() else {
@@ -249,8 +291,13 @@ impl Accel {
         if !(ray.direction.is_finite() && ray.origin.is_finite()) {
             return false;
         }
+        let bray = Self::bvh_ray(ray);
         let prims = &self.prims;
-        !bvh.ray_traverse_miss(Self::to_bvh_ray(ray), |r, id| prims[id].intersect(r))
+        if !bvh.ray_traverse_miss(bray, |r, id| prims[id].intersect(r)) {
+            return true;
+        }
+        let (near, _) = Self::near_ray(&bray, ray.t_max);
+        !bvh.ray_traverse_miss(near, |r, id| prims[id].intersect(r))
     }
 
     /// Number of primitives in the BVH.

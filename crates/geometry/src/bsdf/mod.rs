@@ -228,6 +228,9 @@ impl Bsdf {
                 roughness,
                 diffuse,
             } => {
+                if reflectance == Rgb::ZERO && diffuse == Rgb::ZERO {
+                    return None;
+                }
                 let flip = wo.z < 0.0;
                 let wo_up = if flip { -wo } else { wo };
                 let p_spec = specular_probability(reflectance, diffuse);

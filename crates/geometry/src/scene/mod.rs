@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use glam::{Vec2, Vec3};
 
 use crate::{
-    Aabb, CameraModel, Hit, LightSample, LightSampler, Material, Primitive, Ray, Rgb,
+    Aabb, Bsdf, CameraModel, Hit, LightSample, LightSampler, Material, Primitive, Ray, Rgb,
     SceneDescription,
     bvh::{Accel, RawHit},
 };
@@ -242,6 +242,12 @@ impl Scene {
         } else {
             !self.occluded(&from.spawn_ray(sample.incoming))
         }
+    }
+
+    /// The BSDF at `hit` (see [`Bsdf::new`]); `None` if the hit's material index is out of range.
+    #[inline]
+    pub fn bsdf(&self, hit: &Hit) -> Option<Bsdf> {
+        self.material(hit.material).map(|m| Bsdf::new(m, hit))
     }
 
     /// Radiance emitted at `hit` back along the ray: the material's emission on a front face, else zero.

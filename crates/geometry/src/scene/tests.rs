@@ -305,7 +305,7 @@ fn no_self_intersection_on_walls() {
                 }
                 let next = scene
                     .intersect(&hit.spawn_ray(d))
-                    .expect("a closed box has no leaks");
+                    .unwrap_or_else(|| panic!("leak at {offset}: {hit:?} {:?}", hit.spawn_ray(d)));
                 // A ray leaving a planar wall cannot hit the same plane.
                 assert!(
                     next.t > 1e-4 * (1.0 + offset.abs().max_element())
@@ -351,7 +351,9 @@ fn corners_neither_leak_nor_block() {
                 .unwrap();
             assert!(
                 scene.visible(&from_floor, wall_hit.position),
-                "corner blocked ({k}, eps {eps}, offset {offset})"
+                "corner blocked ({k}, eps {eps}, offset {offset}): {from_floor:?} {wall_hit:?} {:?} {:?}",
+                from_floor.spawn_ray_to(wall_hit.position),
+                scene.intersect(&from_floor.spawn_ray_to(wall_hit.position))
             );
             assert!(scene.visible(&wall_hit, from_floor.position));
             // Just outside the box is never visible from inside.
@@ -452,4 +454,35 @@ fn emitted_only_from_front_faces() {
         .intersect(&Ray::infinite(Vec3::new(0.5, 0.5, -1.0), Vec3::Z))
         .unwrap();
     assert_eq!(scene.emitted(&back), Vec3::ZERO);
+}
+
+/// obvhs' CwBvh culls boxes the ray leaves within 1e-4; hits that close must still be found.
+#[test]
+fn hits_closer_than_obvhs_epsilon() {
+    let mut tris = quad(Vec3::new(-1.0, 0.0, 1.0), Vec3::X * 2.0, -Vec3::Z * 2.0, 0).to_vec();
+    tris.extend(quad(
+        Vec3::new(-1.0, 0.5, 1.0),
+        Vec3::X * 2.0,
+        -Vec3::Z * 2.0,
+        0,
+    ));
+    let scene = Scene::new(description(tris, vec![], vec![point_light(Vec3::Y)])).unwrap();
+    for height in [1e-3f32, 1e-4, 2.4e-5, 1e-6, 1e-8] {
+        for dir in [-Vec3::Y, Vec3::new(0.7, -0.44, 0.56).normalize()] {
+            let ray = Ray::infinite(Vec3::new(0.155, height, 0.634), dir);
+            let hit = scene
+                .intersect(&ray)
+                .unwrap_or_else(|| panic!("missed at {height}"));
+            assert!(
+                (hit.t - height / -dir.y).abs() < 1e-6,
+                "{height}: {}",
+                hit.t
+            );
+            assert!(scene.occluded(&ray));
+            assert!(!scene.occluded(&Ray {
+                t_max: 0.5 * hit.t,
+                ..ray
+            }));
+        }
+    }
 }
