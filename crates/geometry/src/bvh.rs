@@ -12,9 +12,33 @@ use obvhs::{
 
 use crate::{Ray, Sphere, Triangle};
 
-/// obvhs' CwBvh skips child boxes that the ray leaves before this distance (`EPSILON` in
-/// `cwbvh/node.rs`); see [`Accel::near_ray`].
-const CWBVH_CULL: f32 = 1e-4;
+/// Padding of every primitive's box, in internal units.
+///
+/// obvhs' CwBvh skips child boxes that the ray leaves before t = 1e-4 (`EPSILON`, absolute, in
+/// `cwbvh/node.rs`), so a hit closer than that would be missed when its (flat) box ends there:
+/// a ray spawned next to a corner would slip through the adjacent wall. Boxes padded by more than
+/// 1e-4 are left at least 1e-4 after any hit inside them, so nothing is culled that can be hit at
+/// t ≥ 0. The scene is scaled (exactly, by a power of two) to coordinates of about 2¹⁰ internally,
+/// which makes the padding negligible (≈ 10⁻⁷ of the scene) at any scene scale.
+const CWBVH_PAD: f32 = 2e-4;
+
+/// The power of two that brings the largest coordinate magnitude of the scene to [2⁹, 2¹⁰).
+fn internal_scale(triangles: &[Triangle], spheres: &[Sphere]) -> f32 {
+    let mut max = 0.0f32;
+    for t in triangles {
+        for p in t.positions {
+            max = max.max(p.abs().max_element());
+        }
+    }
+    for s in spheres {
+        max = max.max(s.center.abs().max_element() + s.radius);
+    }
+    if !(max.is_finite() && max > 0.0) {
+        return 1.0;
+    }
+    let k = (10 - max.log2().ceil() as i32).clamp(-100, 100);
+    2f32.powi(k)
+}
 
 /// Marks sphere ids in [`Accel::ids`]; the low bits hold the sphere index.
 const SPHERE_BIT: u32 = 1 << 31;
@@ -149,32 +173,42 @@ pub(crate) struct Accel {
     prims: Vec<PrimGeom>,
     /// BVH order → triangle index, or `SPHERE_BIT | sphere index`.
     ids: Vec<u32>,
+    /// Power of two by which world coordinates are multiplied (exactly) to get internal ones.
+    scale: f32,
 }
 
 impl Accel {
     /// Builds the BVH over every non-degenerate triangle and every sphere.
     pub(crate) fn build(triangles: &[Triangle], spheres: &[Sphere]) -> Self {
+        let scale = internal_scale(triangles, spheres);
         let mut prims = Vec::with_capacity(triangles.len() + spheres.len());
         let mut ids = Vec::with_capacity(triangles.len() + spheres.len());
         let mut aabbs = Vec::with_capacity(triangles.len() + spheres.len());
+        let padded = |lo: Vec3A, hi: Vec3A| {
+            let pad = CWBVH_PAD + 4.0 * f32::EPSILON * lo.abs().max(hi.abs()).max_element();
+            BvhAabb::new(lo - Vec3A::splat(pad), hi + Vec3A::splat(pad))
+        };
         for (i, tri) in triangles.iter().enumerate() {
-            let g = PrimGeom::triangle(tri.positions);
+            let p = tri.positions.map(|v| v * scale);
+            let g = PrimGeom::triangle(p);
             if g.is_sphere() || !g.ng.is_finite() {
                 continue;
             }
-            let p = tri.positions.map(Vec3A::from);
-            aabbs.push(BvhAabb::new(
-                p[0].min(p[1]).min(p[2]),
-                p[0].max(p[1]).max(p[2]),
-            ));
+            let p = p.map(Vec3A::from);
+            aabbs.push(padded(p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2])));
             prims.push(g);
             ids.push(i as u32);
         }
         for (i, s) in spheres.iter().enumerate() {
+            let s = Sphere {
+                center: s.center * scale,
+                radius: s.radius * scale,
+                material: s.material,
+            };
             let c = Vec3A::from(s.center);
             let r = Vec3A::splat(s.radius);
-            aabbs.push(BvhAabb::new(c - r, c + r));
-            prims.push(PrimGeom::sphere(s));
+            aabbs.push(padded(c - r, c + r));
+            prims.push(PrimGeom::sphere(&s));
             ids.push(i as u32 | SPHERE_BIT);
         }
         if prims.is_empty() {
@@ -182,13 +216,10 @@ impl Accel {
                 bvh: None,
                 prims,
                 ids,
+                scale,
             };
         }
-        let bvh = build_cwbvh(
-            &aabbs,
-            BvhBuildParams::medium_build(),
-            &mut Duration::ZERO.clone(),
-        );
+        let bvh = build_cwbvh(&aabbs, BvhBuildParams::medium_build(), &mut Duration::ZERO);
         // Reorder the primitives into BVH order (crates.md G2) so that leaf ids index them directly.
         let prims = bvh
             .primitive_indices
@@ -204,35 +235,20 @@ impl Accel {
             bvh: Some(bvh),
             prims,
             ids,
+            scale,
         }
     }
 
-    /// The ray for obvhs (`-0.0` direction components become +0.0, crates.md G1).
+    /// The ray for obvhs, in the internal (scaled) space. `-0.0` direction components become +0.0
+    /// (crates.md G1).
     #[inline(always)]
-    fn bvh_ray(ray: &Ray) -> BvhRay {
+    fn bvh_ray(&self, ray: &Ray) -> BvhRay {
         let direction = Vec3A::from(ray.direction) + Vec3A::ZERO;
-        BvhRay::new(Vec3A::from(ray.origin), direction, 0.0, ray.t_max)
-    }
-
-    /// The ray for the near query, its origin moved back by `shift` > [`CWBVH_CULL`] along the
-    /// direction, covering t ∈ [0, min(`CWBVH_CULL`, t_max)) as t′ ∈ [shift, …); and the shift as rounded.
-    ///
-    /// obvhs' CwBvh culls every child box whose exit distance is below `EPSILON = 1e-4` (absolute,
-    /// in `cwbvh/node.rs`), so the main query misses hits closer than that when their (flat) leaf box
-    /// ends within 1e-4: a ray spawned next to a corner would slip through the adjacent wall.
-    /// From the moved origin those hits lie beyond the culled range. Node and primitive tests see the
-    /// same (rounded) ray, so they agree; the rounding costs an error of about an ulp of the coordinates
-    /// divided by the sine of the hit angle in the returned t, which only the near query pays.
-    #[inline(always)]
-    fn near_ray(ray: &BvhRay, t_max: f32) -> (BvhRay, f32) {
-        let shift = 2.0 * CWBVH_CULL + 16.0 * f32::EPSILON * ray.origin.abs().max_element();
-        let moved = ray.origin - shift * ray.direction;
-        // The shift actually applied, after rounding of the moved origin.
-        let shift = (ray.origin - moved).dot(ray.direction);
-        let t_max = t_max.min(1.01 * CWBVH_CULL);
-        (
-            BvhRay::new(moved, ray.direction, shift, t_max + shift),
-            shift,
+        BvhRay::new(
+            Vec3A::from(ray.origin * self.scale),
+            direction,
+            0.0,
+            ray.t_max * self.scale,
         )
     }
 
@@ -243,27 +259,13 @@ impl Accel {
         if !(ray.direction.is_finite() && ray.origin.is_finite()) {
             return None;
         }
-        let bray = Self::bvh_ray(ray);
+        let bray = self.bvh_ray(ray);
         let prims = &self.prims;
         let mut hit = RayHit::none();
-        let mut t = f32::INFINITY;
-        let mut hit_ray = bray;
-        if bvh.ray_traverse(bray, &mut hit, |r, id| prims[id].intersect(r)) {
-            t = hit.t;
-        }
-        if t >= CWBVH_CULL {
-            // Look for hits the main query culled.
-            let (near, shift) = Self::near_ray(&bray, ray.t_max);
-            let mut near_hit = RayHit::none();
-            if bvh.ray_traverse(near, &mut near_hit, |r, id| prims[id].intersect(r)) {
-                hit = near_hit;
-                t = (near_hit.t - shift).max(0.0);
-                hit_ray = near;
-            }
-        }
-        if !t.is_finite() {
+        if !bvh.ray_traverse(bray, &mut hit, |r, id| prims[id].intersect(r)) {
             return None;
         }
+        let t = hit.t / self.scale;
         let slot = hit.primitive_id as usize;
         let id = self.ids[slot];
         if id & SPHERE_BIT != 0 {
@@ -272,7 +274,7 @@ impl Accel {
                 t,
             })
         } else {
-            let (b1, b2) = prims[slot].barycentrics(hit_ray.origin, hit_ray.direction);
+            let (b1, b2) = prims[slot].barycentrics(bray.origin, bray.direction);
             Some(RawHit::Triangle {
                 index: id,
                 t,
@@ -291,13 +293,8 @@ impl Accel {
         if !(ray.direction.is_finite() && ray.origin.is_finite()) {
             return false;
         }
-        let bray = Self::bvh_ray(ray);
         let prims = &self.prims;
-        if !bvh.ray_traverse_miss(bray, |r, id| prims[id].intersect(r)) {
-            return true;
-        }
-        let (near, _) = Self::near_ray(&bray, ray.t_max);
-        !bvh.ray_traverse_miss(near, |r, id| prims[id].intersect(r))
+        !bvh.ray_traverse_miss(self.bvh_ray(ray), |r, id| prims[id].intersect(r))
     }
 
     /// Number of primitives in the BVH.
