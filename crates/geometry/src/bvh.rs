@@ -219,7 +219,8 @@ impl Accel {
                 scale,
             };
         }
-        let bvh = build_cwbvh(&aabbs, BvhBuildParams::medium_build(), &mut Duration::ZERO);
+        let mut build_time = Duration::ZERO;
+        let bvh = build_cwbvh(&aabbs, BvhBuildParams::medium_build(), &mut build_time);
         // Reorder the primitives into BVH order (crates.md G2) so that leaf ids index them directly.
         let prims = bvh
             .primitive_indices
