@@ -1,5 +1,14 @@
-//! Scenes, loaders, materials, lights, camera and BVH (work in progress for the issue
-//! "`geometry`: load real scenes (TOML, OBJ+MTL, glTF), materials, lights, camera, and a fast obvhs BVH").
+//! Scenes, loaders, materials, lights, camera and BVH.
+//!
+//! The principal type is [`Scene`], built from a plain [`SceneDescription`] by [`Scene::new`].
+//! It answers closest-hit ([`Scene::intersect`]) and shadow ([`Scene::occluded`]) queries through one
+//! obvhs CwBvh over triangles and analytic spheres, and owns the [`CameraModel`] and the
+//! [`LightSampler`]. Materials become [`Bsdf`]s at a [`Hit`].
+//!
+//! Conventions: directions point away from surfaces (pbrt); a [`Hit`]'s normals face the side the ray
+//! came from and `front_face` says whether that is the primitive's front (counter-clockwise triangle
+//! side, sphere outside); curvature is signed as in frequency-algebra §3 (positive = concave seen from
+//! the ray's side); secondary rays are spawned with pbrt-v4's error-bound origin offset.
 //!
 //! The loaders turn a scene file into a plain [`SceneDescription`]:
 //! [`load`] picks the loader by extension (`.toml` scene files of format version 1, lone
@@ -23,18 +32,36 @@
 //! - zero-area triangles are skipped and counted in [`LoadNotes::degenerate_triangles`];
 //!   an emissive material left with no area is an error ([`LoadError::ZeroAreaEmitter`]).
 
+mod aabb;
+mod bsdf;
+mod bvh;
+mod camera;
 mod description;
 mod error;
+mod frame;
+mod light;
 mod load;
+mod ray;
+mod sampling;
+mod scene;
 mod summary;
+#[cfg(test)]
+mod test_util;
 
+pub use aabb::Aabb;
+pub use bsdf::{Bsdf, BsdfSample, Lobe, TransportMode, fresnel_dielectric};
+pub use camera::CameraModel;
 pub use description::{
     Camera, Film, Light, LoadNotes, Material, MaterialKind, RenderDefaults, Rgb, SceneDescription,
     Sphere, Triangle,
 };
 pub use error::LoadError;
+pub use frame::Frame;
+pub use light::{EmissionSample, EmitterShape, LightSample, LightSampler};
 pub use load::{
     DEFAULT_ALBEDO, DEFAULT_FILM_HEIGHT, DEFAULT_FILM_WIDTH, FRAMED_FOV_Y_DEGREES, LoadOptions,
     MAX_FILM_SIDE, METALLIC_THRESHOLD, load, load_toml_str, load_toml_str_with, load_with,
 };
+pub use ray::{Hit, Primitive, Ray};
+pub use scene::{Scene, SceneError};
 pub use summary::{Bounds, CameraSummary, F6, LightCounts, MaterialSummary, Rgb6, SceneSummary};

@@ -1,0 +1,565 @@
+//! Light sampling: next-event estimation toward lights and emission sampling for photons.
+//!
+//! Every light is an *emitter*: a point, spot or directional light of the description, or one
+//! emissive triangle (front face only) or emissive sphere (outward only). Emitters are chosen with
+//! probability proportional to the luminance of their total power:
+//! - point: 4π·I;
+//! - spot: 2π·I·((1 − cos θ_start) + (cos θ_start − cos θ_cone)/2), exact for the smoothstep falloff;
+//! - directional: π·r²·E over the disc of radius r that covers the scene's bounding sphere;
+//! - area: π·L·A (a Lambertian emitter).
+//!
+//! Spot falloff (pbrt-v4): intensity × smoothstep(cos θ; cos θ_cone, cos θ_start), i.e. full inside
+//! `falloff_start`, zero outside `cone_angle`, a smoothstep in cos θ between.
+
+use std::f32::consts::PI;
+
+use glam::{Vec2, Vec3};
+
+use crate::{
+    Aabb, Frame, Hit, Light, Primitive, Ray, Rgb, SceneDescription,
+    bsdf::luminance,
+    ray::offset_ray_origin,
+    sampling::{
+        Distribution1D, concentric_disk, cosine_hemisphere, uniform_cone, uniform_sphere,
+        uniform_triangle,
+    },
+};
+
+#[cfg(test)]
+mod tests;
+
+/// What emitted a photon, for the frequency analysis of the emitted light field.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EmitterShape {
+    /// An area emitter (triangle or sphere).
+    Area {
+        /// Linear size of the emitter: √area for a triangle, the diameter for a sphere.
+        size: f32,
+        /// Cosine between the emitted direction and the emitter's normal.
+        cos_theta: f32,
+    },
+    /// A point light.
+    Point,
+    /// A spot light.
+    Spot {
+        /// Half-angle of the cone in radians.
+        cone_angle: f32,
+        /// Half-angle in radians up to which the intensity is full.
+        falloff_start: f32,
+    },
+    /// A directional light (photons start on a disc covering the scene).
+    Directional,
+}
+
+/// A direction toward a light for next-event estimation at a point.
+///
+/// The estimate of the reflected radiance is f·|cos θ|·`radiance`/`pdf` when the light is visible
+/// (see [`crate::Scene::light_visible`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightSample {
+    /// Unit direction from the point toward the light.
+    pub incoming: Vec3,
+    /// Distance to the sampled point on the light; ∞ for a directional light.
+    pub distance: f32,
+    /// Incident radiance for area emitters; for delta lights the incident irradiance on a surface
+    /// facing the light (I·falloff/d² or E).
+    pub radiance: Rgb,
+    /// Solid-angle density (including the probability of choosing the light); for delta lights
+    /// just the probability of choosing the light.
+    pub pdf: f32,
+    /// Whether the light is a delta light (point, spot, directional): no BSDF sample can hit it.
+    pub is_delta: bool,
+}
+
+/// A photon leaving a light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EmissionSample {
+    /// Point on the light (on the disc for a directional light).
+    pub origin: Vec3,
+    /// Unit direction of travel.
+    pub direction: Vec3,
+    /// Flux carried, already divided by all sampling densities: the mean of `power` over N photons
+    /// estimates the total emitted flux ([`LightSampler::total_power`]).
+    pub power: Rgb,
+    /// Emitter normal (front face of area emitters; the travel direction for the other lights).
+    pub normal: Vec3,
+    /// What emitted the photon.
+    pub emitter: EmitterShape,
+    /// Bound on the floating-point error of `origin`, used by [`EmissionSample::ray`].
+    origin_error: Vec3,
+}
+
+impl EmissionSample {
+    /// The photon's ray, with its origin pushed off an area emitter so it cannot hit it at t ≈ 0.
+    pub fn ray(&self) -> Ray {
+        Ray::infinite(
+            offset_ray_origin(self.origin, self.origin_error, self.normal, self.direction),
+            self.direction,
+        )
+    }
+}
+
+/// One emitter, ready for sampling.
+#[derive(Clone, Copy, Debug)]
+enum Emitter {
+    Point {
+        position: Vec3,
+        intensity: Rgb,
+    },
+    Spot {
+        position: Vec3,
+        frame: Frame,
+        intensity: Rgb,
+        cos_cone: f32,
+        cos_start: f32,
+        cone_angle: f32,
+        falloff_start: f32,
+    },
+    Directional {
+        frame: Frame,
+        irradiance: Rgb,
+        center: Vec3,
+        radius: f32,
+    },
+    Triangle {
+        p0: Vec3,
+        e1: Vec3,
+        e2: Vec3,
+        normal: Vec3,
+        area: f32,
+        radiance: Rgb,
+    },
+    Sphere {
+        center: Vec3,
+        radius: f32,
+        radiance: Rgb,
+    },
+}
+
+/// All emitters of a scene and the distribution that picks them by power.
+#[derive(Clone, Debug)]
+pub struct LightSampler {
+    emitters: Vec<Emitter>,
+    powers: Vec<Rgb>,
+    distribution: Distribution1D,
+    /// Emitter index per triangle (`u32::MAX` for none); empty if no triangle emits.
+    triangle_emitter: Vec<u32>,
+    /// Emitter index per sphere (`u32::MAX` for none); empty if no sphere emits.
+    sphere_emitter: Vec<u32>,
+}
+
+impl LightSampler {
+    /// Collects the emitters; `Err(None)` if none has positive power, `Err(Some(what))` for an
+    /// invalid light.
+    pub(crate) fn new(desc: &SceneDescription, bounds: Aabb) -> Result<Self, Option<String>> {
+        let mut emitters = Vec::new();
+        let rgb_ok = |c: Rgb| c.is_finite() && c.cmpge(Rgb::ZERO).all();
+        for (i, light) in desc.lights.iter().enumerate() {
+            match *light {
+                Light::Point {
+                    position,
+                    intensity,
+                } => {
+                    if !(position.is_finite() && rgb_ok(intensity)) {
+                        return Err(Some(format!("point light {i}")));
+                    }
+                    emitters.push(Emitter::Point {
+                        position,
+                        intensity,
+                    });
+                }
+                Light::Spot {
+                    position,
+                    direction,
+                    intensity,
+                    cone_angle,
+                    falloff_start,
+                } => {
+                    let axis = direction.try_normalize();
+                    let ok = position.is_finite()
+                        && rgb_ok(intensity)
+                        && cone_angle > 0.0
+                        && cone_angle <= PI
+                        && falloff_start.is_finite();
+                    let (Some(axis), true) = (axis, ok) else {
+                        return Err(Some(format!("spot light {i}")));
+                    };
+                    let falloff_start = falloff_start.clamp(0.0, cone_angle);
+                    emitters.push(Emitter::Spot {
+                        position,
+                        frame: Frame::from_normal(axis),
+                        intensity,
+                        cos_cone: cone_angle.cos(),
+                        cos_start: falloff_start.cos(),
+                        cone_angle,
+                        falloff_start,
+                    });
+                }
+                Light::Directional {
+                    direction,
+                    irradiance,
+                } => {
+                    let (Some(axis), true) = (direction.try_normalize(), rgb_ok(irradiance)) else {
+                        return Err(Some(format!("directional light {i}")));
+                    };
+                    emitters.push(Emitter::Directional {
+                        frame: Frame::from_normal(axis),
+                        irradiance,
+                        center: bounds.center(),
+                        radius: bounds.bounding_radius().max(1e-3),
+                    });
+                }
+            }
+        }
+        let emission = |m: u32| {
+            desc.materials
+                .get(m as usize)
+                .map(|m| m.emission)
+                .filter(|e| e.cmpgt(Rgb::ZERO).any() && rgb_ok(*e))
+        };
+        let mut triangle_emitter = Vec::new();
+        for (i, tri) in desc.triangles.iter().enumerate() {
+            let Some(radiance) = emission(tri.material) else {
+                continue;
+            };
+            let [p0, p1, p2] = tri.positions;
+            let (e1, e2) = (p1 - p0, p2 - p0);
+            let n = e1.cross(e2);
+            let area = 0.5 * n.length();
+            if !(area > 0.0 && area.is_finite()) {
+                continue;
+            }
+            if triangle_emitter.is_empty() {
+                triangle_emitter = vec![u32::MAX; desc.triangles.len()];
+            }
+            triangle_emitter[i] = emitters.len() as u32;
+            emitters.push(Emitter::Triangle {
+                p0,
+                e1,
+                e2,
+                normal: n / (2.0 * area),
+                area,
+                radiance,
+            });
+        }
+        let mut sphere_emitter = Vec::new();
+        for (i, s) in desc.spheres.iter().enumerate() {
+            let Some(radiance) = emission(s.material) else {
+                continue;
+            };
+            if sphere_emitter.is_empty() {
+                sphere_emitter = vec![u32::MAX; desc.spheres.len()];
+            }
+            sphere_emitter[i] = emitters.len() as u32;
+            emitters.push(Emitter::Sphere {
+                center: s.center,
+                radius: s.radius,
+                radiance,
+            });
+        }
+        let powers: Vec<Rgb> = emitters.iter().map(Emitter::power).collect();
+        let weights: Vec<f64> = powers.iter().map(|&p| f64::from(luminance(p))).collect();
+        let distribution = Distribution1D::new(&weights).ok_or(None)?;
+        Ok(Self {
+            emitters,
+            powers,
+            distribution,
+            triangle_emitter,
+            sphere_emitter,
+        })
+    }
+
+    /// Number of emitters (lights plus emissive triangles and spheres).
+    pub fn emitter_count(&self) -> usize {
+        self.emitters.len()
+    }
+
+    /// Total emitted flux (W per channel) of emitter `idx`; zero if out of range.
+    pub fn emitter_power(&self, idx: usize) -> Rgb {
+        self.powers.get(idx).copied().unwrap_or(Rgb::ZERO)
+    }
+
+    /// Total emitted flux of the scene (W per channel).
+    pub fn total_power(&self) -> Rgb {
+        self.powers.iter().copied().sum()
+    }
+
+    /// Samples a direction toward a light as seen from `point`: `u_light` ∈ [0, 1) picks the emitter
+    /// by power, `u` ∈ [0, 1)² the point on it. `None` when the sample carries nothing (outside a spot
+    /// cone, behind a one-sided emitter).
+    pub fn sample_direct(&self, point: Vec3, u_light: f32, u: Vec2) -> Option<LightSample> {
+        let (idx, p_light) = self.distribution.sample(u_light);
+        let (target, radiance, pdf_area_to_solid) = match self.emitters[idx] {
+            Emitter::Point {
+                position,
+                intensity,
+            } => {
+                let d = position - point;
+                let d2 = d.length_squared();
+                return (d2 > 0.0).then(|| LightSample {
+                    incoming: d / d2.sqrt(),
+                    distance: d2.sqrt(),
+                    radiance: intensity / d2,
+                    pdf: p_light,
+                    is_delta: true,
+                });
+            }
+            Emitter::Spot {
+                position,
+                frame,
+                intensity,
+                cos_cone,
+                cos_start,
+                ..
+            } => {
+                let d = position - point;
+                let d2 = d.length_squared();
+                let dist = d2.sqrt();
+                let incoming = d / dist;
+                let falloff = spot_falloff(-incoming.dot(frame.n), cos_cone, cos_start);
+                return (d2 > 0.0 && falloff > 0.0).then(|| LightSample {
+                    incoming,
+                    distance: dist,
+                    radiance: intensity * (falloff / d2),
+                    pdf: p_light,
+                    is_delta: true,
+                });
+            }
+            Emitter::Directional {
+                frame, irradiance, ..
+            } => {
+                return Some(LightSample {
+                    incoming: -frame.n,
+                    distance: f32::INFINITY,
+                    radiance: irradiance,
+                    pdf: p_light,
+                    is_delta: true,
+                });
+            }
+            Emitter::Triangle {
+                p0,
+                e1,
+                e2,
+                normal,
+                area,
+                radiance,
+            } => {
+                let b = uniform_triangle(u);
+                (p0 + b.x * e1 + b.y * e2, radiance, (normal, area))
+            }
+            Emitter::Sphere {
+                center,
+                radius,
+                radiance,
+            } => {
+                let n = uniform_sphere(u);
+                (
+                    center + radius * n,
+                    radiance,
+                    (n, 4.0 * PI * radius * radius),
+                )
+            }
+        };
+        let (normal, area) = pdf_area_to_solid;
+        let d = target - point;
+        let d2 = d.length_squared();
+        let distance = d2.sqrt();
+        let incoming = d / distance;
+        let cos_light = -incoming.dot(normal);
+        if !(cos_light > 0.0 && d2 > 0.0) {
+            return None;
+        }
+        let pdf = p_light * d2 / (cos_light * area);
+        pdf.is_finite().then_some(LightSample {
+            incoming,
+            distance,
+            radiance,
+            pdf,
+            is_delta: false,
+        })
+    }
+
+    /// Solid-angle density with which [`LightSampler::sample_direct`] at `point` draws the point of
+    /// `hit` on an emitter (for multiple importance sampling); zero if `hit` is not on an emitting front face.
+    pub fn pdf_direct(&self, point: Vec3, hit: &Hit) -> f32 {
+        if !hit.front_face {
+            return 0.0;
+        }
+        let idx = match hit.primitive {
+            Primitive::Triangle(i) => self.triangle_emitter.get(i as usize),
+            Primitive::Sphere(i) => self.sphere_emitter.get(i as usize),
+        };
+        let Some(&idx) = idx.filter(|&&i| i != u32::MAX) else {
+            return 0.0;
+        };
+        let area = match self.emitters[idx as usize] {
+            Emitter::Triangle { area, .. } => area,
+            Emitter::Sphere { radius, .. } => 4.0 * PI * radius * radius,
+            _ => return 0.0,
+        };
+        let d = hit.position - point;
+        let d2 = d.length_squared();
+        let cos_light = hit.geometric_normal.dot(d).abs() / d2.sqrt();
+        if cos_light.is_nan() || cos_light <= 0.0 {
+            return 0.0;
+        }
+        self.distribution.pmf(idx as usize) * d2 / (cos_light * area)
+    }
+
+    /// Samples a photon: `u_light` ∈ [0, 1) picks the emitter by power, `u_pos` ∈ [0, 1)² the point
+    /// on it (or on the directional light's disc) and `u_dir` ∈ [0, 1)² the direction (cosine-weighted
+    /// about the normal for area emitters, uniform for point lights, uniform in the cone for spots).
+    pub fn sample_emission(
+        &self,
+        u_light: f32,
+        u_pos: Vec2,
+        u_dir: Vec2,
+    ) -> Option<EmissionSample> {
+        let (idx, p_light) = self.distribution.sample(u_light);
+        if p_light.is_nan() || p_light <= 0.0 {
+            return None;
+        }
+        let sample = match self.emitters[idx] {
+            Emitter::Point {
+                position,
+                intensity,
+            } => {
+                let direction = uniform_sphere(u_dir);
+                EmissionSample {
+                    origin: position,
+                    direction,
+                    power: intensity * (4.0 * PI),
+                    normal: direction,
+                    emitter: EmitterShape::Point,
+                    origin_error: Vec3::ZERO,
+                }
+            }
+            Emitter::Spot {
+                position,
+                frame,
+                intensity,
+                cos_cone,
+                cos_start,
+                cone_angle,
+                falloff_start,
+            } => {
+                let local = uniform_cone(u_dir, cos_cone);
+                let falloff = spot_falloff(local.z, cos_cone, cos_start);
+                let direction = frame.to_world(local);
+                EmissionSample {
+                    origin: position,
+                    direction,
+                    power: intensity * (falloff * 2.0 * PI * (1.0 - cos_cone)),
+                    normal: direction,
+                    emitter: EmitterShape::Spot {
+                        cone_angle,
+                        falloff_start,
+                    },
+                    origin_error: Vec3::ZERO,
+                }
+            }
+            Emitter::Directional {
+                frame,
+                irradiance,
+                center,
+                radius,
+            } => {
+                let disc = radius * concentric_disk(u_pos);
+                let origin = center - radius * frame.n + disc.x * frame.s + disc.y * frame.t;
+                EmissionSample {
+                    origin,
+                    direction: frame.n,
+                    power: irradiance * (PI * radius * radius),
+                    normal: frame.n,
+                    emitter: EmitterShape::Directional,
+                    origin_error: Vec3::ZERO,
+                }
+            }
+            Emitter::Triangle {
+                p0,
+                e1,
+                e2,
+                normal,
+                area,
+                radiance,
+            } => {
+                let b = uniform_triangle(u_pos);
+                let b0 = 1.0 - b.x - b.y;
+                let (p1, p2) = (p0 + e1, p0 + e2);
+                let origin = b0 * p0 + b.x * p1 + b.y * p2;
+                let error =
+                    (7.0 * f32::EPSILON) * ((b0 * p0).abs() + (b.x * p1).abs() + (b.y * p2).abs());
+                let local = cosine_hemisphere(u_dir);
+                let direction = Frame::from_normal(normal).to_world(local);
+                EmissionSample {
+                    origin,
+                    direction,
+                    power: radiance * (PI * area),
+                    normal,
+                    emitter: EmitterShape::Area {
+                        size: area.sqrt(),
+                        cos_theta: local.z,
+                    },
+                    origin_error: error,
+                }
+            }
+            Emitter::Sphere {
+                center,
+                radius,
+                radiance,
+            } => {
+                let normal = uniform_sphere(u_pos);
+                let origin = center + radius * normal;
+                let local = cosine_hemisphere(u_dir);
+                let direction = Frame::from_normal(normal).to_world(local);
+                EmissionSample {
+                    origin,
+                    direction,
+                    power: radiance * (PI * 4.0 * PI * radius * radius),
+                    normal,
+                    emitter: EmitterShape::Area {
+                        size: 2.0 * radius,
+                        cos_theta: local.z,
+                    },
+                    origin_error: (8.0 * f32::EPSILON) * (origin.abs() + center.abs()),
+                }
+            }
+        };
+        let power = sample.power / p_light;
+        (power.is_finite() && power.cmpgt(Rgb::ZERO).any())
+            .then_some(EmissionSample { power, ..sample })
+    }
+}
+
+impl Emitter {
+    fn power(&self) -> Rgb {
+        match *self {
+            Emitter::Point { intensity, .. } => intensity * (4.0 * PI),
+            Emitter::Spot {
+                intensity,
+                cos_cone,
+                cos_start,
+                ..
+            } => intensity * (2.0 * PI * ((1.0 - cos_start) + 0.5 * (cos_start - cos_cone))),
+            Emitter::Directional {
+                irradiance, radius, ..
+            } => irradiance * (PI * radius * radius),
+            Emitter::Triangle { area, radiance, .. } => radiance * (PI * area),
+            Emitter::Sphere {
+                radius, radiance, ..
+            } => radiance * (PI * 4.0 * PI * radius * radius),
+        }
+    }
+}
+
+/// Spot falloff: 1 inside `cos_start`, 0 outside `cos_cone`, smoothstep in cos θ between (pbrt-v4).
+fn spot_falloff(cos_theta: f32, cos_cone: f32, cos_start: f32) -> f32 {
+    if cos_theta >= cos_start {
+        return 1.0;
+    }
+    if cos_theta <= cos_cone {
+        return 0.0;
+    }
+    let x = ((cos_theta - cos_cone) / (cos_start - cos_cone)).clamp(0.0, 1.0);
+    x * x * (3.0 - 2.0 * x)
+}

@@ -1,0 +1,381 @@
+//! The renderable scene: description + BVH + camera + light sampler.
+
+use std::path::PathBuf;
+
+use glam::{Vec2, Vec3};
+
+use crate::{
+    Aabb, Bsdf, CameraModel, Hit, LightSample, LightSampler, Material, Primitive, Ray, Rgb,
+    SceneDescription,
+    bvh::{Accel, RawHit},
+};
+
+#[cfg(test)]
+mod tests;
+
+/// Relative floating-point error bound γₙ = n·ε/(1 − n·ε) of pbrt (ε = half an ulp of 1).
+const fn gamma(n: f32) -> f32 {
+    let e = f32::EPSILON * 0.5;
+    n * e / (1.0 - n * e)
+}
+
+/// Why a [`SceneDescription`] cannot be rendered.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SceneError {
+    /// Neither geometry nor lights.
+    #[error("scene `{}` has no geometry and no lights", path.display())]
+    Empty {
+        /// The scene file.
+        path: PathBuf,
+    },
+    /// No light source or emitter has positive power.
+    #[error("scene `{}` has no light: every light and emitter has zero power or zero area", path.display())]
+    NoLight {
+        /// The scene file.
+        path: PathBuf,
+    },
+    /// The camera cannot form an image.
+    #[error("scene `{}` has a degenerate camera (look_at equal to position, up parallel to the view, fov_y outside (0, 180) degrees, empty film or a thin lens without focus distance)", path.display())]
+    Camera {
+        /// The scene file.
+        path: PathBuf,
+    },
+    /// A shape refers to a material that does not exist.
+    #[error("scene `{}`: {what} refers to material {index} but there are {count} materials", path.display())]
+    MaterialIndex {
+        /// The scene file.
+        path: PathBuf,
+        /// Which shape, e.g. `triangle 12`.
+        what: String,
+        /// The bad index.
+        index: u32,
+        /// Number of materials.
+        count: usize,
+    },
+    /// A value is NaN, infinite or out of its range.
+    #[error("scene `{}`: {what} is invalid", path.display())]
+    Invalid {
+        /// The scene file.
+        path: PathBuf,
+        /// What is wrong, e.g. `sphere 3 radius (-1)`.
+        what: String,
+    },
+}
+
+/// Per-triangle data that the hit shading needs, in description order.
+#[derive(Clone, Copy, Debug)]
+struct TriangleExtra {
+    /// Unit geometric normal of the front (counter-clockwise) side.
+    front_normal: Vec3,
+    /// Curvature seen from the front side.
+    front_curvature: f32,
+}
+
+/// A scene ready for ray queries, camera rays, BSDFs and light sampling.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    description: SceneDescription,
+    accel: Accel,
+    extra: Vec<TriangleExtra>,
+    camera: CameraModel,
+    lights: LightSampler,
+    bounds: Aabb,
+}
+
+impl Scene {
+    /// Validates the description and builds the BVH and the light sampler.
+    ///
+    /// Zero-area triangles are kept in the description but never hit.
+    ///
+    /// # Errors
+    /// [`SceneError`] when the scene is empty, has no light with positive power, has a degenerate
+    /// camera, a material index out of range, or a non-finite or out-of-range value.
+    pub fn new(description: SceneDescription) -> Result<Self, SceneError> {
+        let source = || description.source.clone();
+        if description.triangles.is_empty()
+            && description.spheres.is_empty()
+            && description.lights.is_empty()
+        {
+            return Err(SceneError::Empty { path: source() });
+        }
+        let camera = CameraModel::new(&description.camera, &description.film)
+            .ok_or_else(|| SceneError::Camera { path: source() })?;
+        let count = description.materials.len();
+        let invalid = |what: String| SceneError::Invalid {
+            path: source(),
+            what,
+        };
+        for (i, m) in description.materials.iter().enumerate() {
+            if !valid_material(m) {
+                return Err(invalid(format!("material {i} (`{}`)", m.name)));
+            }
+        }
+        let mut bounds = Aabb::EMPTY;
+        for (i, t) in description.triangles.iter().enumerate() {
+            if t.material as usize >= count {
+                return Err(SceneError::MaterialIndex {
+                    path: source(),
+                    what: format!("triangle {i}"),
+                    index: t.material,
+                    count,
+                });
+            }
+            if !t.positions.iter().all(|p| p.is_finite())
+                || !t.normals.is_none_or(|n| n.iter().all(|v| v.is_finite()))
+            {
+                return Err(invalid(format!("triangle {i} (non-finite vertex)")));
+            }
+            for p in t.positions {
+                bounds = bounds.include(p);
+            }
+        }
+        for (i, s) in description.spheres.iter().enumerate() {
+            if s.material as usize >= count {
+                return Err(SceneError::MaterialIndex {
+                    path: source(),
+                    what: format!("sphere {i}"),
+                    index: s.material,
+                    count,
+                });
+            }
+            if !(s.center.is_finite() && s.radius.is_finite() && s.radius > 0.0) {
+                return Err(invalid(format!("sphere {i} (radius {})", s.radius)));
+            }
+            bounds = bounds
+                .include(s.center - Vec3::splat(s.radius))
+                .include(s.center + Vec3::splat(s.radius));
+        }
+        if bounds.is_empty() {
+            // Only lights: bound their positions so that directional lights still have a disc.
+            for l in &description.lights {
+                match *l {
+                    crate::Light::Point { position, .. } | crate::Light::Spot { position, .. } => {
+                        bounds = bounds.include(position);
+                    }
+                    crate::Light::Directional { .. } => {}
+                }
+            }
+            if bounds.is_empty() {
+                bounds = Aabb::EMPTY.include(Vec3::ZERO);
+            }
+        }
+        let extra = description.triangles.iter().map(triangle_extra).collect();
+        let lights = LightSampler::new(&description, bounds).map_err(|what| match what {
+            None => SceneError::NoLight { path: source() },
+            Some(what) => invalid(what),
+        })?;
+        let accel = Accel::build(&description.triangles, &description.spheres);
+        Ok(Self {
+            description,
+            accel,
+            extra,
+            camera,
+            lights,
+            bounds,
+        })
+    }
+
+    /// The description the scene was built from.
+    pub fn description(&self) -> &SceneDescription {
+        &self.description
+    }
+
+    /// Every material.
+    pub fn materials(&self) -> &[Material] {
+        &self.description.materials
+    }
+
+    /// The material with index `idx` (as in [`Hit::material`]); `None` if out of range.
+    pub fn material(&self, idx: u32) -> Option<&Material> {
+        self.description.materials.get(idx as usize)
+    }
+
+    /// Bounding box of all geometry (of the light positions if there is no geometry).
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    /// The camera.
+    pub fn camera(&self) -> &CameraModel {
+        &self.camera
+    }
+
+    /// The lights, including emissive triangles and spheres.
+    pub fn lights(&self) -> &LightSampler {
+        &self.lights
+    }
+
+    /// Number of primitives in the BVH (non-degenerate triangles plus spheres).
+    pub fn primitive_count(&self) -> usize {
+        self.accel.len()
+    }
+
+    /// The closest hit with 0 < t < `ray.t_max`, or `None`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        let raw = self.accel.intersect(ray)?;
+        Some(match raw {
+            RawHit::Triangle { index, t, b1, b2 } => self.triangle_hit(ray, index, t, b1, b2),
+            RawHit::Sphere { index, t } => self.sphere_hit(ray, index, t),
+        })
+    }
+
+    /// Whether anything is hit with 0 < t < `ray.t_max` (a shadow-ray query, faster than [`Scene::intersect`]).
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.accel.occluded(ray)
+    }
+
+    /// Whether the segment from the surface point of `from` to `target` is free of occluders
+    /// (the surface at `target` itself does not count).
+    #[inline]
+    pub fn visible(&self, from: &Hit, target: Vec3) -> bool {
+        !self.occluded(&from.spawn_ray_to(target))
+    }
+
+    /// Whether the light sample `sample`, drawn for the point of `from`, is unoccluded.
+    #[inline]
+    pub fn light_visible(&self, from: &Hit, sample: &LightSample) -> bool {
+        if sample.distance.is_finite() {
+            self.visible(from, from.position + sample.incoming * sample.distance)
+        } else {
+            !self.occluded(&from.spawn_ray(sample.incoming))
+        }
+    }
+
+    /// The BSDF at `hit` (see [`Bsdf::new`]); `None` if the hit's material index is out of range.
+    #[inline]
+    pub fn bsdf(&self, hit: &Hit) -> Option<Bsdf> {
+        self.material(hit.material).map(|m| Bsdf::new(m, hit))
+    }
+
+    /// Radiance emitted at `hit` back along the ray: the material's emission on a front face, else zero.
+    #[inline]
+    pub fn emitted(&self, hit: &Hit) -> Rgb {
+        match self.material(hit.material) {
+            Some(m) if hit.front_face => m.emission,
+            _ => Rgb::ZERO,
+        }
+    }
+
+    fn triangle_hit(&self, ray: &Ray, index: u32, t: f32, b1: f32, b2: f32) -> Hit {
+        let tri = &self.description.triangles[index as usize];
+        let extra = self.extra[index as usize];
+        let b0 = 1.0 - b1 - b2;
+        let [p0, p1, p2] = tri.positions;
+        let position_error = gamma(7.0) * ((b0 * p0).abs() + (b1 * p1).abs() + (b2 * p2).abs());
+        // Nudge the point toward the centroid by the size of its error bound, so that a hit on an edge
+        // does not sit on the plane of an adjacent wall, from where a spawned ray could slip through the
+        // corner (obvhs skips nodes closer than t ≈ 1.2e-7). Then clamp it to the triangle's bounding
+        // box, so that points on axis-aligned walls stay exactly on them.
+        let mut position = b0 * p0 + b1 * p1 + b2 * p2;
+        let to_centroid = (p0 + p1 + p2) / 3.0 - position;
+        let len = to_centroid.length();
+        if len > 0.0 {
+            position += to_centroid * (position_error.length().min(0.5 * len) / len);
+        }
+        let position = position.clamp(p0.min(p1).min(p2), p0.max(p1).max(p2));
+        let front_face = extra.front_normal.dot(ray.direction) < 0.0;
+        let sign = if front_face { 1.0 } else { -1.0 };
+        let geometric_normal = sign * extra.front_normal;
+        let shading_normal = match tri.normals {
+            Some([n0, n1, n2]) => {
+                let n = (b0 * n0 + b1 * n1 + b2 * n2).normalize_or_zero();
+                if n == Vec3::ZERO {
+                    geometric_normal
+                } else if n.dot(geometric_normal) < 0.0 {
+                    -n
+                } else {
+                    n
+                }
+            }
+            None => geometric_normal,
+        };
+        Hit {
+            t,
+            position,
+            position_error,
+            geometric_normal,
+            shading_normal,
+            front_face,
+            material: tri.material,
+            curvature: sign * extra.front_curvature,
+            primitive: Primitive::Triangle(index),
+            uv: Vec2::new(b1, b2),
+        }
+    }
+
+    fn sphere_hit(&self, ray: &Ray, index: u32, t: f32) -> Hit {
+        let s = &self.description.spheres[index as usize];
+        let outward = (ray.at(t) - s.center).normalize_or(Vec3::Z);
+        // Reproject onto the surface, as pbrt does, which bounds the error by γ₅|p|.
+        let position = s.center + s.radius * outward;
+        let position_error = gamma(8.0) * (position.abs() + s.center.abs());
+        let front_face = outward.dot(ray.direction) < 0.0;
+        let (normal, curvature) = if front_face {
+            (outward, -1.0 / s.radius)
+        } else {
+            (-outward, 1.0 / s.radius)
+        };
+        let phi = outward.y.atan2(outward.x).rem_euclid(std::f32::consts::TAU);
+        let theta = outward.z.clamp(-1.0, 1.0).acos();
+        Hit {
+            t,
+            position,
+            position_error,
+            geometric_normal: normal,
+            shading_normal: normal,
+            front_face,
+            material: s.material,
+            curvature,
+            primitive: Primitive::Sphere(index),
+            uv: Vec2::new(phi / std::f32::consts::TAU, theta / std::f32::consts::PI),
+        }
+    }
+}
+
+fn valid_material(m: &Material) -> bool {
+    let rgb_ok = |c: Rgb| c.is_finite() && c.cmpge(Rgb::ZERO).all();
+    let kind_ok = match m.kind {
+        crate::MaterialKind::Diffuse { albedo } => rgb_ok(albedo),
+        crate::MaterialKind::Mirror { reflectance } => rgb_ok(reflectance),
+        crate::MaterialKind::Dielectric { ior } => ior.is_finite() && ior > 0.0,
+        crate::MaterialKind::Glossy {
+            reflectance,
+            roughness,
+            diffuse,
+        } => rgb_ok(reflectance) && rgb_ok(diffuse) && roughness.is_finite() && roughness > 0.0,
+    };
+    kind_ok && rgb_ok(m.emission)
+}
+
+/// Front normal and front-side curvature of a triangle (see [`Hit::curvature`]).
+fn triangle_extra(tri: &crate::Triangle) -> TriangleExtra {
+    let [p0, p1, p2] = tri.positions;
+    let front_normal = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+    let front_curvature = match tri.normals {
+        Some(mut n) => {
+            // Orient the vertex normals to the front side, as the shading normal is.
+            if (n[0] + n[1] + n[2]).dot(front_normal) < 0.0 {
+                n = n.map(|v| -v);
+            }
+            let mut sum = 0.0;
+            for (a, b) in [(0, 1), (1, 2), (2, 0)] {
+                let dp = tri.positions[b] - tri.positions[a];
+                let dn = n[b] - n[a];
+                let len2 = dp.length_squared();
+                if len2 > 0.0 {
+                    sum += dn.dot(dp) / len2;
+                }
+            }
+            let k = -sum / 3.0;
+            if k.is_finite() { k } else { 0.0 }
+        }
+        None => 0.0,
+    };
+    TriangleExtra {
+        front_normal,
+        front_curvature,
+    }
+}
