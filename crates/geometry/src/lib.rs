@@ -1,14 +1,23 @@
 //! Scenes, loaders, materials, lights, camera and BVH.
 //!
 //! The principal type is [`Scene`], built from a plain [`SceneDescription`] by [`Scene::new`].
-//! It answers closest-hit ([`Scene::intersect`]) and shadow ([`Scene::occluded`]) queries through one
-//! obvhs CwBvh over triangles and analytic spheres, and owns the [`CameraModel`] and the
-//! [`LightSampler`]. Materials become [`Bsdf`]s at a [`Hit`].
+//! It answers closest-hit ([`Scene::intersect`]) and shadow ([`Scene::occluded`], [`Scene::visible`])
+//! queries through one obvhs CwBvh over triangles and analytic spheres, and owns the
+//! [`CameraModel`] and the [`LightSampler`]. Materials become [`Bsdf`]s at a [`Hit`].
 //!
-//! Conventions: directions point away from surfaces (pbrt); a [`Hit`]'s normals face the side the ray
-//! came from and `front_face` says whether that is the primitive's front (counter-clockwise triangle
-//! side, sphere outside); curvature is signed as in frequency-algebra §3 (positive = concave seen from
-//! the ray's side); secondary rays are spawned with pbrt-v4's error-bound origin offset.
+//! Conventions:
+//! - Directions point away from surfaces (pbrt): a BSDF's `outgoing` points back along the path.
+//! - A [`Hit`]'s normals face the side the ray came from; `front_face` says whether that is the
+//!   primitive's front (the counter-clockwise side of a triangle, the outside of a sphere).
+//!   Emission leaves front faces only; a dielectric's outside is its front.
+//! - [`Hit::curvature`] is signed as in frequency-algebra §3: positive when the centre of curvature
+//!   lies on the side the ray came from (a sphere: −1/R from outside, +1/R from inside).
+//! - Secondary rays ([`Hit::spawn_ray`], [`Hit::spawn_ray_to`]) start off the surface by pbrt-v4's
+//!   floating-point error bound, so they neither re-hit their surface nor slip through corners.
+//! - Refraction scales radiance by 1/η′² on camera paths only ([`TransportMode`]).
+//!
+//! The BVH works around two obvhs 0.4 limitations: `-0.0` direction components (crates.md G1) and
+//! the CwBvh's culling of boxes a ray leaves within t < 10⁻⁴ (see `bvh.rs`).
 //!
 //! The loaders turn a scene file into a plain [`SceneDescription`]:
 //! [`load`] picks the loader by extension (`.toml` scene files of format version 1, lone
