@@ -113,6 +113,24 @@ impl<F: Copy + Default> HitPoints<F> {
         idx
     }
 
+    /// Overwrites where hitpoint `idx` is (position, normals, outgoing direction, material,
+    /// pixel, weight) and keeps its progressive statistics (R, N, τ, `has_freq`, frequency
+    /// state): the SPPM camera pass, which re-traces the visible point of each slot every
+    /// pass while the statistics carry over. `hitpoint.radius` and `hitpoint.freq` are ignored.
+    ///
+    /// # Panics
+    ///
+    /// If `idx` is out of range (an internal invariant of the caller).
+    pub fn replace_visible_point(&mut self, idx: usize, hitpoint: &NewHitPoint<F>) {
+        self.position[idx] = hitpoint.position;
+        self.shading_normal[idx] = hitpoint.shading_normal;
+        self.geometric_normal[idx] = hitpoint.geometric_normal;
+        self.outgoing[idx] = hitpoint.outgoing;
+        self.material_idx[idx] = hitpoint.material_idx;
+        self.pixel_idx[idx] = hitpoint.pixel_idx;
+        self.weight[idx] = hitpoint.weight;
+    }
+
     /// Number of hitpoints.
     #[must_use]
     pub fn len(&self) -> usize {

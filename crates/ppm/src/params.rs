@@ -108,7 +108,9 @@ pub enum ParamError {
         range: &'static str,
     },
     /// The film has no pixels or more than the renderer can index.
-    #[error("film of {width}x{height} pixels with {samples_per_pixel} samples per pixel is too large")]
+    #[error(
+        "film of {width}x{height} pixels with {samples_per_pixel} samples per pixel is too large"
+    )]
     TooManyHitpoints {
         /// Film width.
         width: u32,

@@ -103,9 +103,8 @@ impl<'s> Renderer<'s> {
     pub fn new(scene: &'s Scene, params: RenderParams) -> Result<Self, ParamError> {
         params.validate()?;
         let film = scene.description().film;
-        let n_slots = u64::from(film.width)
-            * u64::from(film.height)
-            * u64::from(params.samples_per_pixel);
+        let n_slots =
+            u64::from(film.width) * u64::from(film.height) * u64::from(params.samples_per_pixel);
         if n_slots == 0 || n_slots > u64::from(u32::MAX) {
             return Err(ParamError::TooManyHitpoints {
                 width: film.width,
@@ -178,24 +177,21 @@ impl<'s> Renderer<'s> {
         let flux = self.slots.flux();
         let n_emitted = self.n_emitted as f64;
         let camera_passes = f64::from(self.camera_passes.max(1));
-        image
-            .par_iter_mut()
-            .enumerate()
-            .for_each(|(pixel, out)| {
-                let mut sum = [0.0f64; 3];
-                for slot in pixel * spp..(pixel + 1) * spp {
-                    let stats = GatherStats {
-                        radius: radius[slot],
-                        photon_count: count[slot],
-                        flux: flux[slot],
-                    };
-                    let photons = stats.radiance(n_emitted).unwrap_or([0.0; 3]);
-                    for c in 0..3 {
-                        sum[c] += photons[c] + self.direct[slot][c] / camera_passes;
-                    }
+        image.par_iter_mut().enumerate().for_each(|(pixel, out)| {
+            let mut sum = [0.0f64; 3];
+            for slot in pixel * spp..(pixel + 1) * spp {
+                let stats = GatherStats {
+                    radius: radius[slot],
+                    photon_count: count[slot],
+                    flux: flux[slot],
+                };
+                let photons = stats.radiance(n_emitted).unwrap_or([0.0; 3]);
+                for c in 0..3 {
+                    sum[c] += photons[c] + self.direct[slot][c] / camera_passes;
                 }
-                *out = sum.map(|v| v as f32);
-            });
+            }
+            *out = sum.map(|v| v as f32);
+        });
         image
     }
 
@@ -276,7 +272,8 @@ impl<'s> Renderer<'s> {
             if first {
                 self.slots.push(new);
             } else {
-                self.slots.replace_visible_point(slot, new);
+                self.slots.replace_visible_point(slot, &new);
+                self.slots.columns_mut().freq[slot].normal_distance = point.normal_distance;
             }
         }
         self.camera_passes += 1;
@@ -305,8 +302,7 @@ impl<'s> Renderer<'s> {
             if bsdf.is_specular() {
                 let u_lobe = sampler.next_f32();
                 let u = sampler.next_2d();
-                let Some(sample) = bsdf.sample(outgoing, u_lobe, u, TransportMode::Radiance)
-                else {
+                let Some(sample) = bsdf.sample(outgoing, u_lobe, u, TransportMode::Radiance) else {
                     break;
                 };
                 throughput *= sample.weight;
@@ -363,12 +359,13 @@ impl<'s> Renderer<'s> {
     // Phase 2: spatial index.
 
     fn build_index(&mut self) {
-        let rebuild = self.params.method.is_stochastic()
-            || match &self.grid {
-                None => true,
-                Some(grid) => grid.needs_rebuild(&self.grid_radii()),
+        let radii = self.grid_radii();
+        let keep = !self.params.method.is_stochastic()
+            && match self.grid.as_mut() {
+                None => false,
+                Some(grid) => grid.refresh_radii(&radii) && !grid.needs_rebuild(&radii),
             };
-        if !rebuild {
+        if keep {
             return;
         }
         self.grid_slots = (0..self.slots.len() as u32)
@@ -383,6 +380,7 @@ impl<'s> Renderer<'s> {
         self.grid = Some(HitPointGrid::build(&positions, &radii, GridParams::DEFAULT));
     }
 
+    /// Current radius of each grid entry.
     fn grid_radii(&self) -> Vec<f64> {
         self.grid_slots
             .iter()
@@ -393,48 +391,132 @@ impl<'s> Renderer<'s> {
     // ------------------------------------------------------------------------------------
     // Phase 3: photon pass.
 
+    /// Traces this pass's photons (in parallel, fixed chunks), then gathers them into the
+    /// hitpoints in Morton order with `photon::gather`, which sums every hitpoint's
+    /// contributions in photon order whatever the thread count.
     fn photon_pass(&mut self) -> PassDeposits {
         let n = u64::from(self.params.photons_per_pass);
-        let radii = self.grid_radii();
-        let chunks: Vec<ChunkDeposits> = (0..n.div_ceil(PHOTON_CHUNK))
+        let first_index = self.n_emitted;
+        let chunks: Vec<TracedPhotons> = (0..n.div_ceil(PHOTON_CHUNK))
             .into_par_iter()
             .map(|chunk| {
                 let start = chunk * PHOTON_CHUNK;
                 let end = (start + PHOTON_CHUNK).min(n);
-                let mut out = ChunkDeposits::default();
+                let mut out = TracedPhotons::default();
                 for idx in start..end {
-                    self.trace_photon(self.n_emitted + idx, &radii, &mut out);
+                    self.trace_photon(first_index + idx, &mut out);
                 }
                 out
             })
             .collect();
         self.n_emitted += n;
-        PassDeposits { chunks }
+
+        let mut photons = Vec::new();
+        let mut frequency = Vec::new();
+        let mut frequency_photons = 0;
+        for chunk in chunks {
+            photons.extend(chunk.photons);
+            frequency.extend(chunk.frequency);
+            frequency_photons += chunk.frequency_photons;
+        }
+        let Some(grid) = &self.grid else {
+            return PassDeposits::empty(self.slots.len(), frequency_photons);
+        };
+        let positions: Vec<Vec3> = photons.iter().map(|p| p.position).collect();
+        let sorted: Vec<Photon> = photon::morton_order(&positions)
+            .into_iter()
+            .map(|i| photons[i as usize])
+            .collect();
+
+        let slots = &self.slots;
+        let grid_slots = &self.grid_slots;
+        let per_entry: Vec<(u32, [f64; 3])> = photon::gather(
+            grid,
+            &sorted,
+            grid_slots.len(),
+            |photon, entry| {
+                let slot = grid_slots[entry as usize] as usize;
+                self.accepts(photon, slot).then(|| {
+                    let material = self.scene.material(slots.material_idx()[slot])?;
+                    let bsdf = Bsdf::from_normal(material.kind, slots.shading_normal()[slot], true);
+                    let f = bsdf.eval(slots.outgoing()[slot], photon.incoming);
+                    Some(f * photon.power * slots.weight()[slot])
+                })?
+            },
+            |acc: &mut (u32, [f64; 3]), flux: Rgb| {
+                acc.0 += 1;
+                acc.1[0] += f64::from(flux.x);
+                acc.1[1] += f64::from(flux.y);
+                acc.1[2] += f64::from(flux.z);
+            },
+        );
+        let mut deposits = PassDeposits::empty(self.slots.len(), frequency_photons);
+        for (entry, (m, phi)) in per_entry.into_iter().enumerate() {
+            let slot = grid_slots[entry] as usize;
+            deposits.count[slot] = m;
+            deposits.flux[slot] = phi;
+            deposits.photons_deposited += u64::from(m);
+        }
+
+        // Frequency deposits: few photons, and min/max merges do not depend on the order.
+        let policy = self.params.freq_merge;
+        let mut estimates: Vec<(usize, Spectrum)> = Vec::new();
+        for (photon, curvature, spectrum) in &frequency {
+            grid.for_each_containing(photon.position, |entry| {
+                let slot = grid_slots[entry as usize] as usize;
+                if !self.accepts(photon, slot) {
+                    return;
+                }
+                let Some(material) = self.scene.material(slots.material_idx()[slot]) else {
+                    return;
+                };
+                // The field the hitpoint's radius reads (design §8.1): the photon's spectrum
+                // reflected by the hitpoint's lobe, with μo = 1 so that a stays in surface
+                // units (b does not depend on μo) and μi = 1 for the conservative 3D
+                // collapse (§8.5: the out-of-plane axis is not stretched).
+                let lobe = spectrum_lobe(material.kind.lobe());
+                estimates.push((
+                    slot,
+                    spectrum.reflect_isotropic(1.0, f64::from(*curvature), lobe, &self.caps),
+                ));
+            });
+        }
+        let columns = self.slots.columns_mut();
+        for (slot, spectrum) in estimates {
+            columns.freq[slot].estimate.deposit(spectrum, policy);
+            columns.has_freq[slot] = true;
+        }
+        deposits
+    }
+
+    /// Whether `photon` counts for `slot`: inside the radius, on the hitpoint's side, with
+    /// agreeing normals (see `photon::accepts`).
+    fn accepts(&self, photon: &Photon, slot: usize) -> bool {
+        photon::accepts(
+            photon,
+            self.slots.position()[slot],
+            self.slots.geometric_normal()[slot],
+            self.slots.radius()[slot],
+            AcceptParams::COS_60,
+        )
     }
 
     fn is_frequency_photon(&self, index: u64) -> bool {
         if !self.params.method.uses_frequency() || self.params.freq_fraction <= 0.0 {
             return false;
         }
-        // Evenly spaced in the global photon index: exactly the requested share per pass
-        // (up to rounding), with no random draw.
+        // Evenly spaced in the global photon index: exactly the requested share (up to
+        // rounding), with no random draw.
         let f = self.params.freq_fraction;
         ((index + 1) as f64 * f).floor() > (index as f64 * f).floor()
     }
 
-    fn trace_photon(&self, index: u64, radii: &[f64], out: &mut ChunkDeposits) {
-        let Some(grid) = &self.grid else {
-            return;
-        };
+    fn trace_photon(&self, index: u64, out: &mut TracedPhotons) {
         let mut sampler = Sampler::new(self.params.seed, self.pass, index);
         let u_light = sampler.next_f32();
         let u_pos = sampler.next_2d();
         let u_dir = sampler.next_2d();
-        let Some(emission) = self
-            .scene
-            .lights()
-            .sample_emission(u_light, u_pos, u_dir)
-        else {
+        let Some(emission) = self.scene.lights().sample_emission(u_light, u_pos, u_dir) else {
             return;
         };
         let mut power = emission.power;
@@ -457,14 +539,20 @@ impl<'s> Renderer<'s> {
                 *s = s.travel(f64::from(hit.t), &self.caps);
             }
             let bsdf = Bsdf::new(material, &hit);
-            if !bsdf.is_specular() && !(self.params.direct_lighting && depth == 0) {
+            // With direct lighting by light sampling, photons straight from an emitter are
+            // already accounted for at the hitpoints.
+            let counted_by_light_sampling = self.params.direct_lighting && depth == 0;
+            if !bsdf.is_specular() && !counted_by_light_sampling {
                 let photon = Photon {
                     position: hit.position,
                     incoming,
                     power,
                     normal: hit.geometric_normal,
                 };
-                self.deposit(grid, radii, &photon, &hit, spectrum.as_ref(), out);
+                out.photons.push(photon);
+                if let Some(s) = spectrum {
+                    out.frequency.push((photon, hit.curvature, s));
+                }
             }
             // Scatter.
             let u_lobe = sampler.next_f32();
@@ -495,78 +583,10 @@ impl<'s> Renderer<'s> {
         }
     }
 
-    fn deposit(
-        &self,
-        grid: &HitPointGrid,
-        radii: &[f64],
-        photon: &Photon,
-        hit: &Hit,
-        spectrum: Option<&Spectrum>,
-        out: &mut ChunkDeposits,
-    ) {
-        let positions = self.slots.position();
-        let geometric_normals = self.slots.geometric_normal();
-        grid.for_each_containing(photon.position, radii, |entry| {
-            let slot = self.grid_slots[entry as usize] as usize;
-            if !photon::accepts(
-                photon,
-                positions[slot],
-                geometric_normals[slot],
-                radii[entry as usize],
-                AcceptParams::COS_60,
-            ) {
-                return;
-            }
-            let Some(material) = self.scene.material(self.slots.material_idx()[slot]) else {
-                return;
-            };
-            let bsdf = Bsdf::from_normal(material.kind, self.slots.shading_normal()[slot], true);
-            let f = bsdf.eval(self.slots.outgoing()[slot], photon.incoming);
-            let flux = f * photon.power * self.slots.weight()[slot];
-            out.flux.push((slot as u32, flux.to_array()));
-            if let Some(s) = spectrum {
-                // The field the hitpoint's radius reads (design §8.1): the photon's spectrum
-                // reflected by the hitpoint's lobe, with μo = 1 so that a stays in surface
-                // units (b does not depend on μo) and μi = 1 for the conservative 3D collapse
-                // (§8.5: the out-of-plane axis is not stretched).
-                let lobe = spectrum_lobe(material.kind.lobe());
-                let toward_camera =
-                    s.reflect_isotropic(1.0, f64::from(hit.curvature), lobe, &self.caps);
-                out.spectra.push((slot as u32, toward_camera));
-            }
-        });
-    }
-
     // ------------------------------------------------------------------------------------
     // Phase 4: hitpoint update.
 
     fn update_hitpoints(&mut self, deposits: &PassDeposits) -> PassStats {
-        let n = self.slots.len();
-        let mut count = vec![0u32; n];
-        let mut flux = vec![[0.0f64; 3]; n];
-        let mut photons_deposited = 0u64;
-        let mut frequency_photons = 0u64;
-        let policy = self.params.freq_merge;
-        {
-            let columns = self.slots.columns_mut();
-            // Fixed order: chunks in photon order, deposits in trace order.
-            for chunk in &deposits.chunks {
-                frequency_photons += chunk.frequency_photons;
-                for &(slot, f) in &chunk.flux {
-                    let slot = slot as usize;
-                    count[slot] += 1;
-                    for c in 0..3 {
-                        flux[slot][c] += f64::from(f[c]);
-                    }
-                }
-                photons_deposited += chunk.flux.len() as u64;
-                for &(slot, spectrum) in &chunk.spectra {
-                    let slot = slot as usize;
-                    columns.freq[slot].estimate.deposit(spectrum, policy);
-                    columns.has_freq[slot] = true;
-                }
-            }
-        }
         let alpha = self.params.alpha;
         let k = self.params.kernel_k;
         let floor = self.params.freq_floor;
@@ -578,7 +598,7 @@ impl<'s> Renderer<'s> {
             .zip(columns.photon_count.par_iter_mut())
             .zip(columns.flux.par_iter_mut())
             .zip(columns.freq.par_iter())
-            .zip(count.par_iter().zip(flux.par_iter()))
+            .zip(deposits.count.par_iter().zip(deposits.flux.par_iter()))
             .map(|((((radius, photon_count), tau), freq), (&m, &phi))| {
                 let r_freq = if uses_frequency {
                     freq.estimate
@@ -604,9 +624,9 @@ impl<'s> Renderer<'s> {
         let mut stats = PassStats {
             pass: self.pass,
             photons_traced: u64::from(self.params.photons_per_pass),
-            frequency_photons,
-            photons_deposited,
-            hitpoints_hit: count.iter().filter(|&&m| m > 0).count() as u64,
+            frequency_photons: deposits.frequency_photons,
+            photons_deposited: deposits.photons_deposited,
+            hitpoints_hit: deposits.count.iter().filter(|&&m| m > 0).count() as u64,
             hitpoints_valid: 0,
             mean_radius: 0.0,
             min_radius: f64::INFINITY,
@@ -654,16 +674,32 @@ struct VisiblePoint {
     normal_distance: f32,
 }
 
-/// Deposits of one chunk of photons, in trace order.
+/// Photons of one chunk, in trace order.
 #[derive(Default)]
-struct ChunkDeposits {
-    flux: Vec<(u32, [f32; 3])>,
-    spectra: Vec<(u32, Spectrum)>,
+struct TracedPhotons {
+    photons: Vec<Photon>,
+    /// Frequency photons again, with the curvature at their hit and their spectrum.
+    frequency: Vec<(Photon, f32, Spectrum)>,
     frequency_photons: u64,
 }
 
+/// What one photon pass brings to each hitpoint slot: M and Φ.
 struct PassDeposits {
-    chunks: Vec<ChunkDeposits>,
+    count: Vec<u32>,
+    flux: Vec<[f64; 3]>,
+    photons_deposited: u64,
+    frequency_photons: u64,
+}
+
+impl PassDeposits {
+    fn empty(n_slots: usize, frequency_photons: u64) -> Self {
+        Self {
+            count: vec![0; n_slots],
+            flux: vec![[0.0; 3]; n_slots],
+            photons_deposited: 0,
+            frequency_photons,
+        }
+    }
 }
 
 fn luminance(c: Rgb) -> f32 {
@@ -714,7 +750,11 @@ fn scatter_spectrum(
             geometry::MaterialKind::Dielectric { ior } => f64::from(ior),
             _ => 1.0,
         };
-        let (eta_i, eta_t) = if hit.front_face { (1.0, ior) } else { (ior, 1.0) };
+        let (eta_i, eta_t) = if hit.front_face {
+            (1.0, ior)
+        } else {
+            (ior, 1.0)
+        };
         return spectrum.refract(eta_i, eta_t, mu_i, mu_o, curvature, caps);
     }
     let lobe = if sample.is_specular {
