@@ -38,12 +38,17 @@
 //! ```
 
 mod params;
+mod path;
+mod photon_mapper;
 mod renderer;
 mod rng;
+mod state;
 mod update;
 
 pub use crate::params::{Method, ParamError, RenderParams};
-pub use crate::renderer::{PassStats, Renderer, SlotFrequency, auto_initial_radius};
+pub use crate::photon_mapper::{PassStats, auto_initial_radius};
+pub use crate::renderer::{Aov, Renderer};
 pub use crate::rng::Sampler;
+pub use crate::state::{STATE_VERSION, StateError, StateHeader, scene_fingerprint};
 pub use crate::update::{FrequencyFloor, FrequencyRadius, GatherStats};
 pub use spectrum::MergePolicy;

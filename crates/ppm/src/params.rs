@@ -18,11 +18,19 @@ pub enum Method {
     FreqPpm,
     /// SPPM with frequency-guided kernels.
     FreqSppm,
+    /// Unidirectional path tracing with next-event estimation and MIS: the reference.
+    Path,
 }
 
 impl Method {
     /// Every method, in the order reports list them.
-    pub const ALL: [Method; 4] = [Method::Ppm, Method::Sppm, Method::FreqPpm, Method::FreqSppm];
+    pub const ALL: [Method; 5] = [
+        Method::Ppm,
+        Method::Sppm,
+        Method::FreqPpm,
+        Method::FreqSppm,
+        Method::Path,
+    ];
 
     /// The name used on the command line and in scene files.
     #[must_use]
@@ -32,6 +40,7 @@ impl Method {
             Method::Sppm => "sppm",
             Method::FreqPpm => "freq",
             Method::FreqSppm => "freq-sppm",
+            Method::Path => "path",
         }
     }
 
@@ -45,6 +54,12 @@ impl Method {
     #[must_use]
     pub fn uses_frequency(self) -> bool {
         matches!(self, Method::FreqPpm | Method::FreqSppm)
+    }
+
+    /// Whether this is a photon mapper (everything but the path tracer).
+    #[must_use]
+    pub fn is_photon_mapper(self) -> bool {
+        !matches!(self, Method::Path)
     }
 
     /// Whether hitpoints are re-traced every pass (SPPM).
@@ -76,7 +91,7 @@ pub struct RenderParams {
     pub initial_radius: Option<f64>,
     /// Maximum number of path segments for camera and photon paths (≥ 1).
     pub max_depth: u32,
-    /// Hitpoint slots per pixel (jittered; ≥ 1).
+    /// Hitpoint slots per pixel (jittered; ≥ 1); for the path tracer, paths per pixel per pass.
     pub samples_per_pixel: u32,
     /// Seed of every random number.
     pub seed: u64,

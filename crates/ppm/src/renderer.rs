@@ -1,96 +1,74 @@
-//! The progressive loop shared by PPM, SPPM and their frequency-guided variants.
-//!
-//! One pass = four phases, each a private function that can be tested alone:
-//! `camera_pass` (trace or re-trace the visible points), `build_index` (hash grid over the
-//! hitpoint spheres), `photon_pass` (trace photons in fixed chunks, collect deposits) and
-//! `update_hitpoints` (fold the deposits into R, N, τ with the keep-or-shrink rule).
+//! The one progressive API over every integrator.
 
-use geometry::{Bsdf, EmitterShape, Hit, Lobe as MaterialLobe, Rgb, Scene, TransportMode};
-use glam::{Vec2, Vec3};
-use photon::{AcceptParams, GridParams, HitPointGrid, HitPoints, NewHitPoint, Photon};
+use geometry::{MaterialKind, Rgb, Scene};
+use glam::Vec2;
 use rayon::prelude::*;
-use spectrum::{Caps, FrequencyEstimate, Lobe, Spectrum};
 
-use crate::params::{ParamError, RenderParams};
-use crate::rng::Sampler;
-use crate::update::{FrequencyRadius, GatherStats};
-
-/// Photons per parallel work item. Fixed (not derived from the thread count) so that the
-/// reduction order, hence the image, does not depend on the number of threads.
-const PHOTON_CHUNK: u64 = 2048;
-/// Hitpoint slots per parallel work item of the camera pass.
-const SLOT_CHUNK: usize = 1024;
-/// Camera streams live in their own half of the sampler's index space.
-const CAMERA_STREAM: u64 = 1 << 63;
-/// Path depth from which Russian roulette may end a photon path.
-const ROULETTE_DEPTH: u32 = 3;
-
-/// Per-pass statistics returned by [`Renderer::iterate`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PassStats {
-    /// Index of the pass just finished (0-based).
-    pub pass: u32,
-    /// Photon paths started in this pass.
-    pub photons_traced: u64,
-    /// Of which frequency photons.
-    pub frequency_photons: u64,
-    /// Photon-hitpoint contributions accepted in this pass.
-    pub photons_deposited: u64,
-    /// Hitpoint slots that received at least one photon in this pass.
-    pub hitpoints_hit: u64,
-    /// Hitpoint slots with a visible point this pass.
-    pub hitpoints_valid: u64,
-    /// Mean gather radius over valid slots after the update.
-    pub mean_radius: f64,
-    /// Smallest gather radius over valid slots.
-    pub min_radius: f64,
-    /// Largest gather radius over valid slots.
-    pub max_radius: f64,
-    /// Share of valid slots whose radius is held by the frequency floor (R ≤ r_freq).
-    pub frequency_held: f64,
-}
-
-/// Frequency state of one hitpoint slot: the merged estimate plus what a deposit needs to
-/// turn a photon's spectrum into the field seen by the camera.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct SlotFrequency {
-    estimate: FrequencyEstimate,
-    /// Distance to the camera (or last specular vertex) projected on the normal, z of §8.2.
-    normal_distance: f32,
-}
+use crate::params::{Method, ParamError, RenderParams};
+use crate::path::PathTracer;
+use crate::photon_mapper::{PassStats, PhotonMapper};
+use crate::update::FrequencyRadius;
 
 /// A progressive render in progress: create it, call [`Renderer::iterate`] as often as the
-/// budget allows, read [`Renderer::image`] at any time.
+/// budget allows, read [`Renderer::image`] (and [`Renderer::aov`]) at any time, and save or
+/// restore its exact state with [`Renderer::save_state`] / [`Renderer::restore`].
 pub struct Renderer<'s> {
-    scene: &'s Scene,
-    params: RenderParams,
-    caps: Caps,
-    width: u32,
-    height: u32,
-    pass: u32,
-    n_emitted: u64,
-    slots: HitPoints<SlotFrequency>,
-    /// Whether a slot holds a visible point in the current pass.
-    valid: Vec<bool>,
-    /// Per slot: sum of directly seen emission (and direct lighting) over camera passes.
-    direct: Vec<[f64; 3]>,
-    camera_passes: u32,
-    grid: Option<HitPointGrid>,
-    /// Slot index of each grid entry (the grid indexes the valid slots only).
-    grid_slots: Vec<u32>,
+    pub(crate) scene: &'s Scene,
+    pub(crate) engine: Engine<'s>,
 }
 
-/// The smallppm choice of initial radius: twice the mean extent of the scene's bounding box
-/// divided by the mean film size in pixels, about a two-pixel footprint.
-#[must_use]
-pub fn auto_initial_radius(scene: &Scene) -> f64 {
-    let bounds = scene.bounds();
-    let extent = bounds.max - bounds.min;
-    let mean_extent = f64::from(extent.x + extent.y + extent.z) / 3.0;
-    let film = scene.description().film;
-    let mean_pixels = (f64::from(film.width) + f64::from(film.height)) / 2.0;
-    let r = 2.0 * mean_extent / mean_pixels;
-    if r > 0.0 && r.is_finite() { r } else { 1e-3 }
+pub(crate) enum Engine<'s> {
+    Photons(PhotonMapper<'s>),
+    Path(PathTracer<'s>),
+}
+
+/// Auxiliary images ("arbitrary output variables") besides the beauty image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Aov {
+    /// Gather radius R per pixel (mean over the pixel's hitpoint slots); photon mappers only.
+    Radius,
+    /// Accumulated photon count N per pixel (mean over the slots); photon mappers only.
+    PhotonCount,
+    /// Frequency radius r_freq per pixel (mean over the slots that have one; 0 where no
+    /// frequency photon arrived); frequency methods only.
+    FreqRadius,
+    /// Share of the pixel's slots whose radius is held by the frequency floor (R ≤ r_freq);
+    /// frequency methods only.
+    FreqHeld,
+    /// Albedo (reflectance) of the first surface seen through the pixel centre (RGB).
+    Albedo,
+    /// Shading normal of the first surface seen through the pixel centre, facing the camera
+    /// (XYZ in [−1, 1]).
+    Normal,
+    /// Distance from the camera to the first surface seen through the pixel centre (0 if none).
+    Depth,
+}
+
+impl Aov {
+    /// Every AOV.
+    pub const ALL: [Aov; 7] = [
+        Aov::Radius,
+        Aov::PhotonCount,
+        Aov::FreqRadius,
+        Aov::FreqHeld,
+        Aov::Albedo,
+        Aov::Normal,
+        Aov::Depth,
+    ];
+
+    /// Channel names of this AOV in an image file, e.g. `["albedo.R", "albedo.G", "albedo.B"]`.
+    #[must_use]
+    pub fn channel_names(self) -> &'static [&'static str] {
+        match self {
+            Aov::Radius => &["radius"],
+            Aov::PhotonCount => &["count"],
+            Aov::FreqRadius => &["freq.radius"],
+            Aov::FreqHeld => &["freq.held"],
+            Aov::Albedo => &["albedo.R", "albedo.G", "albedo.B"],
+            Aov::Normal => &["normal.X", "normal.Y", "normal.Z"],
+            Aov::Depth => &["depth"],
+        }
+    }
 }
 
 impl<'s> Renderer<'s> {
@@ -102,665 +80,189 @@ impl<'s> Renderer<'s> {
     /// [`ParamError`] if a parameter is outside its domain or the film is too large.
     pub fn new(scene: &'s Scene, params: RenderParams) -> Result<Self, ParamError> {
         params.validate()?;
-        let film = scene.description().film;
-        let n_slots =
-            u64::from(film.width) * u64::from(film.height) * u64::from(params.samples_per_pixel);
-        if n_slots == 0 || n_slots > u64::from(u32::MAX) {
-            return Err(ParamError::TooManyHitpoints {
-                width: film.width,
-                height: film.height,
-                samples_per_pixel: params.samples_per_pixel,
-            });
-        }
-        let bounds = scene.bounds();
-        let scene_size = f64::from((bounds.max - bounds.min).length()).max(1e-6);
-        Ok(Self {
-            scene,
-            params,
-            caps: Caps::for_scene_size(scene_size),
-            width: film.width,
-            height: film.height,
-            pass: 0,
-            n_emitted: 0,
-            slots: HitPoints::with_capacity(0),
-            valid: Vec::new(),
-            direct: Vec::new(),
-            camera_passes: 0,
-            grid: None,
-            grid_slots: Vec::new(),
-        })
+        let engine = match params.method {
+            Method::Path => Engine::Path(PathTracer::new(scene, params)),
+            _ => Engine::Photons(PhotonMapper::new(scene, params)?),
+        };
+        Ok(Self { scene, engine })
+    }
+
+    /// The scene being rendered.
+    #[must_use]
+    pub fn scene(&self) -> &'s Scene {
+        self.scene
     }
 
     /// The parameters this renderer runs with.
     #[must_use]
     pub fn params(&self) -> &RenderParams {
-        &self.params
+        match &self.engine {
+            Engine::Photons(p) => p.params(),
+            Engine::Path(p) => &p.params,
+        }
     }
 
     /// Passes completed so far.
     #[must_use]
     pub fn passes(&self) -> u32 {
-        self.pass
+        match &self.engine {
+            Engine::Photons(p) => p.passes(),
+            Engine::Path(p) => p.passes,
+        }
     }
 
-    /// Photons emitted over all passes so far.
+    /// Photons emitted over all passes so far (0 for the path tracer).
     #[must_use]
     pub fn photons_emitted(&self) -> u64 {
-        self.n_emitted
-    }
-
-    /// Runs one pass: camera pass (the first time, or every time for SPPM), hash grid,
-    /// photon pass, hitpoint update.
-    pub fn iterate(&mut self) -> PassStats {
-        if self.pass == 0 || self.params.method.is_stochastic() {
-            self.camera_pass();
+        match &self.engine {
+            Engine::Photons(p) => p.photons_emitted(),
+            Engine::Path(_) => 0,
         }
-        self.build_index();
-        let deposits = self.photon_pass();
-        let stats = self.update_hitpoints(&deposits);
-        self.pass += 1;
-        stats
-    }
-
-    /// The current estimate: linear RGB radiance per pixel, row-major from the top-left,
-    /// `width × height` entries.
-    #[must_use]
-    pub fn image(&self) -> Vec<[f32; 3]> {
-        let spp = self.params.samples_per_pixel as usize;
-        let n_pixels = self.width as usize * self.height as usize;
-        let mut image = vec![[0.0f32; 3]; n_pixels];
-        if self.slots.is_empty() {
-            return image;
-        }
-        let radius = self.slots.radius();
-        let count = self.slots.photon_count();
-        let flux = self.slots.flux();
-        let n_emitted = self.n_emitted as f64;
-        let camera_passes = f64::from(self.camera_passes.max(1));
-        image.par_iter_mut().enumerate().for_each(|(pixel, out)| {
-            let mut sum = [0.0f64; 3];
-            for slot in pixel * spp..(pixel + 1) * spp {
-                let stats = GatherStats {
-                    radius: radius[slot],
-                    photon_count: count[slot],
-                    flux: flux[slot],
-                };
-                let photons = stats.radiance(n_emitted).unwrap_or([0.0; 3]);
-                for c in 0..3 {
-                    sum[c] += photons[c] + self.direct[slot][c] / camera_passes;
-                }
-            }
-            *out = sum.map(|v| v as f32);
-        });
-        image
     }
 
     /// Film width and height in pixels.
     #[must_use]
     pub fn resolution(&self) -> (u32, u32) {
-        (self.width, self.height)
+        let film = self.scene.description().film;
+        (film.width, film.height)
     }
 
-    /// Current gather radius per pixel (mean over the pixel's slots), for AOVs.
+    /// Runs one pass and returns its statistics.
+    pub fn iterate(&mut self) -> PassStats {
+        match &mut self.engine {
+            Engine::Photons(p) => p.iterate(),
+            Engine::Path(p) => {
+                let pass = p.passes;
+                let paths = p.iterate();
+                PassStats {
+                    pass,
+                    camera_paths: paths,
+                    photons_traced: 0,
+                    frequency_photons: 0,
+                    photons_deposited: 0,
+                    hitpoints_hit: 0,
+                    hitpoints_valid: 0,
+                    mean_radius: 0.0,
+                    min_radius: 0.0,
+                    max_radius: 0.0,
+                    frequency_held: 0.0,
+                }
+            }
+        }
+    }
+
+    /// The current estimate: linear RGB radiance per pixel (the average over the pixel's
+    /// square), row-major from the top-left, `width × height` entries.
     #[must_use]
-    pub fn radius_image(&self) -> Vec<f32> {
-        let spp = self.params.samples_per_pixel as usize;
-        let radius = self.slots.radius();
-        (0..self.width as usize * self.height as usize)
-            .map(|pixel| {
-                if radius.is_empty() {
-                    return 0.0;
-                }
-                let sum: f64 = radius[pixel * spp..(pixel + 1) * spp].iter().sum();
-                (sum / spp as f64) as f32
-            })
-            .collect()
+    pub fn image(&self) -> Vec<[f32; 3]> {
+        match &self.engine {
+            Engine::Photons(p) => p.image(),
+            Engine::Path(p) => p.image(),
+        }
     }
 
-    // ------------------------------------------------------------------------------------
-    // Phase 1: camera pass.
-
-    fn camera_pass(&mut self) {
-        let spp = self.params.samples_per_pixel;
-        let n_slots = self.width as usize * self.height as usize * spp as usize;
-        let initial_radius = self
-            .params
-            .initial_radius
-            .unwrap_or_else(|| auto_initial_radius(self.scene));
-        let first = self.slots.is_empty();
-        // For PPM the only camera pass is pass 0; SPPM re-traces with the pass index.
-        let pass = self.pass;
-        let traced: Vec<CameraSample> = (0..n_slots)
-            .into_par_iter()
-            .with_min_len(SLOT_CHUNK)
-            .map(|slot| self.trace_camera_path(slot as u32, pass))
-            .collect();
-        if first {
-            self.slots = HitPoints::with_capacity(n_slots);
-            self.direct = vec![[0.0; 3]; n_slots];
-            self.valid = vec![false; n_slots];
-        }
-        for (slot, sample) in traced.into_iter().enumerate() {
-            for c in 0..3 {
-                self.direct[slot][c] += f64::from(sample.direct[c]);
+    /// An auxiliary image, `width × height × channels` values (channels as in
+    /// [`Aov::channel_names`]), or `None` if this integrator has no such quantity (e.g. a
+    /// radius for the path tracer, a frequency radius for classical PPM).
+    #[must_use]
+    pub fn aov(&self, aov: Aov) -> Option<Vec<f32>> {
+        match aov {
+            Aov::Albedo | Aov::Normal | Aov::Depth => Some(self.first_hit_aov(aov)),
+            Aov::Radius | Aov::PhotonCount | Aov::FreqRadius | Aov::FreqHeld => {
+                let Engine::Photons(mapper) = &self.engine else {
+                    return None;
+                };
+                let frequency = matches!(aov, Aov::FreqRadius | Aov::FreqHeld);
+                if frequency && !mapper.params.method.uses_frequency() {
+                    return None;
+                }
+                Some(slot_aov(mapper, aov))
             }
-            let point = sample.visible.unwrap_or(VisiblePoint {
-                position: Vec3::ZERO,
-                shading_normal: Vec3::Z,
-                geometric_normal: Vec3::Z,
-                outgoing: Vec3::Z,
-                material: 0,
-                weight: Vec3::ZERO,
-                normal_distance: 0.0,
+        }
+    }
+
+    /// Albedo, normal or depth of the first surface seen through each pixel centre.
+    fn first_hit_aov(&self, aov: Aov) -> Vec<f32> {
+        let (width, height) = self.resolution();
+        let channels = aov.channel_names().len();
+        let mut out = vec![0.0f32; width as usize * height as usize * channels];
+        out.par_chunks_mut(channels)
+            .enumerate()
+            .for_each(|(pixel, values)| {
+                let (x, y) = (pixel as u32 % width, pixel as u32 / width);
+                let film = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                let ray = self.scene.camera().generate_ray(film, Vec2::splat(0.5));
+                let Some(hit) = self.scene.intersect(&ray) else {
+                    return;
+                };
+                match aov {
+                    Aov::Depth => values[0] = hit.t,
+                    Aov::Normal => values.copy_from_slice(&hit.shading_normal.to_array()),
+                    _ => {
+                        let albedo = self
+                            .scene
+                            .material(hit.material)
+                            .map_or(Rgb::ZERO, |m| albedo(m.kind));
+                        values.copy_from_slice(&albedo.to_array());
+                    }
+                }
             });
-            self.valid[slot] = sample.visible.is_some();
-            let freq = SlotFrequency {
-                estimate: FrequencyEstimate::EMPTY,
-                normal_distance: point.normal_distance,
-            };
-            let new = NewHitPoint {
-                position: point.position,
-                shading_normal: point.shading_normal,
-                geometric_normal: point.geometric_normal,
-                outgoing: point.outgoing,
-                material_idx: point.material,
-                pixel_idx: slot as u32 / spp,
-                weight: point.weight,
-                radius: initial_radius,
-                freq,
-            };
-            if first {
-                self.slots.push(new);
+        out
+    }
+}
+
+/// The reflectance a material shows at normal incidence, for the albedo AOV.
+fn albedo(kind: MaterialKind) -> Rgb {
+    match kind {
+        MaterialKind::Diffuse { albedo } => albedo,
+        MaterialKind::Mirror { reflectance } => reflectance,
+        MaterialKind::Dielectric { .. } => Rgb::ONE,
+        MaterialKind::Glossy {
+            reflectance,
+            diffuse,
+            ..
+        } => reflectance + diffuse,
+    }
+}
+
+/// A per-slot quantity averaged over each pixel's slots.
+fn slot_aov(mapper: &PhotonMapper<'_>, aov: Aov) -> Vec<f32> {
+    let spp = mapper.params.samples_per_pixel as usize;
+    let n_pixels = mapper.width as usize * mapper.height as usize;
+    let slots = &mapper.slots;
+    if slots.is_empty() {
+        return vec![0.0; n_pixels];
+    }
+    let k = mapper.params.kernel_k;
+    (0..n_pixels)
+        .into_par_iter()
+        .map(|pixel| {
+            let (mut sum, mut n) = (0.0f64, 0u32);
+            for slot in pixel * spp..(pixel + 1) * spp {
+                if !mapper.valid[slot] {
+                    continue;
+                }
+                let freq = slots.freq()[slot];
+                let r_freq = freq.estimate.radius(f64::from(freq.normal_distance), k);
+                let value = match aov {
+                    Aov::Radius => Some(slots.radius()[slot]),
+                    Aov::PhotonCount => Some(slots.photon_count()[slot]),
+                    Aov::FreqRadius => r_freq,
+                    _ => Some(f64::from(u8::from(matches!(
+                        r_freq.map_or(FrequencyRadius::None, FrequencyRadius::Predicted),
+                        FrequencyRadius::Predicted(r) if slots.radius()[slot] <= r
+                    )))),
+                };
+                if let Some(v) = value {
+                    sum += v.min(f64::from(f32::MAX));
+                    n += 1;
+                }
+            }
+            if n == 0 {
+                0.0
             } else {
-                self.slots.replace_visible_point(slot, &new);
-                self.slots.columns_mut().freq[slot].normal_distance = point.normal_distance;
+                (sum / f64::from(n)) as f32
             }
-        }
-        self.camera_passes += 1;
-    }
-
-    fn trace_camera_path(&self, slot: u32, pass: u32) -> CameraSample {
-        let spp = self.params.samples_per_pixel;
-        let pixel = slot / spp;
-        let (x, y) = (pixel % self.width, pixel / self.width);
-        let mut sampler = Sampler::new(self.params.seed, pass, CAMERA_STREAM | u64::from(slot));
-        let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-        let mut ray = self.scene.camera().generate_ray(film, sampler.next_2d());
-        let weight_scale = 1.0 / spp as f32;
-        let mut throughput = Rgb::ONE;
-        let mut direct = Rgb::ZERO;
-        for _depth in 0..self.params.max_depth {
-            let Some(hit) = self.scene.intersect(&ray) else {
-                break;
-            };
-            direct += throughput * self.scene.emitted(&hit);
-            let Some(material) = self.scene.material(hit.material) else {
-                break;
-            };
-            let bsdf = Bsdf::new(material, &hit);
-            let outgoing = -ray.direction;
-            if bsdf.is_specular() {
-                let u_lobe = sampler.next_f32();
-                let u = sampler.next_2d();
-                let Some(sample) = bsdf.sample(outgoing, u_lobe, u, TransportMode::Radiance) else {
-                    break;
-                };
-                throughput *= sample.weight;
-                if throughput == Rgb::ZERO {
-                    break;
-                }
-                ray = hit.spawn_ray(sample.incoming);
-                continue;
-            }
-            if self.params.direct_lighting {
-                direct += throughput * self.direct_lighting(&hit, &bsdf, outgoing, &mut sampler);
-            }
-            let mu = outgoing.dot(hit.shading_normal).abs();
-            return CameraSample {
-                direct: direct * weight_scale,
-                visible: Some(VisiblePoint {
-                    position: hit.position,
-                    shading_normal: hit.shading_normal,
-                    geometric_normal: hit.geometric_normal,
-                    outgoing,
-                    material: hit.material,
-                    weight: throughput * weight_scale,
-                    normal_distance: hit.t * mu,
-                }),
-            };
-        }
-        CameraSample {
-            direct: direct * weight_scale,
-            visible: None,
-        }
-    }
-
-    /// One light sample of next-event estimation at a non-specular camera hit.
-    fn direct_lighting(
-        &self,
-        hit: &Hit,
-        bsdf: &Bsdf,
-        outgoing: Vec3,
-        sampler: &mut Sampler,
-    ) -> Rgb {
-        let u_light = sampler.next_f32();
-        let u = sampler.next_2d();
-        let Some(sample) = self.scene.lights().sample_direct(hit.position, u_light, u) else {
-            return Rgb::ZERO;
-        };
-        if sample.pdf <= 0.0 || !self.scene.light_visible(hit, &sample) {
-            return Rgb::ZERO;
-        }
-        let cos = sample.incoming.dot(hit.shading_normal).abs();
-        bsdf.eval(outgoing, sample.incoming) * sample.radiance * (cos / sample.pdf)
-    }
-
-    // ------------------------------------------------------------------------------------
-    // Phase 2: spatial index.
-
-    fn build_index(&mut self) {
-        let radii = self.grid_radii();
-        let keep = !self.params.method.is_stochastic()
-            && match self.grid.as_mut() {
-                None => false,
-                Some(grid) => grid.refresh_radii(&radii) && !grid.needs_rebuild(&radii),
-            };
-        if keep {
-            return;
-        }
-        self.grid_slots = (0..self.slots.len() as u32)
-            .filter(|&s| self.valid[s as usize])
-            .collect();
-        let positions: Vec<Vec3> = self
-            .grid_slots
-            .iter()
-            .map(|&s| self.slots.position()[s as usize])
-            .collect();
-        let radii = self.grid_radii();
-        self.grid = Some(HitPointGrid::build(&positions, &radii, GridParams::DEFAULT));
-    }
-
-    /// Current radius of each grid entry.
-    fn grid_radii(&self) -> Vec<f64> {
-        self.grid_slots
-            .iter()
-            .map(|&s| self.slots.radius()[s as usize])
-            .collect()
-    }
-
-    // ------------------------------------------------------------------------------------
-    // Phase 3: photon pass.
-
-    /// Traces this pass's photons (in parallel, fixed chunks), then gathers them into the
-    /// hitpoints in Morton order with `photon::gather`, which sums every hitpoint's
-    /// contributions in photon order whatever the thread count.
-    fn photon_pass(&mut self) -> PassDeposits {
-        let n = u64::from(self.params.photons_per_pass);
-        let first_index = self.n_emitted;
-        let chunks: Vec<TracedPhotons> = (0..n.div_ceil(PHOTON_CHUNK))
-            .into_par_iter()
-            .map(|chunk| {
-                let start = chunk * PHOTON_CHUNK;
-                let end = (start + PHOTON_CHUNK).min(n);
-                let mut out = TracedPhotons::default();
-                for idx in start..end {
-                    self.trace_photon(first_index + idx, &mut out);
-                }
-                out
-            })
-            .collect();
-        self.n_emitted += n;
-
-        let mut photons = Vec::new();
-        let mut frequency = Vec::new();
-        let mut frequency_photons = 0;
-        for chunk in chunks {
-            photons.extend(chunk.photons);
-            frequency.extend(chunk.frequency);
-            frequency_photons += chunk.frequency_photons;
-        }
-        let Some(grid) = &self.grid else {
-            return PassDeposits::empty(self.slots.len(), frequency_photons);
-        };
-        let positions: Vec<Vec3> = photons.iter().map(|p| p.position).collect();
-        let sorted: Vec<Photon> = photon::morton_order(&positions)
-            .into_iter()
-            .map(|i| photons[i as usize])
-            .collect();
-
-        let slots = &self.slots;
-        let grid_slots = &self.grid_slots;
-        let per_entry: Vec<(u32, [f64; 3])> = photon::gather(
-            grid,
-            &sorted,
-            grid_slots.len(),
-            |photon, entry| {
-                let slot = grid_slots[entry as usize] as usize;
-                self.accepts(photon, slot).then(|| {
-                    let material = self.scene.material(slots.material_idx()[slot])?;
-                    let bsdf = Bsdf::from_normal(material.kind, slots.shading_normal()[slot], true);
-                    let f = bsdf.eval(slots.outgoing()[slot], photon.incoming);
-                    Some(f * photon.power * slots.weight()[slot])
-                })?
-            },
-            |acc: &mut (u32, [f64; 3]), flux: Rgb| {
-                acc.0 += 1;
-                acc.1[0] += f64::from(flux.x);
-                acc.1[1] += f64::from(flux.y);
-                acc.1[2] += f64::from(flux.z);
-            },
-        );
-        let mut deposits = PassDeposits::empty(self.slots.len(), frequency_photons);
-        for (entry, (m, phi)) in per_entry.into_iter().enumerate() {
-            let slot = grid_slots[entry] as usize;
-            deposits.count[slot] = m;
-            deposits.flux[slot] = phi;
-            deposits.photons_deposited += u64::from(m);
-        }
-
-        // Frequency deposits: few photons, and min/max merges do not depend on the order.
-        let policy = self.params.freq_merge;
-        let mut estimates: Vec<(usize, Spectrum)> = Vec::new();
-        for (photon, curvature, spectrum) in &frequency {
-            grid.for_each_containing(photon.position, |entry| {
-                let slot = grid_slots[entry as usize] as usize;
-                if !self.accepts(photon, slot) {
-                    return;
-                }
-                let Some(material) = self.scene.material(slots.material_idx()[slot]) else {
-                    return;
-                };
-                // The field the hitpoint's radius reads (design §8.1): the photon's spectrum
-                // reflected by the hitpoint's lobe, with μo = 1 so that a stays in surface
-                // units (b does not depend on μo) and μi = 1 for the conservative 3D
-                // collapse (§8.5: the out-of-plane axis is not stretched).
-                let lobe = spectrum_lobe(material.kind.lobe());
-                estimates.push((
-                    slot,
-                    spectrum.reflect_isotropic(1.0, f64::from(*curvature), lobe, &self.caps),
-                ));
-            });
-        }
-        let columns = self.slots.columns_mut();
-        for (slot, spectrum) in estimates {
-            columns.freq[slot].estimate.deposit(spectrum, policy);
-            columns.has_freq[slot] = true;
-        }
-        deposits
-    }
-
-    /// Whether `photon` counts for `slot`: inside the radius, on the hitpoint's side, with
-    /// agreeing normals (see `photon::accepts`).
-    fn accepts(&self, photon: &Photon, slot: usize) -> bool {
-        photon::accepts(
-            photon,
-            self.slots.position()[slot],
-            self.slots.geometric_normal()[slot],
-            self.slots.radius()[slot],
-            AcceptParams::COS_60,
-        )
-    }
-
-    fn is_frequency_photon(&self, index: u64) -> bool {
-        if !self.params.method.uses_frequency() || self.params.freq_fraction <= 0.0 {
-            return false;
-        }
-        // Evenly spaced in the global photon index: exactly the requested share (up to
-        // rounding), with no random draw.
-        let f = self.params.freq_fraction;
-        ((index + 1) as f64 * f).floor() > (index as f64 * f).floor()
-    }
-
-    fn trace_photon(&self, index: u64, out: &mut TracedPhotons) {
-        let mut sampler = Sampler::new(self.params.seed, self.pass, index);
-        let u_light = sampler.next_f32();
-        let u_pos = sampler.next_2d();
-        let u_dir = sampler.next_2d();
-        let Some(emission) = self.scene.lights().sample_emission(u_light, u_pos, u_dir) else {
-            return;
-        };
-        let mut power = emission.power;
-        let mut ray = emission.ray();
-        let mut spectrum = self
-            .is_frequency_photon(index)
-            .then(|| emitter_spectrum(emission.emitter, &self.caps));
-        if spectrum.is_some() {
-            out.frequency_photons += 1;
-        }
-        for depth in 0..self.params.max_depth {
-            let Some(hit) = self.scene.intersect(&ray) else {
-                break;
-            };
-            let Some(material) = self.scene.material(hit.material) else {
-                break;
-            };
-            let incoming = -ray.direction;
-            if let Some(s) = spectrum.as_mut() {
-                *s = s.travel(f64::from(hit.t), &self.caps);
-            }
-            let bsdf = Bsdf::new(material, &hit);
-            // With direct lighting by light sampling, photons straight from an emitter are
-            // already accounted for at the hitpoints.
-            let counted_by_light_sampling = self.params.direct_lighting && depth == 0;
-            if !bsdf.is_specular() && !counted_by_light_sampling {
-                let photon = Photon {
-                    position: hit.position,
-                    incoming,
-                    power,
-                    normal: hit.geometric_normal,
-                };
-                out.photons.push(photon);
-                if let Some(s) = spectrum {
-                    out.frequency.push((photon, hit.curvature, s));
-                }
-            }
-            // Scatter.
-            let u_lobe = sampler.next_f32();
-            let u = sampler.next_2d();
-            let u_roulette = sampler.next_f32();
-            let Some(sample) = bsdf.sample(incoming, u_lobe, u, TransportMode::Importance) else {
-                break;
-            };
-            let new_power = power * sample.weight;
-            // Russian roulette (pbrt-v4 SPPM): keep the photon's power roughly constant.
-            let mut survive = 1.0f32;
-            if depth + 1 >= ROULETTE_DEPTH {
-                let ratio = luminance(new_power) / luminance(power).max(f32::MIN_POSITIVE);
-                let q = (1.0 - ratio).max(0.0);
-                if u_roulette < q {
-                    break;
-                }
-                survive = 1.0 - q;
-            }
-            power = new_power / survive;
-            if power == Rgb::ZERO || !power.is_finite() {
-                break;
-            }
-            if let Some(s) = spectrum.as_mut() {
-                *s = scatter_spectrum(*s, &hit, incoming, &sample, &bsdf, material, &self.caps);
-            }
-            ray = hit.spawn_ray(sample.incoming);
-        }
-    }
-
-    // ------------------------------------------------------------------------------------
-    // Phase 4: hitpoint update.
-
-    fn update_hitpoints(&mut self, deposits: &PassDeposits) -> PassStats {
-        let alpha = self.params.alpha;
-        let k = self.params.kernel_k;
-        let floor = self.params.freq_floor;
-        let uses_frequency = self.params.method.uses_frequency();
-        let columns = self.slots.columns_mut();
-        let held: Vec<bool> = columns
-            .radius
-            .par_iter_mut()
-            .zip(columns.photon_count.par_iter_mut())
-            .zip(columns.flux.par_iter_mut())
-            .zip(columns.freq.par_iter())
-            .zip(deposits.count.par_iter().zip(deposits.flux.par_iter()))
-            .map(|((((radius, photon_count), tau), freq), (&m, &phi))| {
-                let r_freq = if uses_frequency {
-                    freq.estimate
-                        .radius(f64::from(freq.normal_distance), k)
-                        .map_or(FrequencyRadius::None, FrequencyRadius::Predicted)
-                } else {
-                    FrequencyRadius::None
-                };
-                let held = matches!(r_freq, FrequencyRadius::Predicted(r) if *radius <= r);
-                let mut stats = GatherStats {
-                    radius: *radius,
-                    photon_count: *photon_count,
-                    flux: *tau,
-                };
-                stats.update(m, phi, alpha, r_freq, floor);
-                *radius = stats.radius;
-                *photon_count = stats.photon_count;
-                *tau = stats.flux;
-                held
-            })
-            .collect();
-
-        let mut stats = PassStats {
-            pass: self.pass,
-            photons_traced: u64::from(self.params.photons_per_pass),
-            frequency_photons: deposits.frequency_photons,
-            photons_deposited: deposits.photons_deposited,
-            hitpoints_hit: deposits.count.iter().filter(|&&m| m > 0).count() as u64,
-            hitpoints_valid: 0,
-            mean_radius: 0.0,
-            min_radius: f64::INFINITY,
-            max_radius: 0.0,
-            frequency_held: 0.0,
-        };
-        let mut sum = 0.0;
-        let mut n_held = 0u64;
-        for (slot, &r) in self.slots.radius().iter().enumerate() {
-            if !self.valid[slot] {
-                continue;
-            }
-            stats.hitpoints_valid += 1;
-            sum += r;
-            stats.min_radius = stats.min_radius.min(r);
-            stats.max_radius = stats.max_radius.max(r);
-            n_held += u64::from(held[slot]);
-        }
-        if stats.hitpoints_valid > 0 {
-            stats.mean_radius = sum / stats.hitpoints_valid as f64;
-            stats.frequency_held = n_held as f64 / stats.hitpoints_valid as f64;
-        } else {
-            stats.min_radius = 0.0;
-        }
-        stats
-    }
-}
-
-/// What one camera path produced.
-#[derive(Clone, Copy, Debug)]
-struct CameraSample {
-    /// Emission seen along the path (and direct lighting), already weighted by 1/spp.
-    direct: Rgb,
-    visible: Option<VisiblePoint>,
-}
-
-#[derive(Clone, Copy, Debug)]
-struct VisiblePoint {
-    position: Vec3,
-    shading_normal: Vec3,
-    geometric_normal: Vec3,
-    outgoing: Vec3,
-    material: u32,
-    weight: Rgb,
-    normal_distance: f32,
-}
-
-/// Photons of one chunk, in trace order.
-#[derive(Default)]
-struct TracedPhotons {
-    photons: Vec<Photon>,
-    /// Frequency photons again, with the curvature at their hit and their spectrum.
-    frequency: Vec<(Photon, f32, Spectrum)>,
-    frequency_photons: u64,
-}
-
-/// What one photon pass brings to each hitpoint slot: M and Φ.
-struct PassDeposits {
-    count: Vec<u32>,
-    flux: Vec<[f64; 3]>,
-    photons_deposited: u64,
-    frequency_photons: u64,
-}
-
-impl PassDeposits {
-    fn empty(n_slots: usize, frequency_photons: u64) -> Self {
-        Self {
-            count: vec![0; n_slots],
-            flux: vec![[0.0; 3]; n_slots],
-            photons_deposited: 0,
-            frequency_photons,
-        }
-    }
-}
-
-fn luminance(c: Rgb) -> f32 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
-}
-
-/// The lobe of a material as the frequency operators see it (design §7).
-fn spectrum_lobe(lobe: MaterialLobe) -> Lobe {
-    match lobe {
-        MaterialLobe::Specular => Lobe::Mirror,
-        MaterialLobe::Lambert => Lobe::Lambert,
-        MaterialLobe::Ggx { alpha } => Lobe::Ggx {
-            roughness: f64::from(alpha),
-        },
-    }
-}
-
-/// The spectrum of the light field leaving an emitter (design §6).
-fn emitter_spectrum(shape: EmitterShape, caps: &Caps) -> Spectrum {
-    match shape {
-        EmitterShape::Area { size, cos_theta } => {
-            Spectrum::area_light(f64::from(size), f64::from(cos_theta), caps)
-        }
-        EmitterShape::Point => Spectrum::point_light(caps),
-        // A smooth falloff only lowers the angular frequency: the hard cone is conservative.
-        EmitterShape::Spot { cone_angle, .. } => Spectrum::spot_light(f64::from(cone_angle), caps),
-        EmitterShape::Directional => Spectrum::directional_light(caps),
-    }
-}
-
-/// The photon's spectrum after scattering at `hit` into `sample.incoming` (the new travel
-/// direction), under the conservative isotropic 3D collapse of design §8.5.
-fn scatter_spectrum(
-    spectrum: Spectrum,
-    hit: &Hit,
-    arrived_from: Vec3,
-    sample: &geometry::BsdfSample,
-    bsdf: &Bsdf,
-    material: &geometry::Material,
-    caps: &Caps,
-) -> Spectrum {
-    let normal = hit.shading_normal;
-    let mu_i = f64::from(arrived_from.dot(normal).abs());
-    let mu_o = f64::from(sample.incoming.dot(normal).abs());
-    let curvature = f64::from(hit.curvature);
-    if sample.is_transmission {
-        let ior = match material.kind {
-            geometry::MaterialKind::Dielectric { ior } => f64::from(ior),
-            _ => 1.0,
-        };
-        let (eta_i, eta_t) = if hit.front_face {
-            (1.0, ior)
-        } else {
-            (ior, 1.0)
-        };
-        return spectrum.refract(eta_i, eta_t, mu_i, mu_o, curvature, caps);
-    }
-    let lobe = if sample.is_specular {
-        Lobe::Mirror
-    } else {
-        spectrum_lobe(bsdf.lobe())
-    };
-    spectrum.reflect_isotropic(mu_o, curvature, lobe, caps)
+        })
+        .collect()
 }

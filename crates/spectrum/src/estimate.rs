@@ -32,6 +32,13 @@ impl FrequencyEstimate {
     /// No frequency photon deposited yet.
     pub const EMPTY: FrequencyEstimate = FrequencyEstimate { merged: None };
 
+    /// The estimate holding exactly `merged` (e.g. restored from a checkpoint); `None` is
+    /// [`FrequencyEstimate::EMPTY`].
+    #[must_use]
+    pub fn from_spectrum(merged: Option<Spectrum>) -> Self {
+        Self { merged }
+    }
+
     /// True once a frequency photon has been deposited.
     #[must_use]
     pub fn has_freq(&self) -> bool {

@@ -49,6 +49,38 @@ impl Spectrum {
         (a >= 0.0 && b >= 0.0 && !c.is_nan() && psd).then(|| Self::finish(a, b, c, false, caps))
     }
 
+    /// The exact bits of (a, b, c, Lambertian flag), for storing a spectrum (checkpoints).
+    /// [`Spectrum::from_bits`] restores the identical value.
+    #[must_use]
+    pub fn to_bits(&self) -> [u64; 4] {
+        [
+            self.a.to_bits(),
+            self.b.to_bits(),
+            self.c.to_bits(),
+            u64::from(self.lambertian),
+        ]
+    }
+
+    /// The spectrum stored by [`Spectrum::to_bits`], bit for bit (no caps are applied again).
+    /// `None` if the bits do not describe a valid spectrum: NaN, negative a or b, c² > a·b, or
+    /// a flag other than 0 or 1.
+    #[must_use]
+    pub fn from_bits(bits: [u64; 4]) -> Option<Self> {
+        let [a, b, c] = [bits[0], bits[1], bits[2]].map(f64::from_bits);
+        let lambertian = match bits[3] {
+            0 => false,
+            1 => true,
+            _ => return None,
+        };
+        let valid = a >= 0.0 && b >= 0.0 && !c.is_nan() && c * c <= a * b;
+        valid.then_some(Spectrum {
+            a,
+            b,
+            c,
+            lambertian,
+        })
+    }
+
     /// A spectrum from the primal covariance P of the light field: Q = 2π²·P.
     /// `None` under the conditions of [`Spectrum::new`].
     #[must_use]

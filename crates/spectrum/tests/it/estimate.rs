@@ -110,3 +110,26 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn bits_round_trip_exactly_and_reject_invalid_values() {
+    let caps = Caps::for_scene_size(2.0);
+    let diffuse = Spectrum::point_light(&caps).travel(1.3, &caps).bandlimit(Lobe::Lambert, &caps);
+    let glossy = Spectrum::area_light(0.2, 0.7, &caps)
+        .travel(0.9, &caps)
+        .reflect(0.8, 0.6, 0.5, Lobe::Ggx { roughness: 0.1 }, &caps);
+    for spectrum in [diffuse, glossy] {
+        let back = Spectrum::from_bits(spectrum.to_bits()).unwrap();
+        assert_eq!(back, spectrum);
+        assert_eq!(back.is_lambertian(), spectrum.is_lambertian());
+        let estimate = FrequencyEstimate::from_spectrum(Some(back));
+        assert_eq!(estimate.spectrum(), Some(spectrum));
+    }
+    let nan = [f64::NAN.to_bits(), 1f64.to_bits(), 0f64.to_bits(), 0];
+    let not_psd = [1f64.to_bits(), 1f64.to_bits(), 2f64.to_bits(), 0];
+    let bad_flag = [1f64.to_bits(), 1f64.to_bits(), 0f64.to_bits(), 7];
+    for bits in [nan, not_psd, bad_flag] {
+        assert_eq!(Spectrum::from_bits(bits), None);
+    }
+    assert_eq!(FrequencyEstimate::from_spectrum(None), FrequencyEstimate::EMPTY);
+}

@@ -1,0 +1,166 @@
+//! The reference integrator: unidirectional path tracing with next-event estimation and
+//! multiple importance sampling (power heuristic), sharing the scene, materials and lights of
+//! the photon mappers. It is deliberately simple: it is the independent ground truth the photon
+//! mappers are checked against, not a competitor.
+
+use geometry::{Bsdf, Hit, Rgb, Scene, TransportMode};
+use glam::Vec2;
+use rayon::prelude::*;
+
+use crate::params::RenderParams;
+use crate::rng::Sampler;
+
+/// Pixels per parallel work item; fixed so the work split does not depend on the thread count.
+const PIXEL_CHUNK: usize = 256;
+/// Path depth from which Russian roulette may end a path.
+const ROULETTE_DEPTH: u32 = 3;
+
+/// Progressive path tracing: every pass adds `samples_per_pixel` paths to every pixel.
+pub(crate) struct PathTracer<'s> {
+    scene: &'s Scene,
+    pub(crate) params: RenderParams,
+    width: u32,
+    /// Sum of the radiance samples per pixel.
+    pub(crate) sum: Vec<[f64; 3]>,
+    /// Passes accumulated in `sum`.
+    pub(crate) passes: u32,
+}
+
+impl<'s> PathTracer<'s> {
+    pub(crate) fn new(scene: &'s Scene, params: RenderParams) -> Self {
+        let film = scene.description().film;
+        Self {
+            scene,
+            params,
+            width: film.width,
+            sum: vec![[0.0; 3]; film.width as usize * film.height as usize],
+            passes: 0,
+        }
+    }
+
+    /// Adds one pass of `samples_per_pixel` paths per pixel; returns the number of paths.
+    pub(crate) fn iterate(&mut self) -> u64 {
+        let pass = self.passes;
+        let spp = self.params.samples_per_pixel;
+        let this = &*self;
+        let samples: Vec<[f64; 3]> = (0..this.sum.len())
+            .into_par_iter()
+            .with_min_len(PIXEL_CHUNK)
+            .map(|pixel| {
+                let mut total = [0.0f64; 3];
+                for s in 0..spp {
+                    let index = pixel as u64 * u64::from(spp) + u64::from(s);
+                    let l = this.trace(pixel as u32, Sampler::new(this.params.seed, pass, index));
+                    total[0] += f64::from(l.x);
+                    total[1] += f64::from(l.y);
+                    total[2] += f64::from(l.z);
+                }
+                total
+            })
+            .collect();
+        for (sum, sample) in self.sum.iter_mut().zip(samples) {
+            for c in 0..3 {
+                sum[c] += sample[c];
+            }
+        }
+        self.passes += 1;
+        self.sum.len() as u64 * u64::from(spp)
+    }
+
+    /// The mean radiance per pixel.
+    pub(crate) fn image(&self) -> Vec<[f32; 3]> {
+        let n = f64::from(self.passes.max(1)) * f64::from(self.params.samples_per_pixel);
+        self.sum.iter().map(|s| s.map(|v| (v / n) as f32)).collect()
+    }
+
+    /// One camera path through `pixel`: its radiance estimate.
+    fn trace(&self, pixel: u32, mut sampler: Sampler) -> Rgb {
+        let (x, y) = (pixel % self.width, pixel / self.width);
+        let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+        let mut ray = self.scene.camera().generate_ray(film, sampler.next_2d());
+        let lights = self.scene.lights();
+        let mut radiance = Rgb::ZERO;
+        let mut beta = Rgb::ONE;
+        // The previous vertex and the solid-angle density of the direction sampled there
+        // (`None` after a specular bounce or at the camera: emission then counts in full).
+        let mut previous: Option<(Hit, f32)> = None;
+        for depth in 0..self.params.max_depth {
+            let Some(hit) = self.scene.intersect(&ray) else {
+                break;
+            };
+            let emitted = self.scene.emitted(&hit);
+            if emitted != Rgb::ZERO {
+                let weight = match &previous {
+                    None => 1.0,
+                    Some((from, bsdf_pdf)) => {
+                        power_heuristic(*bsdf_pdf, lights.pdf_direct(from.position, &hit))
+                    }
+                };
+                radiance += beta * emitted * weight;
+            }
+            let Some(bsdf) = self.scene.bsdf(&hit) else {
+                break;
+            };
+            let outgoing = -ray.direction;
+            let u_light = sampler.next_f32();
+            let u_light_2d = sampler.next_2d();
+            if !bsdf.is_specular() {
+                radiance += beta * self.next_event(&hit, &bsdf, outgoing, u_light, u_light_2d);
+            }
+            let u_lobe = sampler.next_f32();
+            let u = sampler.next_2d();
+            let u_roulette = sampler.next_f32();
+            let Some(sample) = bsdf.sample(outgoing, u_lobe, u, TransportMode::Radiance) else {
+                break;
+            };
+            beta *= sample.weight;
+            if depth + 1 >= ROULETTE_DEPTH {
+                let survive = beta.max_element().min(1.0);
+                if survive <= 0.0 || u_roulette >= survive {
+                    break;
+                }
+                beta /= survive;
+            }
+            if beta == Rgb::ZERO || !beta.is_finite() {
+                break;
+            }
+            previous = (!sample.is_specular).then_some((hit, sample.pdf));
+            ray = hit.spawn_ray(sample.incoming);
+        }
+        radiance
+    }
+
+    /// Light sampling at a non-specular vertex, MIS-weighted against BSDF sampling.
+    fn next_event(
+        &self,
+        hit: &Hit,
+        bsdf: &Bsdf,
+        outgoing: glam::Vec3,
+        u_light: f32,
+        u: Vec2,
+    ) -> Rgb {
+        let Some(sample) = self.scene.lights().sample_direct(hit.position, u_light, u) else {
+            return Rgb::ZERO;
+        };
+        if !(sample.pdf > 0.0) || !self.scene.light_visible(hit, &sample) {
+            return Rgb::ZERO;
+        }
+        let f = bsdf.eval(outgoing, sample.incoming);
+        if f == Rgb::ZERO {
+            return Rgb::ZERO;
+        }
+        let cos = sample.incoming.dot(hit.shading_normal).abs();
+        let weight = if sample.is_delta {
+            1.0
+        } else {
+            power_heuristic(sample.pdf, bsdf.pdf(outgoing, sample.incoming))
+        };
+        f * sample.radiance * (cos * weight / sample.pdf)
+    }
+}
+
+/// Veach's power heuristic (β = 2) for the strategy with density `f` against one with `g`.
+fn power_heuristic(f: f32, g: f32) -> f32 {
+    let (f2, g2) = (f * f, g * g);
+    if f2 + g2 > 0.0 { f2 / (f2 + g2) } else { 0.0 }
+}

@@ -1,0 +1,533 @@
+//! Checkpoints: the exact state of a [`Renderer`], as bytes.
+//!
+//! Layout (little-endian): the magic `FPPMSTAT`, the format version, a fingerprint of the scene,
+//! a caller's note (the CLI stores the scene path there), the parameters, the pass count, then
+//! the integrator's columns, and a 64-bit checksum of everything before it. Restoring gives a
+//! renderer whose next passes are bit-identical to those of the renderer that was saved; the
+//! hash grid is not stored (it is rebuilt, and gathers do not depend on its layout).
+
+use geometry::{Light, MaterialKind, Scene, SceneDescription};
+use glam::Vec3;
+use photon::{HitPoints, NewHitPoint};
+use spectrum::{FrequencyEstimate, MergePolicy, Spectrum};
+
+use crate::params::{Method, ParamError, RenderParams};
+use crate::path::PathTracer;
+use crate::photon_mapper::{PhotonMapper, SlotFrequency};
+use crate::renderer::{Engine, Renderer};
+use crate::update::FrequencyFloor;
+
+const MAGIC: &[u8; 8] = b"FPPMSTAT";
+/// Version of the checkpoint layout; bump it whenever the layout or the meaning of a field
+/// changes, so that old checkpoints are refused rather than misread.
+pub const STATE_VERSION: u32 = 1;
+
+/// Why a checkpoint could not be restored.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum StateError {
+    /// The bytes do not start with the checkpoint magic.
+    #[error("not an fppm checkpoint")]
+    NotACheckpoint,
+    /// A checkpoint of another format version.
+    #[error("checkpoint format version {found}, this fppm reads version {STATE_VERSION}")]
+    Version {
+        /// The version in the file.
+        found: u32,
+    },
+    /// The checkpoint was made for a different scene (or a changed scene file).
+    #[error(
+        "checkpoint was made for another scene (fingerprint {found:016x}, this scene {expected:016x})"
+    )]
+    SceneMismatch {
+        /// Fingerprint stored in the checkpoint.
+        found: u64,
+        /// Fingerprint of the scene given.
+        expected: u64,
+    },
+    /// The file ends early or its checksum does not match.
+    #[error("checkpoint is truncated or corrupt")]
+    Corrupt,
+    /// The stored parameters are invalid.
+    #[error("checkpoint parameters are invalid: {0}")]
+    Params(#[from] ParamError),
+}
+
+/// What a checkpoint says about itself, readable without the scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateHeader {
+    /// The note given to [`Renderer::save_state`].
+    pub note: String,
+    /// The render parameters.
+    pub params: RenderParams,
+    /// Passes completed.
+    pub passes: u32,
+    /// Fingerprint of the scene ([`scene_fingerprint`]).
+    pub scene_fingerprint: u64,
+}
+
+impl StateHeader {
+    /// Reads the header of a checkpoint.
+    ///
+    /// # Errors
+    ///
+    /// [`StateError`] if the bytes are not a checkpoint of this version or are corrupt.
+    pub fn read(bytes: &[u8]) -> Result<Self, StateError> {
+        let mut reader = Reader::new(bytes)?;
+        read_header(&mut reader)
+    }
+}
+
+impl<'s> Renderer<'s> {
+    /// The exact state of this render, with a free-form `note` (e.g. the scene path) stored
+    /// alongside; see [`Renderer::restore`].
+    #[must_use]
+    pub fn save_state(&self, note: &str) -> Vec<u8> {
+        let mut w = Writer::default();
+        w.bytes(MAGIC);
+        w.u32(STATE_VERSION);
+        w.u64(scene_fingerprint(self.scene.description()));
+        w.str(note);
+        write_params(&mut w, self.params());
+        w.u32(self.passes());
+        match &self.engine {
+            Engine::Photons(p) => write_photon_mapper(&mut w, p),
+            Engine::Path(p) => {
+                w.u64(p.sum.len() as u64);
+                for s in &p.sum {
+                    s.iter().for_each(|&v| w.f64(v));
+                }
+            }
+        }
+        let checksum = fnv1a(FNV_OFFSET, &w.out);
+        w.u64(checksum);
+        w.out
+    }
+
+    /// The renderer saved by [`Renderer::save_state`], for `scene`. Its next passes are
+    /// bit-identical to those the saved renderer would have run.
+    ///
+    /// # Errors
+    ///
+    /// [`StateError`] if the bytes are not a checkpoint of this version, are corrupt, or were
+    /// made for another scene.
+    pub fn restore(scene: &'s Scene, bytes: &[u8]) -> Result<Self, StateError> {
+        let mut r = Reader::new(bytes)?;
+        let header = read_header(&mut r)?;
+        let expected = scene_fingerprint(scene.description());
+        if header.scene_fingerprint != expected {
+            return Err(StateError::SceneMismatch {
+                found: header.scene_fingerprint,
+                expected,
+            });
+        }
+        let mut renderer = Renderer::new(scene, header.params)?;
+        match &mut renderer.engine {
+            Engine::Photons(p) => read_photon_mapper(&mut r, p, header.passes)?,
+            Engine::Path(p) => read_path_tracer(&mut r, p, header.passes)?,
+        }
+        if !r.rest.is_empty() {
+            return Err(StateError::Corrupt);
+        }
+        Ok(renderer)
+    }
+}
+
+fn read_header(r: &mut Reader<'_>) -> Result<StateHeader, StateError> {
+    if r.take(8)? != MAGIC {
+        return Err(StateError::NotACheckpoint);
+    }
+    let found = r.u32()?;
+    if found != STATE_VERSION {
+        return Err(StateError::Version { found });
+    }
+    let scene_fingerprint = r.u64()?;
+    let note = r.str()?;
+    let params = read_params(r)?;
+    params.validate()?;
+    let passes = r.u32()?;
+    Ok(StateHeader {
+        note,
+        params,
+        passes,
+        scene_fingerprint,
+    })
+}
+
+fn write_params(w: &mut Writer, p: &RenderParams) {
+    w.str(p.method.name());
+    w.u32(p.photons_per_pass);
+    w.f64(p.alpha);
+    w.f64(p.initial_radius.unwrap_or(-1.0));
+    w.u32(p.max_depth);
+    w.u32(p.samples_per_pixel);
+    w.u64(p.seed);
+    w.f64(p.freq_fraction);
+    w.u32(match p.freq_merge {
+        MergePolicy::MinRadius => 0,
+        MergePolicy::PosterMax => 1,
+    });
+    w.f64(p.kernel_k);
+    w.u32(match p.freq_floor {
+        FrequencyFloor::Keep => 0,
+        FrequencyFloor::Clamp => 1,
+    });
+    w.u32(u32::from(p.direct_lighting));
+}
+
+fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
+    let method = Method::from_name(&r.str()?).ok_or(StateError::Corrupt)?;
+    let photons_per_pass = r.u32()?;
+    let alpha = r.f64()?;
+    let initial_radius = r.f64()?;
+    let max_depth = r.u32()?;
+    let samples_per_pixel = r.u32()?;
+    let seed = r.u64()?;
+    let freq_fraction = r.f64()?;
+    let freq_merge = match r.u32()? {
+        0 => MergePolicy::MinRadius,
+        1 => MergePolicy::PosterMax,
+        _ => return Err(StateError::Corrupt),
+    };
+    let kernel_k = r.f64()?;
+    let freq_floor = match r.u32()? {
+        0 => FrequencyFloor::Keep,
+        1 => FrequencyFloor::Clamp,
+        _ => return Err(StateError::Corrupt),
+    };
+    let direct_lighting = match r.u32()? {
+        0 => false,
+        1 => true,
+        _ => return Err(StateError::Corrupt),
+    };
+    Ok(RenderParams {
+        method,
+        photons_per_pass,
+        alpha,
+        initial_radius: (initial_radius >= 0.0).then_some(initial_radius),
+        max_depth,
+        samples_per_pixel,
+        seed,
+        freq_fraction,
+        freq_merge,
+        kernel_k,
+        freq_floor,
+        direct_lighting,
+    })
+}
+
+fn write_photon_mapper(w: &mut Writer, p: &PhotonMapper<'_>) {
+    w.u64(p.n_emitted);
+    w.u32(p.camera_passes);
+    let s = &p.slots;
+    w.u64(s.len() as u64);
+    for i in 0..s.len() {
+        for v in [
+            s.position()[i],
+            s.shading_normal()[i],
+            s.geometric_normal()[i],
+            s.outgoing()[i],
+            s.weight()[i],
+        ] {
+            v.to_array().iter().for_each(|&c| w.f32(c));
+        }
+        w.u32(s.material_idx()[i]);
+        w.u32(s.pixel_idx()[i]);
+        w.f64(s.radius()[i]);
+        w.f64(s.photon_count()[i]);
+        s.flux()[i].iter().for_each(|&c| w.f64(c));
+        w.u32(u32::from(s.has_freq()[i]));
+        let freq = s.freq()[i];
+        w.f32(freq.normal_distance);
+        match freq.estimate.spectrum() {
+            None => w.u32(0),
+            Some(spectrum) => {
+                w.u32(1);
+                spectrum.to_bits().iter().for_each(|&b| w.u64(b));
+            }
+        }
+        w.u32(u32::from(p.valid[i]));
+        p.direct[i].iter().for_each(|&c| w.f64(c));
+    }
+}
+
+fn read_photon_mapper(
+    r: &mut Reader<'_>,
+    p: &mut PhotonMapper<'_>,
+    passes: u32,
+) -> Result<(), StateError> {
+    p.pass = passes;
+    p.n_emitted = r.u64()?;
+    p.camera_passes = r.u32()?;
+    let n = usize::try_from(r.u64()?).map_err(|_| StateError::Corrupt)?;
+    let expected = p.width as usize * p.height as usize * p.params.samples_per_pixel as usize;
+    if n != expected && n != 0 {
+        return Err(StateError::Corrupt);
+    }
+    let mut slots = HitPoints::with_capacity(n);
+    let mut stats = Vec::with_capacity(n);
+    p.valid = Vec::with_capacity(n);
+    p.direct = Vec::with_capacity(n);
+    for _ in 0..n {
+        let mut v = [Vec3::ZERO; 5];
+        for item in &mut v {
+            *item = Vec3::new(r.f32()?, r.f32()?, r.f32()?);
+        }
+        let material_idx = r.u32()?;
+        let pixel_idx = r.u32()?;
+        let radius = r.f64()?;
+        let photon_count = r.f64()?;
+        let flux = [r.f64()?, r.f64()?, r.f64()?];
+        let has_freq = r.bool()?;
+        let normal_distance = r.f32()?;
+        let spectrum = match r.u32()? {
+            0 => None,
+            1 => Some(
+                Spectrum::from_bits([r.u64()?, r.u64()?, r.u64()?, r.u64()?])
+                    .ok_or(StateError::Corrupt)?,
+            ),
+            _ => return Err(StateError::Corrupt),
+        };
+        p.valid.push(r.bool()?);
+        p.direct.push([r.f64()?, r.f64()?, r.f64()?]);
+        slots.push(NewHitPoint {
+            position: v[0],
+            shading_normal: v[1],
+            geometric_normal: v[2],
+            outgoing: v[3],
+            weight: v[4],
+            material_idx,
+            pixel_idx,
+            radius,
+            freq: SlotFrequency {
+                estimate: FrequencyEstimate::from_spectrum(spectrum),
+                normal_distance,
+            },
+        });
+        stats.push((photon_count, flux, has_freq));
+    }
+    let columns = slots.columns_mut();
+    for (i, (photon_count, flux, has_freq)) in stats.into_iter().enumerate() {
+        columns.photon_count[i] = photon_count;
+        columns.flux[i] = flux;
+        columns.has_freq[i] = has_freq;
+    }
+    p.slots = slots;
+    Ok(())
+}
+
+fn read_path_tracer(
+    r: &mut Reader<'_>,
+    p: &mut PathTracer<'_>,
+    passes: u32,
+) -> Result<(), StateError> {
+    let n = usize::try_from(r.u64()?).map_err(|_| StateError::Corrupt)?;
+    if n != p.sum.len() {
+        return Err(StateError::Corrupt);
+    }
+    for s in &mut p.sum {
+        *s = [r.f64()?, r.f64()?, r.f64()?];
+    }
+    p.passes = passes;
+    Ok(())
+}
+
+/// A 64-bit fingerprint of everything in a scene that affects rendering (camera, film,
+/// materials, geometry, lights), so that a checkpoint is never resumed on another scene.
+#[must_use]
+pub fn scene_fingerprint(d: &SceneDescription) -> u64 {
+    let mut w = Writer::hashing();
+    let camera = &d.camera;
+    for v in [camera.position, camera.look_at, camera.up] {
+        v.to_array().iter().for_each(|&c| w.f32(c));
+    }
+    [camera.fov_y, camera.aperture_radius, camera.focus_distance]
+        .iter()
+        .for_each(|&c| w.f32(c));
+    w.u32(d.film.width);
+    w.u32(d.film.height);
+    w.u64(d.materials.len() as u64);
+    for m in &d.materials {
+        m.emission.to_array().iter().for_each(|&c| w.f32(c));
+        let (tag, values): (u32, [f32; 7]) = match m.kind {
+            MaterialKind::Diffuse { albedo } => {
+                (0, [albedo.x, albedo.y, albedo.z, 0.0, 0.0, 0.0, 0.0])
+            }
+            MaterialKind::Mirror { reflectance: r } => (1, [r.x, r.y, r.z, 0.0, 0.0, 0.0, 0.0]),
+            MaterialKind::Dielectric { ior } => (2, [ior, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+            MaterialKind::Glossy {
+                reflectance: r,
+                roughness,
+                diffuse: k,
+            } => (3, [r.x, r.y, r.z, roughness, k.x, k.y, k.z]),
+        };
+        w.u32(tag);
+        values.iter().for_each(|&c| w.f32(c));
+    }
+    w.u64(d.triangles.len() as u64);
+    for t in &d.triangles {
+        t.positions
+            .iter()
+            .for_each(|p| p.to_array().iter().for_each(|&c| w.f32(c)));
+        if let Some(normals) = t.normals {
+            normals
+                .iter()
+                .for_each(|n| n.to_array().iter().for_each(|&c| w.f32(c)));
+        }
+        w.u32(t.material);
+    }
+    w.u64(d.spheres.len() as u64);
+    for s in &d.spheres {
+        s.center.to_array().iter().for_each(|&c| w.f32(c));
+        w.f32(s.radius);
+        w.u32(s.material);
+    }
+    w.u64(d.lights.len() as u64);
+    for light in &d.lights {
+        match *light {
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                w.u32(0);
+                [position, intensity]
+                    .iter()
+                    .for_each(|v| v.to_array().iter().for_each(|&c| w.f32(c)));
+            }
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                cone_angle,
+                falloff_start,
+            } => {
+                w.u32(1);
+                [position, direction, intensity]
+                    .iter()
+                    .for_each(|v| v.to_array().iter().for_each(|&c| w.f32(c)));
+                w.f32(cone_angle);
+                w.f32(falloff_start);
+            }
+            Light::Directional {
+                direction,
+                irradiance,
+            } => {
+                w.u32(2);
+                [direction, irradiance]
+                    .iter()
+                    .for_each(|v| v.to_array().iter().for_each(|&c| w.f32(c)));
+            }
+        }
+    }
+    w.hash.unwrap_or(FNV_OFFSET)
+}
+
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+
+fn fnv1a(mut hash: u64, bytes: &[u8]) -> u64 {
+    for &b in bytes {
+        hash ^= u64::from(b);
+        hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    hash
+}
+
+/// Little-endian encoder that either collects the bytes or only hashes them (the scene
+/// fingerprint of a million triangles need not be held in memory).
+#[derive(Default)]
+struct Writer {
+    out: Vec<u8>,
+    hash: Option<u64>,
+}
+
+impl Writer {
+    fn hashing() -> Self {
+        Self {
+            out: Vec::new(),
+            hash: Some(FNV_OFFSET),
+        }
+    }
+    fn bytes(&mut self, b: &[u8]) {
+        match &mut self.hash {
+            Some(hash) => *hash = fnv1a(*hash, b),
+            None => self.out.extend_from_slice(b),
+        }
+    }
+    fn u32(&mut self, v: u32) {
+        self.bytes(&v.to_le_bytes());
+    }
+    fn u64(&mut self, v: u64) {
+        self.bytes(&v.to_le_bytes());
+    }
+    fn f32(&mut self, v: f32) {
+        self.bytes(&v.to_bits().to_le_bytes());
+    }
+    fn f64(&mut self, v: f64) {
+        self.bytes(&v.to_bits().to_le_bytes());
+    }
+    fn str(&mut self, s: &str) {
+        self.u64(s.len() as u64);
+        self.bytes(s.as_bytes());
+    }
+}
+
+struct Reader<'a> {
+    rest: &'a [u8],
+}
+
+impl<'a> Reader<'a> {
+    /// A reader over the payload of `bytes`, after checking the trailing checksum.
+    fn new(bytes: &'a [u8]) -> Result<Self, StateError> {
+        if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
+            return Err(StateError::NotACheckpoint);
+        }
+        let split = bytes.len().checked_sub(8).ok_or(StateError::Corrupt)?;
+        let (payload, checksum) = bytes.split_at(split);
+        let stored = u64::from_le_bytes(checksum.try_into().map_err(|_| StateError::Corrupt)?);
+        if fnv1a(FNV_OFFSET, payload) != stored {
+            // A version mismatch is the more useful message when the header can be read.
+            if payload.len() >= 12 {
+                let found = u32::from_le_bytes([payload[8], payload[9], payload[10], payload[11]]);
+                if found != STATE_VERSION {
+                    return Err(StateError::Version { found });
+                }
+            }
+            return Err(StateError::Corrupt);
+        }
+        Ok(Self { rest: payload })
+    }
+    fn take(&mut self, n: usize) -> Result<&'a [u8], StateError> {
+        if self.rest.len() < n {
+            return Err(StateError::Corrupt);
+        }
+        let (head, tail) = self.rest.split_at(n);
+        self.rest = tail;
+        Ok(head)
+    }
+    fn array<const N: usize>(&mut self) -> Result<[u8; N], StateError> {
+        self.take(N)?.try_into().map_err(|_| StateError::Corrupt)
+    }
+    fn u32(&mut self) -> Result<u32, StateError> {
+        Ok(u32::from_le_bytes(self.array()?))
+    }
+    fn u64(&mut self) -> Result<u64, StateError> {
+        Ok(u64::from_le_bytes(self.array()?))
+    }
+    fn f32(&mut self) -> Result<f32, StateError> {
+        Ok(f32::from_bits(self.u32()?))
+    }
+    fn f64(&mut self) -> Result<f64, StateError> {
+        Ok(f64::from_bits(self.u64()?))
+    }
+    fn bool(&mut self) -> Result<bool, StateError> {
+        match self.u32()? {
+            0 => Ok(false),
+            1 => Ok(true),
+            _ => Err(StateError::Corrupt),
+        }
+    }
+    fn str(&mut self) -> Result<String, StateError> {
+        let n = usize::try_from(self.u64()?).map_err(|_| StateError::Corrupt)?;
+        String::from_utf8(self.take(n)?.to_vec()).map_err(|_| StateError::Corrupt)
+    }
+}
