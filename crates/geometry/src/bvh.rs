@@ -1,4 +1,5 @@
-//! The one obvhs CwBvh over triangles and analytic spheres. obvhs types never leave this module.
+//! The one obvhs CwBvh over triangles, analytic spheres and analytic cylinders. obvhs types never
+//! leave this module.
 
 use std::time::Duration;
 
@@ -10,7 +11,7 @@ use obvhs::{
     ray::{Ray as BvhRay, RayHit},
 };
 
-use crate::{Ray, Sphere, Triangle};
+use crate::{Cylinder, Ray, Sphere, Triangle};
 
 /// Padding of every primitive's box, in internal units.
 ///
@@ -23,7 +24,7 @@ use crate::{Ray, Sphere, Triangle};
 const CWBVH_PAD: f32 = 2e-4;
 
 /// The power of two that brings the largest coordinate magnitude of the scene to [2⁹, 2¹⁰).
-fn internal_scale(triangles: &[Triangle], spheres: &[Sphere]) -> f32 {
+fn internal_scale(triangles: &[Triangle], spheres: &[Sphere], cylinders: &[Cylinder]) -> f32 {
     let mut max = 0.0f32;
     for t in triangles {
         for p in t.positions {
@@ -32,6 +33,10 @@ fn internal_scale(triangles: &[Triangle], spheres: &[Sphere]) -> f32 {
     }
     for s in spheres {
         max = max.max(s.center.abs().max_element() + s.radius);
+    }
+    for c in cylinders {
+        let b = c.bounds();
+        max = max.max(b.min.abs().max(b.max.abs()).max_element());
     }
     if !(max.is_finite() && max > 0.0) {
         return 1.0;
@@ -43,11 +48,17 @@ fn internal_scale(triangles: &[Triangle], spheres: &[Sphere]) -> f32 {
 /// Marks sphere ids in [`Accel::ids`]; the low bits hold the sphere index.
 const SPHERE_BIT: u32 = 1 << 31;
 
+/// Marks cylinder ids in [`Accel::ids`]; the low bits hold the cylinder index. Triangle indices
+/// therefore stay below 2³⁰.
+const CYLINDER_BIT: u32 = 1 << 30;
+
 /// A primitive in BVH order, laid out for fast intersection (64 bytes).
 ///
 /// Triangles use the layout of obvhs' `RtTriangle` (e1 = v0 − v1, e2 = v2 − v0, ng = e1 × e2).
 /// Spheres are tagged by `ng == 0` (degenerate triangles never enter the BVH):
-/// `v0` is the centre, `e1.x` the radius and `e1.y` its square.
+/// `v0` is the centre, `e1.x` the radius and `e1.y` its square. Cylinders are tagged by a NaN
+/// `ng.x` (triangles with a non-finite normal never enter the BVH either); their data lives in
+/// [`Accel::cylinders`], found through [`Accel::ids`].
 #[derive(Clone, Copy, Debug)]
 struct PrimGeom {
     v0: Vec3A,
@@ -78,19 +89,24 @@ impl PrimGeom {
         }
     }
 
+    /// The tag of a cylinder (see the type's documentation).
+    fn cylinder() -> Self {
+        Self {
+            v0: Vec3A::ZERO,
+            e1: Vec3A::ZERO,
+            e2: Vec3A::ZERO,
+            ng: Vec3A::new(f32::NAN, 0.0, 0.0),
+        }
+    }
+
     #[inline(always)]
     fn is_sphere(&self) -> bool {
         self.ng.cmpeq(Vec3A::ZERO).all()
     }
 
-    /// Ray parameter of the closest intersection in [tmin, tmax) (triangles) or (tmin, tmax) (spheres), or ∞.
     #[inline(always)]
-    fn intersect(&self, ray: &BvhRay) -> f32 {
-        if self.is_sphere() {
-            intersect_sphere(self.v0, self.e1.y, ray)
-        } else {
-            self.intersect_triangle(ray)
-        }
+    fn is_cylinder(&self) -> bool {
+        self.ng.x.is_nan()
     }
 
     /// Möller–Trumbore in the form of obvhs' `RtTriangle::intersect`, with inclusive edges.
@@ -150,6 +166,94 @@ fn intersect_sphere(center: Vec3A, radius2: f32, ray: &BvhRay) -> f32 {
     }
 }
 
+/// A cylinder in internal (scaled) coordinates.
+#[derive(Clone, Copy, Debug)]
+struct CylGeom {
+    /// Centre of the bottom circle.
+    center: Vec3A,
+    /// Unit axis.
+    axis: Vec3A,
+    /// Unit vector perpendicular to the axis on which the kept arc is centred.
+    facing: Vec3A,
+    radius: f32,
+    height: f32,
+    /// cos(arc / 2); below −1 for a whole circle.
+    cos_half_arc: f32,
+}
+
+impl CylGeom {
+    fn new(c: &Cylinder, scale: f32) -> Self {
+        Self {
+            center: Vec3A::from(c.center * scale),
+            axis: Vec3A::from(c.axis),
+            facing: Vec3A::from(c.facing),
+            radius: c.radius * scale,
+            height: c.height * scale,
+            cos_half_arc: if c.arc >= std::f32::consts::TAU {
+                -2.0
+            } else {
+                (0.5 * c.arc).cos()
+            },
+        }
+    }
+
+    /// Closest root in (tmin, tmax) of the open cylinder that lies within its height and arc, or ∞.
+    ///
+    /// With f = o − c split into f⊥ + fₐ·a (and likewise d), the roots of |f⊥ + t·d⊥|² = r² are
+    /// t = (b ± √disc)/A with A = |d⊥|², b = −f⊥·d⊥ and disc = A·(r² − |l|²), l = f⊥ + (b/A)·d⊥
+    /// the point of closest approach to the axis (the stable form of the sphere's test); both roots
+    /// are tried, nearer first, against the height and arc ranges.
+    #[inline(always)]
+    fn intersect(&self, ray: &BvhRay) -> f32 {
+        let a = self.axis;
+        let f = ray.origin - self.center;
+        let d = ray.direction;
+        let fa = f.dot(a);
+        let da = d.dot(a);
+        let fp = f - fa * a;
+        let dp = d - da * a;
+        let aa = dp.length_squared();
+        if aa.is_nan() || aa <= 0.0 {
+            // Parallel to the axis: an open cylinder is never crossed.
+            return f32::INFINITY;
+        }
+        let r2 = self.radius * self.radius;
+        let b = -fp.dot(dp);
+        let l = fp + (b / aa) * dp;
+        let disc = aa * (r2 - l.length_squared());
+        if disc.is_nan() || disc < 0.0 {
+            return f32::INFINITY;
+        }
+        let c = fp.length_squared() - r2;
+        let q = b + disc.sqrt().copysign(b);
+        if q == 0.0 {
+            return f32::INFINITY;
+        }
+        let (t0, t1) = {
+            let x = c / q;
+            let y = q / aa;
+            if x < y { (x, y) } else { (y, x) }
+        };
+        for t in [t0, t1] {
+            if !(t > ray.tmin && t < ray.tmax) {
+                continue;
+            }
+            let s = fa + t * da;
+            if !(s >= 0.0 && s <= self.height) {
+                continue;
+            }
+            if self.cos_half_arc >= -1.0 {
+                let radial = fp + t * dp;
+                if radial.dot(self.facing) < self.cos_half_arc * radial.length() {
+                    continue;
+                }
+            }
+            return t;
+        }
+        f32::INFINITY
+    }
+}
+
 /// What a closest-hit query found, in terms of the scene description.
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum RawHit {
@@ -162,6 +266,8 @@ pub(crate) enum RawHit {
     },
     /// A sphere.
     Sphere { index: u32, t: f32 },
+    /// A cylinder.
+    Cylinder { index: u32, t: f32 },
 }
 
 /// The acceleration structure.
@@ -171,19 +277,26 @@ pub(crate) struct Accel {
     bvh: Option<CwBvh>,
     /// Primitives in BVH order.
     prims: Vec<PrimGeom>,
-    /// BVH order → triangle index, or `SPHERE_BIT | sphere index`.
+    /// BVH order → triangle index, `SPHERE_BIT | sphere index` or `CYLINDER_BIT | cylinder index`.
     ids: Vec<u32>,
+    /// Cylinders in description order, in internal coordinates.
+    cylinders: Vec<CylGeom>,
     /// Power of two by which world coordinates are multiplied (exactly) to get internal ones.
     scale: f32,
 }
 
 impl Accel {
-    /// Builds the BVH over every non-degenerate triangle and every sphere.
-    pub(crate) fn build(triangles: &[Triangle], spheres: &[Sphere]) -> Self {
-        let scale = internal_scale(triangles, spheres);
-        let mut prims = Vec::with_capacity(triangles.len() + spheres.len());
-        let mut ids = Vec::with_capacity(triangles.len() + spheres.len());
-        let mut aabbs = Vec::with_capacity(triangles.len() + spheres.len());
+    /// Builds the BVH over every non-degenerate triangle, every sphere and every cylinder.
+    pub(crate) fn build(
+        triangles: &[Triangle],
+        spheres: &[Sphere],
+        cylinders: &[Cylinder],
+    ) -> Self {
+        let scale = internal_scale(triangles, spheres, cylinders);
+        let n = triangles.len() + spheres.len() + cylinders.len();
+        let mut prims = Vec::with_capacity(n);
+        let mut ids = Vec::with_capacity(n);
+        let mut aabbs = Vec::with_capacity(n);
         let padded = |lo: Vec3A, hi: Vec3A| {
             let pad = CWBVH_PAD + 4.0 * f32::EPSILON * lo.abs().max(hi.abs()).max_element();
             BvhAabb::new(lo - Vec3A::splat(pad), hi + Vec3A::splat(pad))
@@ -211,11 +324,23 @@ impl Accel {
             prims.push(PrimGeom::sphere(&s));
             ids.push(i as u32 | SPHERE_BIT);
         }
+        let cylinder_geoms: Vec<CylGeom> =
+            cylinders.iter().map(|c| CylGeom::new(c, scale)).collect();
+        for (i, c) in cylinders.iter().enumerate() {
+            let b = c.bounds();
+            aabbs.push(padded(
+                Vec3A::from(b.min * scale),
+                Vec3A::from(b.max * scale),
+            ));
+            prims.push(PrimGeom::cylinder());
+            ids.push(i as u32 | CYLINDER_BIT);
+        }
         if prims.is_empty() {
             return Self {
                 bvh: None,
                 prims,
                 ids,
+                cylinders: cylinder_geoms,
                 scale,
             };
         }
@@ -236,7 +361,23 @@ impl Accel {
             bvh: Some(bvh),
             prims,
             ids,
+            cylinders: cylinder_geoms,
             scale,
+        }
+    }
+
+    /// Ray parameter of the closest intersection with the primitive in BVH slot `slot`, in
+    /// [tmin, tmax) (triangles) or (tmin, tmax) (spheres, cylinders), or ∞.
+    #[inline(always)]
+    fn intersect_prim(&self, ray: &BvhRay, slot: usize) -> f32 {
+        let p = &self.prims[slot];
+        if p.is_sphere() {
+            intersect_sphere(p.v0, p.e1.y, ray)
+        } else if p.is_cylinder() {
+            let index = (self.ids[slot] & !CYLINDER_BIT) as usize;
+            self.cylinders[index].intersect(ray)
+        } else {
+            p.intersect_triangle(ray)
         }
     }
 
@@ -261,9 +402,8 @@ impl Accel {
             return None;
         }
         let bray = self.bvh_ray(ray);
-        let prims = &self.prims;
         let mut hit = RayHit::none();
-        if !bvh.ray_traverse(bray, &mut hit, |r, id| prims[id].intersect(r)) {
+        if !bvh.ray_traverse(bray, &mut hit, |r, id| self.intersect_prim(r, id)) {
             return None;
         }
         let t = hit.t / self.scale;
@@ -274,8 +414,13 @@ impl Accel {
                 index: id & !SPHERE_BIT,
                 t,
             })
+        } else if id & CYLINDER_BIT != 0 {
+            Some(RawHit::Cylinder {
+                index: id & !CYLINDER_BIT,
+                t,
+            })
         } else {
-            let (b1, b2) = prims[slot].barycentrics(bray.origin, bray.direction);
+            let (b1, b2) = self.prims[slot].barycentrics(bray.origin, bray.direction);
             Some(RawHit::Triangle {
                 index: id,
                 t,
@@ -294,8 +439,7 @@ impl Accel {
         if !(ray.direction.is_finite() && ray.origin.is_finite()) {
             return false;
         }
-        let prims = &self.prims;
-        !bvh.ray_traverse_miss(self.bvh_ray(ray), |r, id| prims[id].intersect(r))
+        !bvh.ray_traverse_miss(self.bvh_ray(ray), |r, id| self.intersect_prim(r, id))
     }
 
     /// Number of primitives in the BVH.

@@ -28,6 +28,8 @@ pub struct SceneDescription {
     pub triangles: Vec<Triangle>,
     /// Analytic spheres.
     pub spheres: Vec<Sphere>,
+    /// Analytic open cylinders (an extension to scene format 1, see `docs/scene-format-extensions.md`).
+    pub cylinders: Vec<Cylinder>,
     /// Point, spot and directional lights (area emitters are emissive materials).
     pub lights: Vec<Light>,
     /// Optional render defaults from the `[render]` table; flags override them.
@@ -134,6 +136,49 @@ pub struct Sphere {
     pub radius: f32,
     /// Index into [`SceneDescription::materials`].
     pub material: u32,
+}
+
+/// An analytic open cylinder (no caps), possibly cut to an arc of its circle.
+///
+/// The surface is every point `center + s·axis + radius·r` with `s` in `[0, height]` and `r` a
+/// unit vector perpendicular to `axis` whose angle to `facing` is at most `arc / 2`. Its front
+/// face is the outside (normals pointing away from the axis). It scatters on both sides and
+/// cannot emit ([`crate::Scene::new`] rejects an emissive material).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cylinder {
+    /// Centre of the bottom circle.
+    pub center: Vec3,
+    /// Unit axis direction, from the bottom circle to the top one.
+    pub axis: Vec3,
+    /// Radius (> 0).
+    pub radius: f32,
+    /// Height along `axis` (> 0).
+    pub height: f32,
+    /// Angle of the circle that is kept, in radians, in (0, 2π]; 2π is the whole cylinder.
+    pub arc: f32,
+    /// Unit vector perpendicular to `axis` on which the kept arc is centred.
+    pub facing: Vec3,
+    /// Index into [`SceneDescription::materials`].
+    pub material: u32,
+}
+
+impl Cylinder {
+    /// Axis-aligned bounds of the whole (uncut) cylinder: the box of its two end circles.
+    #[must_use]
+    pub fn bounds(&self) -> crate::Aabb {
+        let top = self.center + self.height * self.axis;
+        let extent = self.radius * (Vec3::ONE - self.axis * self.axis).max(Vec3::ZERO).sqrt();
+        crate::Aabb {
+            min: self.center.min(top) - extent,
+            max: self.center.max(top) + extent,
+        }
+    }
+
+    /// Whether the unit vector `radial` (perpendicular to the axis) lies in the kept arc.
+    #[must_use]
+    pub fn in_arc(&self, radial: Vec3) -> bool {
+        self.arc >= std::f32::consts::TAU || radial.dot(self.facing) >= (0.5 * self.arc).cos()
+    }
 }
 
 /// A delta light source.

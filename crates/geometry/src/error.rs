@@ -188,8 +188,8 @@ pub enum LoadError {
         /// `"nan"` or `"infinite"`.
         what: &'static str,
     },
-    /// The scene has no geometry at all (no non-degenerate triangle and no sphere).
-    #[error("{}: empty scene: no triangles or spheres", path.display())]
+    /// The scene has no geometry at all (no non-degenerate triangle, no sphere, no cylinder).
+    #[error("{}: empty scene: no triangles, spheres or cylinders", path.display())]
     EmptyScene {
         /// The file.
         path: PathBuf,

@@ -2,16 +2,20 @@
 //!
 //! The principal type is [`Scene`], built from a plain [`SceneDescription`] by [`Scene::new`].
 //! It answers closest-hit ([`Scene::intersect`]) and shadow ([`Scene::occluded`], [`Scene::visible`])
-//! queries through one obvhs CwBvh over triangles and analytic spheres, and owns the
+//! queries through one obvhs CwBvh over triangles, analytic spheres and analytic open cylinders
+//! (a scene-format extension, `docs/scene-format-extensions.md`), and owns the
 //! [`CameraModel`] and the [`LightSampler`]. Materials become [`Bsdf`]s at a [`Hit`].
 //!
 //! Conventions:
 //! - Directions point away from surfaces (pbrt): a BSDF's `outgoing` points back along the path.
 //! - A [`Hit`]'s normals face the side the ray came from; `front_face` says whether that is the
-//!   primitive's front (the counter-clockwise side of a triangle, the outside of a sphere).
+//!   primitive's front (the counter-clockwise side of a triangle, the outside of a sphere or of
+//!   a cylinder).
 //!   Emission leaves front faces only; a dielectric's outside is its front.
 //! - [`Hit::curvature`] is signed as in frequency-algebra §3: positive when the centre of curvature
-//!   lies on the side the ray came from (a sphere: −1/R from outside, +1/R from inside).
+//!   lies on the side the ray came from (a sphere: −1/R from outside, +1/R from inside). It is
+//!   the mean curvature: a cylinder, curved by 1/R around its axis and not along it, gives
+//!   ∓1/(2R); frequency analysis of the focusing around the axis would want the 1/R itself.
 //! - Secondary rays ([`Hit::spawn_ray`], [`Hit::spawn_ray_to`]) start off the surface by pbrt-v4's
 //!   floating-point error bound, so they neither re-hit their surface nor slip through corners.
 //! - Refraction scales radiance by 1/η′² on camera paths only ([`TransportMode`]).
@@ -61,8 +65,8 @@ pub use aabb::Aabb;
 pub use bsdf::{Bsdf, BsdfSample, Lobe, TransportMode, fresnel_dielectric};
 pub use camera::CameraModel;
 pub use description::{
-    Camera, Film, Light, LoadNotes, Material, MaterialKind, RenderDefaults, Rgb, SceneDescription,
-    Sphere, Triangle,
+    Camera, Cylinder, Film, Light, LoadNotes, Material, MaterialKind, RenderDefaults, Rgb,
+    SceneDescription, Sphere, Triangle,
 };
 pub use error::LoadError;
 pub use frame::Frame;

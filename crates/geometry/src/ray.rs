@@ -50,6 +50,8 @@ pub enum Primitive {
     Triangle(u32),
     /// Index into [`crate::SceneDescription::spheres`].
     Sphere(u32),
+    /// Index into [`crate::SceneDescription::cylinders`].
+    Cylinder(u32),
 }
 
 /// The closest intersection of a ray with the scene.
@@ -57,7 +59,7 @@ pub enum Primitive {
 /// Normal convention: `geometric_normal` and `shading_normal` are unit vectors on the side the ray
 /// came from (`geometric_normal · ray.direction ≤ 0`), which suits two-sided scattering.
 /// `front_face` says whether that side is the primitive's front: the counter-clockwise side of a
-/// triangle, the outside of a sphere. Emission and the dielectric's inside/outside follow `front_face`.
+/// triangle, the outside of a sphere or cylinder. Emission and the dielectric's inside/outside follow `front_face`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
     /// Ray parameter of the hit (the distance, since ray directions are unit).
@@ -71,18 +73,23 @@ pub struct Hit {
     /// Unit shading normal (interpolated vertex normals if present, else the geometric normal),
     /// flipped onto the same side as `geometric_normal`.
     pub shading_normal: Vec3,
-    /// Whether the ray hit the front face (counter-clockwise side of a triangle, outside of a sphere).
+    /// Whether the ray hit the front face (counter-clockwise side of a triangle, outside of a sphere
+    /// or cylinder).
     pub front_face: bool,
     /// Index into [`crate::SceneDescription::materials`].
     pub material: u32,
     /// Signed mean curvature seen from the side the ray came from, following frequency-algebra §3:
     /// positive when the centre of curvature lies on the ray's side (concave, focusing).
-    /// A sphere is exactly −1/R from outside and +1/R from inside; a mesh triangle gets the mean
+    /// A sphere is exactly −1/R from outside and +1/R from inside; a cylinder reports its mean
+    /// curvature, −1/(2R) from outside and +1/(2R) from inside (its curvature around the axis,
+    /// the one that focuses in a plane across the axis, is twice that); a mesh triangle gets the mean
     /// over its edges of −Δn·Δp/|Δp|² from its vertex normals; flat or normal-less triangles give 0.
     pub curvature: f32,
     /// The primitive that was hit.
     pub primitive: Primitive,
-    /// Triangle barycentrics (b1, b2) of the hit (b0 = 1 − b1 − b2); for spheres (φ/2π, θ/π) about +z.
+    /// Triangle barycentrics (b1, b2) of the hit (b0 = 1 − b1 − b2); for spheres (φ/2π, θ/π) about +z;
+    /// for cylinders (position across the kept arc from 0 to 1, counter-clockwise about the axis;
+    /// height / `height`).
     pub uv: Vec2,
 }
 

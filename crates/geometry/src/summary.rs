@@ -19,6 +19,8 @@ pub struct SceneSummary {
     pub triangles: usize,
     /// Number of analytic spheres.
     pub spheres: usize,
+    /// Number of analytic cylinders (never emissive).
+    pub cylinders: usize,
     /// Triangles whose material emits.
     pub emissive_triangles: usize,
     /// Spheres whose material emits.
@@ -77,6 +79,13 @@ pub struct MaterialSummary {
     pub triangles: usize,
     /// Spheres using the material.
     pub spheres: usize,
+    /// Cylinders using the material (left out of snapshots when zero).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub cylinders: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// The camera in a [`SceneSummary`] (field of view in degrees).
@@ -192,6 +201,7 @@ impl SceneDescription {
                     emission: Rgb6(m.emission),
                     triangles: 0,
                     spheres: 0,
+                    cylinders: 0,
                 }
             })
             .collect();
@@ -203,6 +213,11 @@ impl SceneDescription {
         for s in &self.spheres {
             if let Some(m) = materials.get_mut(s.material as usize) {
                 m.spheres += 1;
+            }
+        }
+        for c in &self.cylinders {
+            if let Some(m) = materials.get_mut(c.material as usize) {
+                m.cylinders += 1;
             }
         }
         let emits = |i: u32| {
@@ -223,6 +238,7 @@ impl SceneDescription {
             source: self.source.display().to_string(),
             triangles: self.triangles.len(),
             spheres: self.spheres.len(),
+            cylinders: self.cylinders.len(),
             emissive_triangles: self.triangles.iter().filter(|t| emits(t.material)).count(),
             emissive_spheres: self.spheres.iter().filter(|s| emits(s.material)).count(),
             lights,
@@ -236,10 +252,12 @@ impl SceneDescription {
                 focus_distance: F6(c.focus_distance),
             },
             film: [self.film.width, self.film.height],
-            bounds: crate::load::bounds(&self.triangles, &self.spheres).map(|(min, max)| Bounds {
-                min: Rgb6(min),
-                max: Rgb6(max),
-            }),
+            bounds: crate::load::bounds(&self.triangles, &self.spheres, &self.cylinders).map(
+                |(min, max)| Bounds {
+                    min: Rgb6(min),
+                    max: Rgb6(max),
+                },
+            ),
             degenerate_triangles: self.notes.degenerate_triangles,
             camera_framed: self.notes.camera_framed,
             warnings: self.notes.warnings.clone(),
@@ -264,8 +282,12 @@ impl fmt::Display for SceneSummary {
         writeln!(f, "scene      {}", self.source)?;
         writeln!(
             f,
-            "geometry   {} triangles ({} emissive), {} spheres ({} emissive)",
-            self.triangles, self.emissive_triangles, self.spheres, self.emissive_spheres
+            "geometry   {} triangles ({} emissive), {} spheres ({} emissive), {} cylinders",
+            self.triangles,
+            self.emissive_triangles,
+            self.spheres,
+            self.emissive_spheres,
+            self.cylinders
         )?;
         writeln!(
             f,
@@ -306,7 +328,11 @@ impl fmt::Display for SceneSummary {
             if m.emission.0 != Vec3::ZERO {
                 write!(f, " emission {}", m.emission)?;
             }
-            writeln!(f, " ({} triangles, {} spheres)", m.triangles, m.spheres)?;
+            write!(f, " ({} triangles, {} spheres", m.triangles, m.spheres)?;
+            if m.cylinders > 0 {
+                write!(f, ", {} cylinders", m.cylinders)?;
+            }
+            writeln!(f, ")")?;
         }
         if self.degenerate_triangles > 0 {
             writeln!(

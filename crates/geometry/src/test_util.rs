@@ -80,6 +80,7 @@ pub(crate) fn description(
         materials: vec![diffuse(0.5, Vec3::ZERO), diffuse(0.0, Vec3::ONE)],
         triangles,
         spheres,
+        cylinders: Vec::new(),
         lights,
         render: RenderDefaults::default(),
         notes: LoadNotes::default(),

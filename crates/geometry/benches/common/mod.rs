@@ -133,6 +133,7 @@ fn framed_description(path: &Path, triangles: Vec<Triangle>) -> SceneDescription
         }],
         triangles,
         spheres: vec![],
+        cylinders: Vec::new(),
         lights: vec![Light::Point {
             position: center + Vec3::Y * 2.0 * radius,
             intensity: Vec3::ONE,

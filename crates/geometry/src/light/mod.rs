@@ -388,6 +388,7 @@ impl LightSampler {
         let idx = match hit.primitive {
             Primitive::Triangle(i) => self.triangle_emitter.get(i as usize),
             Primitive::Sphere(i) => self.sphere_emitter.get(i as usize),
+            Primitive::Cylinder(_) => None,
         };
         let Some(&idx) = idx.filter(|&&i| i != u32::MAX) else {
             return 0.0;

@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 
-use crate::description::{Camera, Sphere, Triangle};
+use crate::description::{Camera, Cylinder, Sphere, Triangle};
 
 /// Vertical field of view of a framed camera, in degrees.
 pub const FRAMED_FOV_Y_DEGREES: f32 = 40.0;
@@ -10,8 +10,12 @@ pub const FRAMED_FOV_Y_DEGREES: f32 = 40.0;
 /// Extra room around the framed bounding box (5 %).
 const MARGIN: f32 = 1.05;
 
-/// World-space bounding box of triangles and spheres, or `None` if there are none.
-pub(crate) fn bounds(triangles: &[Triangle], spheres: &[Sphere]) -> Option<(Vec3, Vec3)> {
+/// World-space bounding box of triangles, spheres and cylinders, or `None` if there are none.
+pub(crate) fn bounds(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    cylinders: &[Cylinder],
+) -> Option<(Vec3, Vec3)> {
     let mut lo = Vec3::splat(f32::INFINITY);
     let mut hi = Vec3::splat(f32::NEG_INFINITY);
     for p in triangles.iter().flat_map(|t| t.positions) {
@@ -22,6 +26,11 @@ pub(crate) fn bounds(triangles: &[Triangle], spheres: &[Sphere]) -> Option<(Vec3
         lo = lo.min(s.center - Vec3::splat(s.radius));
         hi = hi.max(s.center + Vec3::splat(s.radius));
     }
+    for c in cylinders {
+        let b = c.bounds();
+        lo = lo.min(b.min);
+        hi = hi.max(b.max);
+    }
     (lo.cmple(hi).all()).then_some((lo, hi))
 }
 
@@ -30,8 +39,14 @@ pub(crate) fn bounds(triangles: &[Triangle], spheres: &[Sphere]) -> Option<(Vec3
 /// face (z = max z), and with it everything behind it, fits the image with a 5 % margin:
 /// distance = max(half height, half width / aspect) / tan(fov / 2) from the front face.
 /// (For McGuire's Cornell box this gives a camera at about z = 3.9, as in the classic setup.)
-pub(crate) fn frame_camera(triangles: &[Triangle], spheres: &[Sphere], aspect: f32) -> Camera {
-    let (lo, hi) = bounds(triangles, spheres).unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)));
+pub(crate) fn frame_camera(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    cylinders: &[Cylinder],
+    aspect: f32,
+) -> Camera {
+    let (lo, hi) =
+        bounds(triangles, spheres, cylinders).unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)));
     let center = 0.5 * (lo + hi);
     let half = 0.5 * (hi - lo);
     let aspect = if aspect.is_finite() && aspect > 0.0 {

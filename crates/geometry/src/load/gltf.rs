@@ -115,7 +115,7 @@ pub(crate) fn load_gltf(path: &Path) -> Result<MeshData, LoadError> {
     }
     data.camera = walker.camera.map(|(_, mut camera, aspect)| {
         // Focus on the scene's centre (depth along the view), for a later thin lens.
-        if let Some((lo, hi)) = super::bounds(&data.triangles, &[]) {
+        if let Some((lo, hi)) = super::bounds(&data.triangles, &[], &[]) {
             let forward = camera.look_at - camera.position;
             let depth = (0.5 * (lo + hi) - camera.position).dot(forward);
             if depth.is_finite() && depth > 0.0 {

@@ -26,7 +26,8 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 
 use crate::description::{
-    Camera, Film, Light, LoadNotes, Material, RenderDefaults, SceneDescription, Sphere, Triangle,
+    Camera, Cylinder, Film, Light, LoadNotes, Material, RenderDefaults, SceneDescription, Sphere,
+    Triangle,
 };
 use crate::error::LoadError;
 
@@ -194,6 +195,7 @@ impl MeshData {
             materials: self.materials,
             triangles: self.triangles,
             spheres: Vec::new(),
+            cylinders: Vec::new(),
             lights: self.lights,
             render: RenderDefaults::default(),
             notes: LoadNotes {
@@ -254,6 +256,7 @@ pub(crate) struct SceneParts {
     pub(crate) materials: Vec<Material>,
     pub(crate) triangles: Vec<Triangle>,
     pub(crate) spheres: Vec<Sphere>,
+    pub(crate) cylinders: Vec<Cylinder>,
     pub(crate) lights: Vec<Light>,
     pub(crate) render: RenderDefaults,
     pub(crate) notes: LoadNotes,
@@ -273,6 +276,7 @@ pub(crate) fn finish(
         materials,
         triangles,
         spheres,
+        cylinders,
         lights,
         render,
         mut notes,
@@ -284,7 +288,7 @@ pub(crate) fn finish(
     for light in &lights {
         check_light(path, light)?;
     }
-    if triangles.is_empty() && spheres.is_empty() {
+    if triangles.is_empty() && spheres.is_empty() && cylinders.is_empty() {
         return Err(LoadError::EmptyScene {
             path: path.to_path_buf(),
         });
@@ -294,6 +298,7 @@ pub(crate) fn finish(
         .iter()
         .map(|t| t.material)
         .chain(spheres.iter().map(|s| s.material))
+        .chain(cylinders.iter().map(|c| c.material))
     {
         if let Some(u) = used.get_mut(m as usize) {
             *u = true;
@@ -328,7 +333,7 @@ pub(crate) fn finish(
         None => {
             notes.camera_framed = true;
             let aspect = film.width as f32 / film.height as f32;
-            frame_camera(&triangles, &spheres, aspect)
+            frame_camera(&triangles, &spheres, &cylinders, aspect)
         }
     };
     Ok(SceneDescription {
@@ -338,6 +343,7 @@ pub(crate) fn finish(
         materials,
         triangles,
         spheres,
+        cylinders,
         lights,
         render,
         notes,

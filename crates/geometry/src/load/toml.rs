@@ -10,6 +10,9 @@
 //! reflectance must lie in [0, 1]; a spot light's `falloff_start` defaults to `cone_angle`
 //! (a hard edge); `cone_angle` is in (0, 180]; a mesh file's own materials are named
 //! `FILE/NAME` in the scene; lights and cameras inside a mesh file are ignored (with a warning).
+//!
+//! Extensions (`docs/scene-format-extensions.md`): the `cylinder` shape, an analytic open
+//! cylinder cut to an optional arc; its material must not emit.
 
 use std::collections::{BTreeMap, HashSet};
 use std::path::Path;
@@ -19,8 +22,8 @@ use serde::Deserialize;
 
 use super::{LoadOptions, MAX_FILM_SIDE, MeshData, SceneParts, check_colour, fmt_vec};
 use crate::description::{
-    Camera, Film, Light, LoadNotes, Material, MaterialKind, RenderDefaults, SceneDescription,
-    Sphere, Triangle,
+    Camera, Cylinder, Film, Light, LoadNotes, Material, MaterialKind, RenderDefaults,
+    SceneDescription, Sphere, Triangle,
 };
 use crate::error::LoadError;
 
@@ -97,6 +100,16 @@ enum ShapeToml {
         corner: [f32; 3],
         edge1: [f32; 3],
         edge2: [f32; 3],
+        material: String,
+    },
+    /// Extension to format 1 (`docs/scene-format-extensions.md`).
+    Cylinder {
+        center: [f32; 3],
+        axis: Option<[f32; 3]>,
+        radius: f32,
+        height: f32,
+        arc: Option<f32>,
+        facing: Option<[f32; 3]>,
         material: String,
     },
 }
@@ -286,6 +299,66 @@ impl Converter<'_> {
                         material: lookup(&context, &material)?,
                     });
                 }
+                ShapeToml::Cylinder {
+                    center,
+                    axis,
+                    radius,
+                    height,
+                    arc,
+                    facing,
+                    material,
+                } => {
+                    let key = |k: &str| format!("{context} {k}");
+                    let center = self.finite(&key("center"), center)?;
+                    let axis = self.direction(&key("axis"), axis.unwrap_or([0.0, 1.0, 0.0]))?;
+                    let radius = self.positive(&key("radius"), radius)?;
+                    let height = self.positive(&key("height"), height)?;
+                    let arc = arc.unwrap_or(360.0);
+                    if !(arc.is_finite() && arc > 0.0 && arc <= 360.0) {
+                        return Err(self.invalid(
+                            key("arc"),
+                            format!("must be in (0, 360] degrees, got {arc}"),
+                        ));
+                    }
+                    let facing = match facing {
+                        Some(f) => {
+                            let f = self.direction(&key("facing"), f)?;
+                            (f - f.dot(axis) * axis)
+                                .try_normalize()
+                                .filter(|p| p.dot(f) > 1e-3)
+                                .ok_or_else(|| {
+                                    self.invalid(key("facing"), "must not be parallel to the axis")
+                                })?
+                        }
+                        None => default_facing(axis),
+                    };
+                    let m = lookup(&context, &material)?;
+                    if let Some(mat) = materials.get(m as usize)
+                        && mat.emission.max_element() > 0.0
+                    {
+                        return Err(self.invalid(
+                            key("material"),
+                            format!(
+                                "cylinders cannot emit, but material `{material}` has emission {}",
+                                fmt_vec(mat.emission)
+                            ),
+                        ));
+                    }
+                    acc.cylinders.push(Cylinder {
+                        center,
+                        axis,
+                        radius,
+                        height,
+                        // Exactly 2π for a whole circle, whatever to_radians rounds to.
+                        arc: if arc >= 360.0 {
+                            std::f32::consts::TAU
+                        } else {
+                            arc.to_radians()
+                        },
+                        facing,
+                        material: m,
+                    });
+                }
                 ShapeToml::Quad {
                     corner,
                     edge1,
@@ -369,6 +442,7 @@ impl Converter<'_> {
             materials,
             triangles: acc.triangles,
             spheres: acc.spheres,
+            cylinders: acc.cylinders,
             lights,
             render: render.unwrap_or_default(),
             notes: acc.notes,
@@ -575,6 +649,7 @@ impl Converter<'_> {
 struct Accumulator {
     triangles: Vec<Triangle>,
     spheres: Vec<Sphere>,
+    cylinders: Vec<Cylinder>,
     notes: LoadNotes,
     degenerate_materials: HashSet<u32>,
 }
@@ -592,6 +667,13 @@ impl Accumulator {
             });
         }
     }
+}
+
+/// The default `facing` of a cylinder with unit `axis`: +Z made perpendicular to the axis, or +X
+/// when the axis is within about 25° of ±Z.
+fn default_facing(axis: Vec3) -> Vec3 {
+    let reference = if axis.z.abs() < 0.9 { Vec3::Z } else { Vec3::X };
+    (reference - reference.dot(axis) * axis).normalize_or(axis.any_orthonormal_vector())
 }
 
 /// Loads the mesh file of a `[[shapes]]` entry.

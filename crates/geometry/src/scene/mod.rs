@@ -11,6 +11,8 @@ use crate::{
 };
 
 #[cfg(test)]
+mod cylinder_tests;
+#[cfg(test)]
 mod tests;
 
 /// Relative floating-point error bound γₙ = n·ε/(1 − n·ε) of pbrt (ε = half an ulp of 1).
@@ -90,11 +92,13 @@ impl Scene {
     ///
     /// # Errors
     /// [`SceneError`] when the scene is empty, has no light with positive power, has a degenerate
-    /// camera, a material index out of range, or a non-finite or out-of-range value.
+    /// camera, a material index out of range, or a non-finite or out-of-range value (including a
+    /// cylinder whose axis and facing are not perpendicular unit vectors, or whose material emits).
     pub fn new(description: SceneDescription) -> Result<Self, SceneError> {
         let source = || description.source.clone();
         if description.triangles.is_empty()
             && description.spheres.is_empty()
+            && description.cylinders.is_empty()
             && description.lights.is_empty()
         {
             return Err(SceneError::Empty { path: source() });
@@ -146,6 +150,26 @@ impl Scene {
                 .include(s.center - Vec3::splat(s.radius))
                 .include(s.center + Vec3::splat(s.radius));
         }
+        for (i, c) in description.cylinders.iter().enumerate() {
+            let Some(material) = description.materials.get(c.material as usize) else {
+                return Err(SceneError::MaterialIndex {
+                    path: source(),
+                    what: format!("cylinder {i}"),
+                    index: c.material,
+                    count,
+                });
+            };
+            if let Some(what) = invalid_cylinder(c) {
+                return Err(invalid(format!("cylinder {i} ({what})")));
+            }
+            if material.emission.max_element() > 0.0 {
+                return Err(invalid(format!(
+                    "cylinder {i} (material `{}` emits, but cylinders cannot)",
+                    material.name
+                )));
+            }
+            bounds = bounds.union(c.bounds());
+        }
         if bounds.is_empty() {
             // Only lights: bound their positions so that directional lights still have a disc.
             for l in &description.lights {
@@ -165,7 +189,11 @@ impl Scene {
             None => SceneError::NoLight { path: source() },
             Some(what) => invalid(what),
         })?;
-        let accel = Accel::build(&description.triangles, &description.spheres);
+        let accel = Accel::build(
+            &description.triangles,
+            &description.spheres,
+            &description.cylinders,
+        );
         Ok(Self {
             description,
             accel,
@@ -206,7 +234,7 @@ impl Scene {
         &self.lights
     }
 
-    /// Number of primitives in the BVH (non-degenerate triangles plus spheres).
+    /// Number of primitives in the BVH (non-degenerate triangles, spheres and cylinders).
     pub fn primitive_count(&self) -> usize {
         self.accel.len()
     }
@@ -218,6 +246,7 @@ impl Scene {
         Some(match raw {
             RawHit::Triangle { index, t, b1, b2 } => self.triangle_hit(ray, index, t, b1, b2),
             RawHit::Sphere { index, t } => self.sphere_hit(ray, index, t),
+            RawHit::Cylinder { index, t } => self.cylinder_hit(ray, index, t),
         })
     }
 
@@ -333,6 +362,67 @@ impl Scene {
             uv: Vec2::new(phi / std::f32::consts::TAU, theta / std::f32::consts::PI),
         }
     }
+
+    fn cylinder_hit(&self, ray: &Ray, index: u32, t: f32) -> Hit {
+        let c = &self.description.cylinders[index as usize];
+        let rel = ray.at(t) - c.center;
+        let s = rel.dot(c.axis).clamp(0.0, c.height);
+        let outward = (rel - rel.dot(c.axis) * c.axis).normalize_or(c.facing);
+        // Reproject onto the surface, as for spheres. The bound covers the rounding of this sum and
+        // of the intersection test's |f⊥|² − r² (whose error grows with the distance to the bottom
+        // centre, at most the radius plus the height), so that an origin offset by it is on the
+        // intended side of the surface.
+        let position = c.center + s * c.axis + c.radius * outward;
+        let position_error =
+            gamma(16.0) * (position.abs() + c.center.abs() + Vec3::splat(c.radius + c.height));
+        let front_face = outward.dot(ray.direction) < 0.0;
+        let mean_curvature = 0.5 / c.radius;
+        let (normal, curvature) = if front_face {
+            (outward, -mean_curvature)
+        } else {
+            (-outward, mean_curvature)
+        };
+        let angle = outward
+            .dot(c.axis.cross(c.facing))
+            .atan2(outward.dot(c.facing));
+        let u = ((angle + 0.5 * c.arc) / c.arc).clamp(0.0, 1.0);
+        Hit {
+            t,
+            position,
+            position_error,
+            geometric_normal: normal,
+            shading_normal: normal,
+            front_face,
+            material: c.material,
+            curvature,
+            primitive: Primitive::Cylinder(index),
+            uv: Vec2::new(u, s / c.height),
+        }
+    }
+}
+
+/// What is wrong with a cylinder's numbers, if anything.
+fn invalid_cylinder(c: &crate::Cylinder) -> Option<String> {
+    const TOLERANCE: f32 = 1e-4;
+    if !(c.center.is_finite() && c.axis.is_finite() && c.facing.is_finite()) {
+        return Some("non-finite center, axis or facing".to_owned());
+    }
+    if !(c.radius.is_finite() && c.radius > 0.0) {
+        return Some(format!("radius {}", c.radius));
+    }
+    if !(c.height.is_finite() && c.height > 0.0) {
+        return Some(format!("height {}", c.height));
+    }
+    if !(c.arc > 0.0 && c.arc <= std::f32::consts::TAU * (1.0 + TOLERANCE)) {
+        return Some(format!("arc {} outside (0, 2π]", c.arc));
+    }
+    if (c.axis.length() - 1.0).abs() > TOLERANCE
+        || (c.facing.length() - 1.0).abs() > TOLERANCE
+        || c.axis.dot(c.facing).abs() > TOLERANCE
+    {
+        return Some("axis and facing must be perpendicular unit vectors".to_owned());
+    }
+    None
 }
 
 fn valid_material(m: &Material) -> bool {

@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::print_stdout, clippy::print_stderr)]
 
 mod bad_input;
+mod cylinder;
 mod gltf;
 mod obj;
 mod shared_scenes;

@@ -46,6 +46,7 @@ fn cornell() -> Option<Scene> {
         }],
         triangles,
         spheres: vec![],
+        cylinders: vec![],
         lights: vec![Light::Point {
             position: Vec3::new(0.0, 1.9, 0.0),
             intensity: Vec3::ONE,
