@@ -142,7 +142,7 @@ impl<'s> PathTracer<'s> {
         let Some(sample) = self.scene.lights().sample_direct(hit.position, u_light, u) else {
             return Rgb::ZERO;
         };
-        if !(sample.pdf > 0.0) || !self.scene.light_visible(hit, &sample) {
+        if sample.pdf.is_nan() || sample.pdf <= 0.0 || !self.scene.light_visible(hit, &sample) {
             return Rgb::ZERO;
         }
         let f = bsdf.eval(outgoing, sample.incoming);

@@ -155,11 +155,9 @@ impl<'s> PhotonMapper<'s> {
     /// Runs one pass: camera pass (the first time, or every time for SPPM), hash grid,
     /// photon pass, hitpoint update.
     pub(crate) fn iterate(&mut self) -> PassStats {
-        let mut camera_paths = 0;
-        if self.slots.is_empty() || self.params.method.is_stochastic() {
-            self.camera_pass();
-            camera_paths = self.slots.len() as u64;
-        }
+        let retrace = self.slots.is_empty() || self.params.method.is_stochastic();
+        self.camera_pass(retrace);
+        let camera_paths = self.slots.len() as u64;
         self.build_index();
         let deposits = self.photon_pass();
         let mut stats = self.update_hitpoints(&deposits);
@@ -204,7 +202,11 @@ impl<'s> PhotonMapper<'s> {
     // ------------------------------------------------------------------------------------
     // Phase 1: camera pass.
 
-    fn camera_pass(&mut self) {
+    /// Traces one camera path per slot with this pass's jitter. The emission they see
+    /// directly (and the direct lighting, if enabled) is always accumulated, so that emitters
+    /// seen through a pixel are antialiased progressively even by PPM; the visible points
+    /// replace the slots' only when `update_hitpoints` (the first pass, and every SPPM pass).
+    fn camera_pass(&mut self, update_hitpoints: bool) {
         let spp = self.params.samples_per_pixel;
         let n_slots = self.width as usize * self.height as usize * spp as usize;
         let initial_radius = self
@@ -212,7 +214,6 @@ impl<'s> PhotonMapper<'s> {
             .initial_radius
             .unwrap_or_else(|| auto_initial_radius(self.scene));
         let first = self.slots.is_empty();
-        // For PPM the only camera pass is pass 0; SPPM re-traces with the pass index.
         let pass = self.pass;
         let traced: Vec<CameraSample> = (0..n_slots)
             .into_par_iter()
@@ -227,6 +228,9 @@ impl<'s> PhotonMapper<'s> {
         for (slot, sample) in traced.into_iter().enumerate() {
             for c in 0..3 {
                 self.direct[slot][c] += f64::from(sample.direct[c]);
+            }
+            if !update_hitpoints {
+                continue;
             }
             let point = sample.visible.unwrap_or(VisiblePoint {
                 position: Vec3::ZERO,

@@ -18,7 +18,7 @@ pub struct Renderer<'s> {
 }
 
 pub(crate) enum Engine<'s> {
-    Photons(PhotonMapper<'s>),
+    Photons(Box<PhotonMapper<'s>>),
     Path(PathTracer<'s>),
 }
 
@@ -82,7 +82,7 @@ impl<'s> Renderer<'s> {
         params.validate()?;
         let engine = match params.method {
             Method::Path => Engine::Path(PathTracer::new(scene, params)),
-            _ => Engine::Photons(PhotonMapper::new(scene, params)?),
+            _ => Engine::Photons(Box::new(PhotonMapper::new(scene, params)?)),
         };
         Ok(Self { scene, engine })
     }

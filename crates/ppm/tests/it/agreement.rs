@@ -1,0 +1,48 @@
+//! The photon mappers converge to the path tracer's image: means within 1 % at a long budget,
+//! and the per-pixel error shrinks as the budget grows.
+
+use ppm::Method;
+
+use crate::support::{PHOTON_METHODS, cornell, mean, params, render, rmse};
+
+#[test]
+fn photon_mappers_converge_to_the_path_traced_reference() {
+    let scene = cornell("CornellBox-Original.obj", 24, 24);
+    let mut reference_params = params(Method::Path, 1);
+    reference_params.samples_per_pixel = 128;
+    reference_params.max_depth = 16;
+    let reference = render(&scene, reference_params, 4);
+    let reference_mean = mean(&reference);
+
+    for method in PHOTON_METHODS {
+        let mut p = params(method, 20_000);
+        p.max_depth = 16;
+        // Fixed hitpoints (PPM) antialias only through several slots per pixel.
+        p.samples_per_pixel = 4;
+        // About a pixel's footprint, rather than the automatic two-pixel radius of this tiny
+        // film, whose blur would dominate the comparison.
+        p.initial_radius = Some(0.04);
+        let errors: Vec<(u32, f64, f64)> = [4, 16, 64]
+            .into_iter()
+            .map(|passes| {
+                let image = render(&scene, p, passes);
+                (passes, rmse(&image, &reference), mean(&image))
+            })
+            .collect();
+        eprintln!("{method}: reference mean {reference_mean:.5}, (passes, rmse, mean) {errors:?}");
+        for pair in errors.windows(2) {
+            assert!(
+                pair[1].1 < pair[0].1,
+                "{method}: error does not shrink from {} to {} passes: {errors:?}",
+                pair[0].0,
+                pair[1].0
+            );
+        }
+        let (_, _, final_mean) = errors[2];
+        let ratio = final_mean / reference_mean;
+        assert!(
+            (ratio - 1.0).abs() < 0.01,
+            "{method}: mean ratio to the path tracer {ratio}"
+        );
+    }
+}

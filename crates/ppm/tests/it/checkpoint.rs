@@ -1,0 +1,76 @@
+//! Saving and restoring a render gives the image of an uninterrupted run, bit for bit.
+
+use ppm::{Method, Renderer, StateError, StateHeader};
+
+use crate::support::{cornell, params};
+
+#[test]
+fn resumed_render_is_bit_identical_to_an_uninterrupted_one() {
+    let scene = cornell("CornellBox-Sphere.obj", 20, 20);
+    for method in Method::ALL {
+        let p = params(method, 5_000);
+        let mut straight = Renderer::new(&scene, p).unwrap();
+        for _ in 0..4 {
+            straight.iterate();
+        }
+
+        let mut first = Renderer::new(&scene, p).unwrap();
+        first.iterate();
+        first.iterate();
+        let bytes = first.save_state("scene: cornell sphere");
+        drop(first);
+        let header = StateHeader::read(&bytes).unwrap();
+        assert_eq!(header.passes, 2);
+        assert_eq!(header.note, "scene: cornell sphere");
+        assert_eq!(header.params, p);
+        let mut resumed = Renderer::restore(&scene, &bytes).unwrap();
+        assert_eq!(resumed.passes(), 2);
+        resumed.iterate();
+        resumed.iterate();
+
+        let a = straight.image();
+        let b = resumed.image();
+        let same = a
+            .iter()
+            .zip(&b)
+            .all(|(x, y)| x.map(f32::to_bits) == y.map(f32::to_bits));
+        assert!(same, "{method}: resumed image differs");
+        assert_eq!(straight.photons_emitted(), resumed.photons_emitted());
+    }
+}
+
+#[test]
+fn checkpoints_of_another_scene_version_or_corrupt_bytes_are_refused() {
+    let scene = cornell("CornellBox-Sphere.obj", 8, 8);
+    let other = cornell("CornellBox-Original.obj", 8, 8);
+    let mut renderer = Renderer::new(&scene, params(Method::Ppm, 1_000)).unwrap();
+    renderer.iterate();
+    let bytes = renderer.save_state("");
+
+    assert!(matches!(
+        Renderer::restore(&other, &bytes),
+        Err(StateError::SceneMismatch { .. })
+    ));
+    assert!(matches!(
+        Renderer::restore(&scene, b"not a checkpoint"),
+        Err(StateError::NotACheckpoint)
+    ));
+    let truncated = &bytes[..bytes.len() - 100];
+    assert!(matches!(
+        Renderer::restore(&scene, truncated),
+        Err(StateError::Corrupt)
+    ));
+    let mut flipped = bytes.clone();
+    let middle = flipped.len() / 2;
+    flipped[middle] ^= 1;
+    assert!(matches!(
+        Renderer::restore(&scene, &flipped),
+        Err(StateError::Corrupt)
+    ));
+    let mut newer = bytes;
+    newer[8] = newer[8].wrapping_add(1);
+    assert!(matches!(
+        Renderer::restore(&scene, &newer),
+        Err(StateError::Version { .. })
+    ));
+}

@@ -1,0 +1,56 @@
+//! Same seed ⇒ bit-identical image, whatever the number of threads.
+
+use ppm::{Method, Renderer};
+
+use crate::support::{cornell, params};
+
+fn render_with_threads(threads: usize, method: Method) -> (Vec<[f32; 3]>, Vec<u8>) {
+    let scene = cornell("CornellBox-Sphere.obj", 24, 24);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let mut p = params(method, 6_000);
+        p.samples_per_pixel = 2;
+        let mut renderer = Renderer::new(&scene, p).unwrap();
+        for _ in 0..3 {
+            renderer.iterate();
+        }
+        (renderer.image(), renderer.save_state("determinism"))
+    })
+}
+
+#[test]
+fn images_are_bit_identical_for_1_2_and_8_threads() {
+    for method in Method::ALL {
+        let (one, state_one) = render_with_threads(1, method);
+        for threads in [2, 8] {
+            let (many, state_many) = render_with_threads(threads, method);
+            let same = one
+                .iter()
+                .zip(&many)
+                .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits));
+            assert!(
+                same,
+                "{method}: image differs between 1 and {threads} threads"
+            );
+            assert!(
+                state_one == state_many,
+                "{method}: state differs between 1 and {threads} threads"
+            );
+        }
+    }
+}
+
+#[test]
+fn different_seeds_give_different_images() {
+    let scene = cornell("CornellBox-Original.obj", 16, 16);
+    let mut a = params(Method::Ppm, 4_000);
+    let mut b = a;
+    a.seed = 1;
+    b.seed = 2;
+    let image_a = crate::support::render(&scene, a, 2);
+    let image_b = crate::support::render(&scene, b, 2);
+    assert!(image_a != image_b);
+}
