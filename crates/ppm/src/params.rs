@@ -103,6 +103,10 @@ pub struct RenderParams {
     pub kernel_k: f64,
     /// What happens once the PPM radius reaches the frequency radius.
     pub freq_floor: FrequencyFloor,
+    /// Whether frequency photons probe for partial occlusion near their hits (one extra
+    /// shadow ray per segment of a frequency photon), so that shadow edges raise the spatial
+    /// frequency and keep hitpoints there shrinking.
+    pub freq_occlusion: bool,
     /// Add direct lighting by light sampling at hitpoints instead of gathering photons that
     /// arrive straight from an emitter.
     pub direct_lighting: bool,
@@ -152,6 +156,7 @@ impl RenderParams {
             freq_merge: MergePolicy::MinRadius,
             kernel_k: K_POSTER,
             freq_floor: FrequencyFloor::Keep,
+            freq_occlusion: true,
             direct_lighting: false,
         }
     }

@@ -173,6 +173,7 @@ fn write_params(w: &mut Writer, p: &RenderParams) {
         FrequencyFloor::Clamp => 1,
     });
     w.u32(u32::from(p.direct_lighting));
+    w.u32(u32::from(p.freq_occlusion));
 }
 
 fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
@@ -195,11 +196,8 @@ fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
         1 => FrequencyFloor::Clamp,
         _ => return Err(StateError::Corrupt),
     };
-    let direct_lighting = match r.u32()? {
-        0 => false,
-        1 => true,
-        _ => return Err(StateError::Corrupt),
-    };
+    let direct_lighting = r.bool()?;
+    let freq_occlusion = r.bool()?;
     Ok(RenderParams {
         method,
         photons_per_pass,
@@ -212,6 +210,7 @@ fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
         freq_merge,
         kernel_k,
         freq_floor,
+        freq_occlusion,
         direct_lighting,
     })
 }

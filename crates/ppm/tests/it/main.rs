@@ -12,5 +12,6 @@ mod agreement;
 mod analytic;
 mod checkpoint;
 mod determinism;
+mod frequency;
 mod statistics;
 mod support;
