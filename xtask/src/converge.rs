@@ -1,0 +1,682 @@
+//! `cargo xtask converge`: error versus wall-clock time (and versus photons) of every method on
+//! one scene of the suite, against its golden path-traced reference; error restricted to
+//! regional masks; radius and frequency-floor maps; and a one-at-a-time sweep of the
+//! frequency-method parameters for choosing defaults.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+use glam::Vec2;
+
+use crate::image_io::{self, Errors, Image};
+use crate::suite::{self, SuiteScene};
+
+pub(crate) const HELP: &str = "\
+cargo xtask converge --scene NAME [--budgets 2,4,8,16,32] [--methods ppm,sppm,freq,freq-sppm,path]
+                     [--photons N] [--seed S] [--out DIR] [--quick]
+                     [--alpha A] [--freq-fraction F] [--kernel-k poster|strict|K] [--freq-merge min|poster-max]
+cargo xtask converge --scene NAME --sweep [--budget SECONDS] [--methods freq]
+
+Runs each method alone (one after another) on the suite scene NAME at its suite film size and
+snapshots the image whenever the measured wall-clock time passes a budget. Every snapshot's
+RMSE, relMSE and mean ratio against tests/golden/NAME.exr, over the whole image and over three
+masks (low-frequency diffuse, caustic / high-frequency diffuse, glossy or specular first hit),
+goes to DIR/NAME.csv; DIR/NAME-time.svg and DIR/NAME-photons.svg plot relMSE on log-log axes
+(error versus seconds, and versus photons emitted: the equal-photon-count comparison). The
+masks and, for each photon mapper, the final radius map (and for the frequency methods the
+map of the share of hitpoints held by the frequency floor) are written as PNGs. DIR defaults
+to docs/convergence. --quick uses budgets 1,2 and writes to target/converge.
+--sweep renders the methods (default freq and ppm) at one budget (default 8 s) with one
+parameter varied at a time around the defaults (alpha, freq-fraction, kernel-k, freq-merge)
+and writes DIR/NAME-sweep.csv.";
+
+/// Line colours of the plots, per method in `ppm::Method::ALL` order.
+const COLOURS: [(u8, u8, u8); 5] = [
+    (31, 119, 180),
+    (255, 127, 14),
+    (44, 160, 44),
+    (214, 39, 40),
+    (100, 100, 100),
+];
+
+struct Flags {
+    scene: String,
+    budgets: Vec<f64>,
+    methods: Vec<ppm::Method>,
+    photons: u32,
+    seed: u64,
+    out: Option<PathBuf>,
+    quick: bool,
+    sweep: bool,
+    budget: f64,
+    overrides: Overrides,
+}
+
+/// Parameter values given on the command line.
+#[derive(Clone, Copy, Debug, Default)]
+struct Overrides {
+    alpha: Option<f64>,
+    freq_fraction: Option<f64>,
+    kernel_k: Option<f64>,
+    freq_merge: Option<ppm::MergePolicy>,
+}
+
+impl Overrides {
+    fn apply(&self, params: &mut ppm::RenderParams) {
+        if let Some(a) = self.alpha {
+            params.alpha = a;
+        }
+        if let Some(f) = self.freq_fraction {
+            params.freq_fraction = f;
+        }
+        if let Some(k) = self.kernel_k {
+            params.kernel_k = k;
+        }
+        if let Some(m) = self.freq_merge {
+            params.freq_merge = m;
+        }
+    }
+
+    fn label(&self, defaults: &ppm::RenderParams) -> String {
+        let mut p = *defaults;
+        self.apply(&mut p);
+        format!(
+            "alpha={:.3} ff={} k={} merge={}",
+            p.alpha,
+            p.freq_fraction,
+            k_name(p.kernel_k),
+            merge_name(p.freq_merge)
+        )
+    }
+}
+
+fn k_name(k: f64) -> String {
+    if (k - spectrum::K_POSTER).abs() < 1e-12 {
+        "poster".to_string()
+    } else if (k - spectrum_k_strict()).abs() < 1e-12 {
+        "strict".to_string()
+    } else {
+        format!("{k}")
+    }
+}
+
+fn spectrum_k_strict() -> f64 {
+    spectrum::K_STRICT
+}
+
+fn merge_name(m: ppm::MergePolicy) -> &'static str {
+    match m {
+        ppm::MergePolicy::MinRadius => "min",
+        ppm::MergePolicy::PosterMax => "poster-max",
+    }
+}
+
+fn parse_list<T>(text: &str, f: impl Fn(&str) -> Result<T>) -> Result<Vec<T>> {
+    text.split(',')
+        .filter(|s| !s.is_empty())
+        .map(|s| f(s.trim()))
+        .collect()
+}
+
+impl Flags {
+    fn parse(args: &[String]) -> Result<Self> {
+        let mut flags = Flags {
+            scene: String::new(),
+            budgets: vec![2.0, 4.0, 8.0, 16.0, 32.0],
+            methods: ppm::Method::ALL.to_vec(),
+            photons: 100_000,
+            seed: 1,
+            out: None,
+            quick: false,
+            sweep: false,
+            budget: 8.0,
+            overrides: Overrides::default(),
+        };
+        let mut methods_given = false;
+        let mut it = args.iter();
+        while let Some(arg) = it.next() {
+            let mut value = || it.next().with_context(|| format!("{arg} needs a value"));
+            match arg.as_str() {
+                "--scene" => flags.scene = value()?.clone(),
+                "--budgets" => flags.budgets = parse_list(value()?, |s| Ok(s.parse::<f64>()?))?,
+                "--budget" => flags.budget = value()?.parse()?,
+                "--methods" => {
+                    methods_given = true;
+                    flags.methods = parse_list(value()?, |s| {
+                        ppm::Method::from_name(s).with_context(|| format!("unknown method `{s}`"))
+                    })?;
+                }
+                "--photons" => flags.photons = value()?.parse()?,
+                "--seed" => flags.seed = value()?.parse()?,
+                "--out" => flags.out = Some(PathBuf::from(value()?)),
+                "--quick" => flags.quick = true,
+                "--sweep" => flags.sweep = true,
+                "--alpha" => flags.overrides.alpha = Some(value()?.parse()?),
+                "--freq-fraction" => flags.overrides.freq_fraction = Some(value()?.parse()?),
+                "--kernel-k" => {
+                    let v = value()?;
+                    flags.overrides.kernel_k = Some(match v.as_str() {
+                        "poster" => spectrum::K_POSTER,
+                        "strict" => spectrum_k_strict(),
+                        other => other.parse()?,
+                    });
+                }
+                "--freq-merge" => {
+                    flags.overrides.freq_merge = Some(match value()?.as_str() {
+                        "min" => ppm::MergePolicy::MinRadius,
+                        "poster-max" => ppm::MergePolicy::PosterMax,
+                        other => bail!("unknown merge policy `{other}` (min, poster-max)"),
+                    });
+                }
+                other => bail!("converge: unknown flag `{other}`"),
+            }
+        }
+        if flags.scene.is_empty() {
+            bail!("converge: --scene NAME is required (a name from tests/scenes.toml)");
+        }
+        if flags.quick {
+            flags.budgets = vec![1.0, 2.0];
+            flags.budget = 1.0;
+        }
+        if flags.sweep && !methods_given {
+            flags.methods = vec![ppm::Method::FreqPpm, ppm::Method::Ppm];
+        }
+        if flags
+            .budgets
+            .iter()
+            .any(|b| b.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
+        {
+            bail!("converge: budgets must be positive seconds");
+        }
+        flags.budgets.sort_by(f64::total_cmp);
+        Ok(flags)
+    }
+}
+
+/// Error restricted to each mask.
+struct Masks {
+    names: [&'static str; 3],
+    masks: [Vec<bool>; 3],
+}
+
+/// One snapshot of one method.
+struct Row {
+    method: ppm::Method,
+    budget: f64,
+    seconds: f64,
+    passes: u32,
+    photons: u64,
+    all: Errors,
+    masked: [Errors; 3],
+}
+
+pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
+    let flags = Flags::parse(args)?;
+    let suite = suite::load_suite(root)?;
+    let entry = suite
+        .scene
+        .iter()
+        .find(|s| s.name == flags.scene)
+        .with_context(|| format!("no scene named `{}` in tests/scenes.toml", flags.scene))?;
+    let golden = root
+        .join("tests/golden")
+        .join(format!("{}.exr", entry.name));
+    let reference = image_io::read_exr(&golden)
+        .with_context(|| format!("run `cargo xtask render-all --bless {}` first", entry.name))?;
+    let out = flags.out.clone().map_or_else(
+        || {
+            root.join(if flags.quick {
+                "target/converge"
+            } else {
+                "docs/convergence"
+            })
+        },
+        |o| if o.is_absolute() { o } else { root.join(o) },
+    );
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let scene = suite::load_scene(root, entry)?;
+    if flags.sweep {
+        return sweep(&scene, entry, &reference, &flags, &out);
+    }
+    let masks = build_masks(&scene, &reference);
+    write_masks(
+        &out.join(format!("{}-masks.png", entry.name)),
+        &masks,
+        reference.width,
+    )?;
+
+    let mut rows = Vec::new();
+    for &method in &flags.methods {
+        let mut params = base_params(entry, method, &flags);
+        flags.overrides.apply(&mut params);
+        println!(
+            "converge: {} {} ({})",
+            entry.name,
+            method,
+            flags.overrides.label(&params)
+        );
+        let mut renderer = ppm::Renderer::new(&scene, params).context("render parameters")?;
+        let mut elapsed = Duration::ZERO;
+        for &budget in &flags.budgets {
+            while elapsed.as_secs_f64() < budget {
+                let start = Instant::now();
+                renderer.iterate();
+                elapsed += start.elapsed();
+            }
+            let image = Image::new(reference.width, reference.height, renderer.image());
+            let all = image_io::errors(&image, &reference, None)?;
+            let masked = [0, 1, 2].map(|i| {
+                image_io::errors(&image, &reference, Some(&masks.masks[i])).expect("sizes match")
+            });
+            println!(
+                "  {:>6.1} s ({:>5} passes): relMSE {:.5}  RMSE {:.5}  mean ratio {:.4}  [low {:.5} caustic {:.5} glossy {:.5}]",
+                elapsed.as_secs_f64(),
+                renderer.passes(),
+                all.rel_mse,
+                all.rmse,
+                all.mean_ratio,
+                masked[0].rel_mse,
+                masked[1].rel_mse,
+                masked[2].rel_mse
+            );
+            rows.push(Row {
+                method,
+                budget,
+                seconds: elapsed.as_secs_f64(),
+                passes: renderer.passes(),
+                photons: renderer.photons_emitted(),
+                all,
+                masked,
+            });
+        }
+        let stem = format!("{}-{}", entry.name, method.name());
+        let image = Image::new(reference.width, reference.height, renderer.image());
+        image_io::write_png(
+            &out.join(format!("{stem}.png")),
+            &image,
+            image_io::auto_exposure(&reference),
+            3,
+        )?;
+        write_maps(&renderer, &out, &stem, reference.width)?;
+    }
+    image_io::write_png(
+        &out.join(format!("{}-reference.png", entry.name)),
+        &reference,
+        image_io::auto_exposure(&reference),
+        3,
+    )?;
+    write_csv(
+        &out.join(format!("{}.csv", entry.name)),
+        entry,
+        &masks,
+        &rows,
+    )?;
+    plot(
+        &out.join(format!("{}-time.svg", entry.name)),
+        &rows,
+        |r| r.seconds,
+        false,
+    )?;
+    plot(
+        &out.join(format!("{}-photons.svg", entry.name)),
+        &rows,
+        |r| r.photons as f64,
+        true,
+    )?;
+    println!("converge: slopes of log relMSE versus log seconds (least squares over the budgets):");
+    for &method in &flags.methods {
+        let points: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| r.method == method)
+            .map(|r| (r.seconds.ln(), r.all.rel_mse.ln()))
+            .collect();
+        println!("  {:<9} {:+.3}", method.name(), slope(&points));
+    }
+    println!("converge: wrote {}", out.display());
+    Ok(true)
+}
+
+fn base_params(entry: &SuiteScene, method: ppm::Method, flags: &Flags) -> ppm::RenderParams {
+    let mut params = suite::params(entry, method, flags.seed);
+    params.photons_per_pass = flags.photons;
+    params
+}
+
+/// Least-squares slope of y over x.
+fn slope(points: &[(f64, f64)]) -> f64 {
+    let n = points.len() as f64;
+    if n < 2.0 {
+        return f64::NAN;
+    }
+    let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = points.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    sxy / sxx
+}
+
+/// The three masks, from a camera ray through each pixel centre and the reference image:
+/// - glossy: the first surface is glossy, a mirror or a dielectric;
+/// - caustic (high-frequency diffuse): the first surface is diffuse and the reference's
+///   luminance differs from its 5×5 box blur by more than 25 % (caustics, and also shadow and
+///   contact edges);
+/// - low-frequency: every other diffuse pixel (smoothly lit, directly or indirectly).
+///
+/// Pixels that see no surface or an emitter belong to no mask.
+fn build_masks(scene: &geometry::Scene, reference: &Image) -> Masks {
+    let (w, h) = (reference.width, reference.height);
+    let lum: Vec<f64> = reference
+        .pixels
+        .iter()
+        .map(|p| 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]))
+        .collect();
+    let mut low = vec![false; w * h];
+    let mut caustic = vec![false; w * h];
+    let mut glossy = vec![false; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let idx = y * w + x;
+            let ray = scene
+                .camera()
+                .generate_ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), Vec2::splat(0.5));
+            let Some(hit) = scene.intersect(&ray) else {
+                continue;
+            };
+            let Some(material) = scene.material(hit.material) else {
+                continue;
+            };
+            if material.emission.max_element() > 0.0 {
+                continue;
+            }
+            match material.kind {
+                geometry::MaterialKind::Diffuse { .. } => {
+                    let (mut sum, mut n) = (0.0, 0.0);
+                    for yy in y.saturating_sub(2)..(y + 3).min(h) {
+                        for xx in x.saturating_sub(2)..(x + 3).min(w) {
+                            sum += lum[yy * w + xx];
+                            n += 1.0;
+                        }
+                    }
+                    let blur = sum / n;
+                    if (lum[idx] - blur).abs() > 0.25 * blur.max(1e-6) {
+                        caustic[idx] = true;
+                    } else {
+                        low[idx] = true;
+                    }
+                }
+                _ => glossy[idx] = true,
+            }
+        }
+    }
+    Masks {
+        names: ["low", "caustic", "glossy"],
+        masks: [low, caustic, glossy],
+    }
+}
+
+/// The masks as one PNG: green = low-frequency, red = caustic / high-frequency, blue = glossy.
+fn write_masks(path: &Path, masks: &Masks, width: usize) -> Result<()> {
+    let n = masks.masks[0].len();
+    let pixels = (0..n)
+        .map(|i| {
+            let f = |m: usize| if masks.masks[m][i] { 1.0 } else { 0.0 };
+            [f(1), 0.6 * f(0), f(2)]
+        })
+        .collect();
+    image_io::write_png(path, &Image::new(width, n / width, pixels), 1.0, 3)
+}
+
+/// Radius map (all photon mappers), frequency radius and held-by-floor maps (frequency methods).
+fn write_maps(renderer: &ppm::Renderer<'_>, out: &Path, stem: &str, width: usize) -> Result<()> {
+    if let Some(radius) = renderer.aov(ppm::Aov::Radius) {
+        let max = percentile(&radius, 0.99);
+        image_io::write_false_colour(
+            &out.join(format!("{stem}-radius.png")),
+            width,
+            &radius,
+            max,
+            3,
+        )?;
+        println!("  radius map: 99th percentile {max:.5} (red)");
+    }
+    if let Some(held) = renderer.aov(ppm::Aov::FreqHeld) {
+        image_io::write_false_colour(&out.join(format!("{stem}-held.png")), width, &held, 1.0, 3)?;
+        let share = held.iter().map(|&v| f64::from(v)).sum::<f64>() / held.len().max(1) as f64;
+        println!(
+            "  held by the frequency floor: {:.1} % of hitpoints",
+            100.0 * share
+        );
+    }
+    if let Some(freq) = renderer.aov(ppm::Aov::FreqRadius) {
+        let max = percentile(&freq, 0.99);
+        image_io::write_false_colour(
+            &out.join(format!("{stem}-freq-radius.png")),
+            width,
+            &freq,
+            max,
+            3,
+        )?;
+    }
+    Ok(())
+}
+
+fn percentile(values: &[f32], q: f64) -> f32 {
+    let mut v: Vec<f32> = values
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite() && *x > 0.0)
+        .collect();
+    if v.is_empty() {
+        return 1.0;
+    }
+    v.sort_by(f32::total_cmp);
+    v[((v.len() as f64 * q) as usize).min(v.len() - 1)]
+}
+
+fn write_csv(path: &Path, entry: &SuiteScene, masks: &Masks, rows: &[Row]) -> Result<()> {
+    let mut csv =
+        String::from("scene,method,budget_s,seconds,passes,photons,rmse,rel_mse,mean_ratio");
+    for name in masks.names {
+        let _ = write!(csv, ",rmse_{name},rel_mse_{name}");
+    }
+    csv.push('\n');
+    for r in rows {
+        let _ = write!(
+            csv,
+            "{},{},{},{:.3},{},{},{:.6e},{:.6e},{:.5}",
+            entry.name,
+            r.method.name(),
+            r.budget,
+            r.seconds,
+            r.passes,
+            r.photons,
+            r.all.rmse,
+            r.all.rel_mse,
+            r.all.mean_ratio
+        );
+        for m in &r.masked {
+            let _ = write!(csv, ",{:.6e},{:.6e}", m.rmse, m.rel_mse);
+        }
+        csv.push('\n');
+    }
+    std::fs::write(path, csv).with_context(|| format!("writing {}", path.display()))
+}
+
+/// relMSE against `x(row)` on log-log axes, one line per method; `photon_mappers_only` drops
+/// the path tracer (which emits no photons).
+fn plot(
+    path: &Path,
+    rows: &[Row],
+    x: impl Fn(&Row) -> f64,
+    photon_mappers_only: bool,
+) -> Result<()> {
+    use plotters::prelude::*;
+    let pts = |m: ppm::Method| -> Vec<(f64, f64)> {
+        rows.iter()
+            .filter(|r| r.method == m && x(r) > 0.0 && r.all.rel_mse > 0.0)
+            .map(|r| (x(r).log10(), r.all.rel_mse.log10()))
+            .collect()
+    };
+    let methods: Vec<ppm::Method> = ppm::Method::ALL
+        .into_iter()
+        .filter(|m| !(photon_mappers_only && *m == ppm::Method::Path))
+        .filter(|m| !pts(*m).is_empty())
+        .collect();
+    let all: Vec<(f64, f64)> = methods.iter().flat_map(|m| pts(*m)).collect();
+    if all.is_empty() {
+        return Ok(());
+    }
+    let (x0, x1) = bounds(all.iter().map(|p| p.0));
+    let (y0, y1) = bounds(all.iter().map(|p| p.1));
+    let root = SVGBackend::new(path, (640, 480)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    let area = root.margin(20, 20, 20, 20);
+    let mut chart = ChartBuilder::on(&area)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    // Decade grid lines (no text: the SVG backend is built without fonts; the axes are
+    // described in docs/convergence.md).
+    for d in (x0.floor() as i32)..=(x1.ceil() as i32) {
+        let d = f64::from(d);
+        if d >= x0 && d <= x1 {
+            chart
+                .draw_series(LineSeries::new([(d, y0), (d, y1)], BLACK.mix(0.25)))
+                .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        }
+    }
+    for d in (y0.floor() as i32)..=(y1.ceil() as i32) {
+        let d = f64::from(d);
+        if d >= y0 && d <= y1 {
+            chart
+                .draw_series(LineSeries::new([(x0, d), (x1, d)], BLACK.mix(0.25)))
+                .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        }
+    }
+    chart
+        .draw_series(LineSeries::new(
+            [(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)],
+            BLACK,
+        ))
+        .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    for m in methods {
+        let (r, g, b) = COLOURS[ppm::Method::ALL.iter().position(|x| *x == m).unwrap_or(0)];
+        let colour = RGBColor(r, g, b);
+        chart
+            .draw_series(LineSeries::new(pts(m), colour.stroke_width(2)))
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        chart
+            .draw_series(
+                pts(m)
+                    .into_iter()
+                    .map(|p| Circle::new(p, 3, colour.filled())),
+            )
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    }
+    root.present().map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    Ok(())
+}
+
+/// Padded bounds of log values.
+fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
+    let pad = ((hi - lo) * 0.05).max(0.05);
+    (lo - pad, hi + pad)
+}
+
+/// One-at-a-time parameter sweep at one budget.
+fn sweep(
+    scene: &geometry::Scene,
+    entry: &SuiteScene,
+    reference: &Image,
+    flags: &Flags,
+    out: &Path,
+) -> Result<bool> {
+    let masks = build_masks(scene, reference);
+    let mut variants: Vec<Overrides> = vec![Overrides::default()];
+    for alpha in [0.5, 2.0 / 3.0, 0.8] {
+        variants.push(Overrides {
+            alpha: Some(alpha),
+            ..Overrides::default()
+        });
+    }
+    for ff in [0.05, 0.2] {
+        variants.push(Overrides {
+            freq_fraction: Some(ff),
+            ..Overrides::default()
+        });
+    }
+    variants.push(Overrides {
+        kernel_k: Some(spectrum_k_strict()),
+        ..Overrides::default()
+    });
+    variants.push(Overrides {
+        freq_merge: Some(ppm::MergePolicy::PosterMax),
+        ..Overrides::default()
+    });
+    let mut csv = String::from(
+        "scene,method,budget_s,alpha,freq_fraction,kernel_k,freq_merge,seconds,passes,rel_mse,rmse,mean_ratio,rel_mse_low,rel_mse_caustic,rel_mse_glossy\n",
+    );
+    for &method in &flags.methods {
+        for v in &variants {
+            let only_alpha =
+                v.freq_fraction.is_none() && v.kernel_k.is_none() && v.freq_merge.is_none();
+            if !method.uses_frequency() && !only_alpha {
+                continue;
+            }
+            let mut params = base_params(entry, method, flags);
+            flags.overrides.apply(&mut params);
+            v.apply(&mut params);
+            let mut renderer = ppm::Renderer::new(scene, params).context("render parameters")?;
+            let mut elapsed = Duration::ZERO;
+            while elapsed.as_secs_f64() < flags.budget {
+                let start = Instant::now();
+                renderer.iterate();
+                elapsed += start.elapsed();
+            }
+            let image = Image::new(reference.width, reference.height, renderer.image());
+            let e = image_io::errors(&image, reference, None)?;
+            let m = [0, 1, 2].map(|i| {
+                image_io::errors(&image, reference, Some(&masks.masks[i])).expect("sizes match")
+            });
+            println!(
+                "sweep {} {:<9} {:<48} relMSE {:.5} [low {:.5} caustic {:.5} glossy {:.5}] mean {:.4} ({} passes)",
+                entry.name,
+                method.name(),
+                v.label(&params),
+                e.rel_mse,
+                m[0].rel_mse,
+                m[1].rel_mse,
+                m[2].rel_mse,
+                e.mean_ratio,
+                renderer.passes()
+            );
+            let _ = writeln!(
+                csv,
+                "{},{},{},{:.4},{},{},{},{:.3},{},{:.6e},{:.6e},{:.5},{:.6e},{:.6e},{:.6e}",
+                entry.name,
+                method.name(),
+                flags.budget,
+                params.alpha,
+                params.freq_fraction,
+                k_name(params.kernel_k),
+                merge_name(params.freq_merge),
+                elapsed.as_secs_f64(),
+                renderer.passes(),
+                e.rel_mse,
+                e.rmse,
+                e.mean_ratio,
+                m[0].rel_mse,
+                m[1].rel_mse,
+                m[2].rel_mse
+            );
+        }
+    }
+    let path = out.join(format!("{}-sweep.csv", entry.name));
+    std::fs::write(&path, csv).with_context(|| format!("writing {}", path.display()))?;
+    println!("converge: wrote {}", path.display());
+    Ok(true)
+}

@@ -1,0 +1,155 @@
+//! The golden-image suite, `tests/scenes.toml`, and rendering one of its scenes.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+use serde::Deserialize;
+
+use crate::image_io::Image;
+
+/// The whole suite file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Suite {
+    /// Seeds used by `render-all --calibrate`.
+    pub(crate) calibration_seeds: Vec<u64>,
+    /// Every scene, in report order.
+    pub(crate) scene: Vec<SuiteScene>,
+}
+
+/// One scene of the suite.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SuiteScene {
+    /// Short name: golden file name, `--bless` and `--filter` argument.
+    pub(crate) name: String,
+    /// Scene file, relative to the repository root.
+    pub(crate) path: PathBuf,
+    /// Film width in pixels (overrides the scene's).
+    pub(crate) width: u32,
+    /// Film height in pixels.
+    pub(crate) height: u32,
+    /// Photon-mapper passes at the check budget.
+    pub(crate) passes: u32,
+    /// Photons per pass.
+    pub(crate) photons: u32,
+    /// Hitpoint slots per pixel for the photon mappers.
+    #[serde(default = "one")]
+    pub(crate) spp: u32,
+    /// Path-tracer passes (one path per pixel per pass) at the check budget.
+    pub(crate) path_passes: u32,
+    /// Path-tracer passes of the golden reference.
+    pub(crate) reference_passes: u32,
+    /// Paths per pixel per pass of the golden reference.
+    pub(crate) reference_spp: u32,
+    /// Maximum path depth (camera and photon paths, and the reference).
+    #[serde(default = "default_depth")]
+    pub(crate) max_depth: u32,
+    /// Tolerances per method name.
+    #[serde(default)]
+    pub(crate) tolerance: BTreeMap<String, Tolerance>,
+}
+
+/// What a check accepts: relative MSE against the golden image and the deviation of the mean.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Tolerance {
+    /// Largest accepted relative MSE.
+    pub(crate) rel_mse: f64,
+    /// Largest accepted |mean / reference mean − 1|.
+    pub(crate) mean: f64,
+}
+
+fn one() -> u32 {
+    1
+}
+
+fn default_depth() -> u32 {
+    8
+}
+
+/// Reads `tests/scenes.toml`.
+pub(crate) fn load_suite(root: &Path) -> Result<Suite> {
+    let path = root.join("tests/scenes.toml");
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let suite: Suite =
+        toml::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+    Ok(suite)
+}
+
+/// Loads the scene file with the suite's film size.
+pub(crate) fn load_scene(root: &Path, entry: &SuiteScene) -> Result<geometry::Scene> {
+    load_scene_sized(root, &entry.path, entry.width, entry.height)
+}
+
+/// Loads a scene file (relative to the repository root) with the given film size.
+pub(crate) fn load_scene_sized(
+    root: &Path,
+    path: &Path,
+    width: u32,
+    height: u32,
+) -> Result<geometry::Scene> {
+    let path = root.join(path);
+    let mut description =
+        geometry::load(&path).with_context(|| format!("loading {}", path.display()))?;
+    description.film.width = width;
+    description.film.height = height;
+    geometry::Scene::new(description).with_context(|| format!("building {}", path.display()))
+}
+
+/// The parameters of `method` on `entry` at the check budget.
+pub(crate) fn params(entry: &SuiteScene, method: ppm::Method, seed: u64) -> ppm::RenderParams {
+    let mut params = ppm::RenderParams::preview();
+    params.method = method;
+    params.seed = seed;
+    params.max_depth = entry.max_depth;
+    params.photons_per_pass = entry.photons;
+    params.samples_per_pixel = if method == ppm::Method::Path {
+        1
+    } else {
+        entry.spp
+    };
+    params
+}
+
+/// A finished render.
+pub(crate) struct Rendered {
+    pub(crate) image: Image,
+    pub(crate) time: Duration,
+}
+
+/// Renders `passes` passes of `params` and returns the image.
+pub(crate) fn render(
+    scene: &geometry::Scene,
+    params: ppm::RenderParams,
+    passes: u32,
+) -> Result<Rendered> {
+    let start = Instant::now();
+    let mut renderer = ppm::Renderer::new(scene, params).context("render parameters")?;
+    for _ in 0..passes {
+        renderer.iterate();
+    }
+    let (w, h) = renderer.resolution();
+    let image = Image::new(w as usize, h as usize, renderer.image());
+    let time = start.elapsed();
+    if image
+        .pixels
+        .iter()
+        .any(|p| p.iter().any(|v| !v.is_finite()))
+    {
+        bail!("{} produced a non-finite pixel", params.method);
+    }
+    Ok(Rendered { image, time })
+}
+
+/// The passes of `method` at the check budget of `entry`.
+pub(crate) fn passes(entry: &SuiteScene, method: ppm::Method) -> u32 {
+    if method == ppm::Method::Path {
+        entry.path_passes
+    } else {
+        entry.passes
+    }
+}
