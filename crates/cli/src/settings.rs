@@ -1,0 +1,427 @@
+//! Stage two: flags, scene defaults and presets become one validated render job.
+//!
+//! Precedence: a flag overrides the scene's `[render]` table, which overrides
+//! [`ppm::RenderParams::preview`]. Flags are checked before anything is read, so a bad flag is
+//! a usage error (exit 2) even when the scene is also missing.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use anyhow::Context;
+use geometry::{RenderDefaults, SceneDescription};
+use ppm::{Method, ParamError, RenderParams};
+
+use crate::args::{
+    AovArg, FloorArg, MergeArg, OutputArgs, ParamArgs, RenderArgs, RunArgs, TonemapArg,
+};
+use crate::output::{self, Tonemap};
+use crate::{DEFAULT_SCENE, DEFAULT_SCENE_NAME, usage};
+
+/// Passes rendered when neither the flags nor the scene give a budget.
+pub(crate) const DEFAULT_PASSES: u32 = 16;
+/// The EXR written when `-o` is not given.
+pub(crate) const DEFAULT_EXR: &str = "fppm.exr";
+
+/// A validated render: everything `render.rs` needs.
+pub(crate) struct Job {
+    /// Where the scene came from (`None`: the built-in default scene).
+    pub(crate) scene_path: Option<PathBuf>,
+    /// The loaded scene, with the film overrides applied.
+    pub(crate) description: SceneDescription,
+    pub(crate) params: RenderParams,
+    pub(crate) budget: Budget,
+    pub(crate) outputs: Outputs,
+    pub(crate) checkpoint: Option<PathBuf>,
+    pub(crate) run: RunSettings,
+    /// Render time of earlier runs (for a resumed render).
+    pub(crate) earlier_seconds: f64,
+}
+
+/// When to stop: after `passes` passes in total or `time` of this run, whichever comes first.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Budget {
+    pub(crate) passes: Option<u32>,
+    pub(crate) time: Option<Duration>,
+}
+
+/// The output files and what goes into them.
+#[derive(Clone, Debug)]
+pub(crate) struct Outputs {
+    pub(crate) exr: PathBuf,
+    pub(crate) png: PathBuf,
+    pub(crate) aovs: Vec<AovArg>,
+    pub(crate) tonemap: Tonemap,
+}
+
+/// Threads, progress and snapshots.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RunSettings {
+    pub(crate) threads: Option<usize>,
+    pub(crate) snapshot_every: Option<Duration>,
+    pub(crate) quiet: bool,
+    pub(crate) json: bool,
+}
+
+/// What a checkpoint's note records so that `fppm resume` can go on: stored as JSON.
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+pub(crate) struct Note {
+    /// Absolute scene path; `None` for the built-in default scene.
+    pub(crate) scene: Option<PathBuf>,
+    /// Film size the render was started with (after `--width`/`--height`).
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    /// Absolute output paths.
+    pub(crate) exr: PathBuf,
+    pub(crate) png: PathBuf,
+    pub(crate) aovs: Vec<AovArg>,
+    pub(crate) exposure: f32,
+    pub(crate) tonemap: TonemapArg,
+    /// The original budget.
+    pub(crate) passes: Option<u32>,
+    pub(crate) time_seconds: Option<f64>,
+    /// Render time up to this checkpoint.
+    pub(crate) render_seconds: f64,
+}
+
+/// `fppm render [SCENE]` (the default scene when `scene` is `None`).
+pub(crate) fn render_job(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Result<Job> {
+    // Flags alone, before anything is read.
+    let flagged = apply_flags(RenderParams::preview(), &args.params)?;
+    flagged.validate().map_err(flag_error)?;
+    let passes = passes_flag(args.budget.passes)?;
+    let film = film_flags(args.width, args.height)?;
+    let run = run_settings(&args.run)?;
+    let outputs = outputs(&args.output, &args.aov, None)?;
+    if let Some(checkpoint) = &args.checkpoint
+        && checkpoint
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr") || e.eq_ignore_ascii_case("png"))
+    {
+        usage!(
+            "--checkpoint {} would overwrite an image; use e.g. state.fppm",
+            checkpoint.display()
+        );
+    }
+    check_outputs(&outputs, args.checkpoint.as_deref())?;
+
+    // The scene and its [render] defaults.
+    let mut description = load_scene(scene)?;
+    apply_film(&mut description, film);
+    let defaults = description.render.clone();
+    let source = description.source.clone();
+    let base = apply_scene_defaults(RenderParams::preview(), &defaults, &source)?;
+    let params = apply_flags(base, &args.params)?;
+    params
+        .validate()
+        .map_err(|e| anyhow::anyhow!("{}: [render] {}", source.display(), param_message(&e)))?;
+    check_aovs(&outputs.aovs, params.method)?;
+
+    let budget = Budget {
+        passes: passes.or(if args.budget.time.is_some() {
+            None
+        } else {
+            Some(defaults.passes.unwrap_or(DEFAULT_PASSES).max(1))
+        }),
+        time: args.budget.time,
+    };
+    Ok(Job {
+        scene_path: scene.map(absolute),
+        description,
+        params,
+        budget,
+        outputs,
+        checkpoint: args.checkpoint.clone(),
+        run,
+        earlier_seconds: 0.0,
+    })
+}
+
+/// The scene file, or the built-in default scene.
+pub(crate) fn load_scene(scene: Option<&Path>) -> anyhow::Result<SceneDescription> {
+    Ok(match scene {
+        Some(path) => geometry::load(path)?,
+        None => geometry::load_toml_str(DEFAULT_SCENE, Path::new(DEFAULT_SCENE_NAME))?,
+    })
+}
+
+/// `--width`/`--height` after their range check: both, one (the other follows the scene's
+/// aspect ratio) or none.
+pub(crate) type FilmOverride = (Option<u32>, Option<u32>);
+
+fn film_flags(width: Option<u32>, height: Option<u32>) -> anyhow::Result<FilmOverride> {
+    for (flag, value) in [("--width", width), ("--height", height)] {
+        if let Some(v) = value
+            && !(1..=geometry::MAX_FILM_SIDE).contains(&v)
+        {
+            usage!("{flag} {v} is outside [1, {}]", geometry::MAX_FILM_SIDE);
+        }
+    }
+    Ok((width, height))
+}
+
+/// Sets the film size; a lone side keeps the scene's aspect ratio.
+pub(crate) fn apply_film(description: &mut SceneDescription, (width, height): FilmOverride) {
+    let film = &mut description.film;
+    let aspect = f64::from(film.width) / f64::from(film.height);
+    match (width, height) {
+        (Some(w), Some(h)) => (film.width, film.height) = (w, h),
+        (Some(w), None) => {
+            film.width = w;
+            film.height =
+                ((f64::from(w) / aspect).round() as u32).clamp(1, geometry::MAX_FILM_SIDE);
+        }
+        (None, Some(h)) => {
+            film.height = h;
+            film.width = ((f64::from(h) * aspect).round() as u32).clamp(1, geometry::MAX_FILM_SIDE);
+        }
+        (None, None) => {}
+    }
+}
+
+/// `--passes` must be at least 1.
+pub(crate) fn passes_flag(passes: Option<i64>) -> anyhow::Result<Option<u32>> {
+    match passes {
+        None => Ok(None),
+        Some(n) if n >= 1 => match u32::try_from(n) {
+            Ok(n) => Ok(Some(n)),
+            Err(_) => usage!("--passes {n} is too large (at most {})", u32::MAX),
+        },
+        Some(n) => usage!("--passes {n} must be at least 1"),
+    }
+}
+
+pub(crate) fn run_settings(run: &RunArgs) -> anyhow::Result<RunSettings> {
+    let threads = match run.threads {
+        None => None,
+        Some(n) if (1..=4096).contains(&n) => Some(n as usize),
+        Some(n) => usage!("--threads {n} is outside [1, 4096]"),
+    };
+    Ok(RunSettings {
+        threads,
+        snapshot_every: run.snapshot_every,
+        quiet: run.quiet,
+        json: run.json,
+    })
+}
+
+/// Output paths and tone mapping from the flags, falling back to a checkpoint's `note`.
+pub(crate) fn outputs(
+    args: &OutputArgs,
+    aovs: &[AovArg],
+    note: Option<&Note>,
+) -> anyhow::Result<Outputs> {
+    let exr = match (&args.exr, note) {
+        (Some(p), _) => p.clone(),
+        (None, Some(n)) => n.exr.clone(),
+        (None, None) => PathBuf::from(DEFAULT_EXR),
+    };
+    if !has_extension(&exr, "exr") {
+        usage!("-o {} must name an .exr file", exr.display());
+    }
+    let png = match (&args.png, note) {
+        (Some(p), _) => p.clone(),
+        (None, Some(n)) if args.exr.is_none() => n.png.clone(),
+        _ => exr.with_extension("png"),
+    };
+    if !has_extension(&png, "png") {
+        usage!("--png {} must name a .png file", png.display());
+    }
+    if absolute(&png) == absolute(&exr) {
+        usage!("--png and -o name the same file {}", png.display());
+    }
+    let exposure = args.exposure.or(note.map(|n| n.exposure)).unwrap_or(0.0);
+    if !exposure.is_finite() || exposure.abs() > 64.0 {
+        usage!("--exposure {exposure} is outside [-64, 64]");
+    }
+    let curve = args
+        .tonemap
+        .or(note.map(|n| n.tonemap))
+        .unwrap_or(TonemapArg::Srgb);
+    let mut aov_list: Vec<AovArg> = if aovs.is_empty() {
+        note.map(|n| n.aovs.clone()).unwrap_or_default()
+    } else {
+        aovs.to_vec()
+    };
+    aov_list.dedup();
+    Ok(Outputs {
+        exr,
+        png,
+        aovs: aov_list,
+        tonemap: Tonemap { exposure, curve },
+    })
+}
+
+/// Fails early (exit 1) if an output cannot be created in its directory.
+pub(crate) fn check_outputs(outputs: &Outputs, checkpoint: Option<&Path>) -> anyhow::Result<()> {
+    output::check_writable(&outputs.exr, "-o")?;
+    output::check_writable(&outputs.png, "--png")?;
+    if let Some(c) = checkpoint {
+        output::check_writable(c, "--checkpoint")?;
+    }
+    Ok(())
+}
+
+/// AOVs the chosen method cannot produce are a usage error.
+pub(crate) fn check_aovs(aovs: &[AovArg], method: Method) -> anyhow::Result<()> {
+    for &aov in aovs {
+        let ok = match aov {
+            AovArg::Radius | AovArg::Count => method.is_photon_mapper(),
+            AovArg::Freq => method.uses_frequency(),
+            AovArg::Albedo | AovArg::Normal | AovArg::Depth => true,
+        };
+        if !ok {
+            let needs = if aov == AovArg::Freq {
+                "a frequency method (freq or freq-sppm)"
+            } else {
+                "a photon mapping method (ppm, sppm, freq or freq-sppm)"
+            };
+            usage!(
+                "--aov {} needs {needs}, but the method is {}",
+                aov.name(),
+                method.name()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The flags over `base`. Only conversions are checked here; ranges are checked by
+/// [`RenderParams::validate`].
+fn apply_flags(base: RenderParams, flags: &ParamArgs) -> anyhow::Result<RenderParams> {
+    let mut p = base;
+    if let Some(m) = flags.method {
+        p.method = m.method();
+    }
+    if let Some(n) = flags.photons_per_pass {
+        if n <= 0 {
+            usage!("--photons-per-pass {n} must be positive");
+        }
+        p.photons_per_pass = match u32::try_from(n) {
+            Ok(n) => n,
+            Err(_) => usage!("--photons-per-pass {n} is too large (at most {})", u32::MAX),
+        };
+    }
+    if let Some(a) = flags.alpha {
+        p.alpha = a;
+    }
+    if let Some(r) = flags.initial_radius {
+        p.initial_radius = Some(r);
+    }
+    if let Some(f) = flags.freq_fraction {
+        p.freq_fraction = f;
+    }
+    if let Some(m) = flags.freq_merge {
+        p.freq_merge = match m {
+            MergeArg::Min => ppm::MergePolicy::MinRadius,
+            MergeArg::PosterMax => ppm::MergePolicy::PosterMax,
+        };
+    }
+    if let Some(f) = flags.freq_floor {
+        p.freq_floor = match f {
+            FloorArg::Keep => ppm::FrequencyFloor::Keep,
+            FloorArg::Clamp => ppm::FrequencyFloor::Clamp,
+        };
+    }
+    if let Some(k) = flags.kernel_k {
+        p.kernel_k = k;
+    }
+    if let Some(d) = flags.max_depth {
+        p.max_depth = small_count("--max-depth", d)?;
+    }
+    if let Some(s) = flags.spp {
+        p.samples_per_pixel = small_count("--spp", s)?;
+    }
+    if let Some(seed) = flags.seed {
+        p.seed = seed;
+    }
+    if flags.direct_lighting {
+        p.direct_lighting = true;
+    }
+    Ok(p)
+}
+
+/// A count whose range `validate` knows; values that do not fit a `u32` are refused here.
+fn small_count(flag: &str, n: i64) -> anyhow::Result<u32> {
+    match u32::try_from(n) {
+        Ok(v) => Ok(v),
+        Err(_) => usage!("{flag} {n} is outside [1, 1024]"),
+    }
+}
+
+/// The scene's `[render]` table over `base`.
+fn apply_scene_defaults(
+    base: RenderParams,
+    d: &RenderDefaults,
+    source: &Path,
+) -> anyhow::Result<RenderParams> {
+    let mut p = base;
+    let bad = |what: String| anyhow::anyhow!("{}: [render] {what}", source.display());
+    if let Some(name) = &d.method {
+        p.method = Method::from_name(name).ok_or_else(|| {
+            let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+            bad(format!(
+                "method {name:?} is not one of {}",
+                names.join(", ")
+            ))
+        })?;
+    }
+    if let Some(n) = d.photons_per_pass {
+        p.photons_per_pass = u32::try_from(n)
+            .ok()
+            .filter(|&n| n > 0)
+            .ok_or_else(|| bad(format!("photons_per_pass {n} is outside [1, 2^32)")))?;
+    }
+    if let Some(a) = d.alpha {
+        p.alpha = a;
+    }
+    if let Some(r) = d.initial_radius {
+        p.initial_radius = Some(r);
+    }
+    if let Some(m) = d.max_depth {
+        p.max_depth = m;
+    }
+    if let Some(s) = d.seed {
+        p.seed = s;
+    }
+    Ok(p)
+}
+
+/// A [`ParamError`] of the flags as a usage error naming the flag.
+fn flag_error(e: ParamError) -> anyhow::Error {
+    anyhow::Error::new(crate::UsageError(match &e {
+        ParamError::OutOfRange { name, value, range } => {
+            format!("--{name} {value} is outside {range}")
+        }
+        other => other.to_string(),
+    }))
+}
+
+/// `alpha 1.5 is outside (0, 1]`.
+fn param_message(e: &ParamError) -> String {
+    match e {
+        ParamError::OutOfRange { name, value, range } => {
+            format!("{} {value} is outside {range}", name.replace('-', "_"))
+        }
+        other => other.to_string(),
+    }
+}
+
+fn has_extension(path: &Path, extension: &str) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case(extension))
+}
+
+/// The absolute form of a path (the file need not exist).
+pub(crate) fn absolute(path: &Path) -> PathBuf {
+    std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf())
+}
+
+/// Reads a checkpoint's note.
+pub(crate) fn read_note(checkpoint: &Path, note: &str) -> anyhow::Result<Note> {
+    serde_json::from_str(note).with_context(|| {
+        format!(
+            "{}: checkpoint note is not one fppm render writes (was it made by another program?)",
+            checkpoint.display()
+        )
+    })
+}

@@ -1,0 +1,3 @@
+//! Tests of the `fppm` binary.
+
+fn main() {}
