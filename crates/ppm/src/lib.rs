@@ -46,7 +46,7 @@ mod state;
 mod update;
 
 pub use crate::params::{Method, ParamError, RenderParams};
-pub use crate::photon_mapper::{PassStats, auto_initial_radius};
+pub use crate::photon_mapper::{PassStats, PassTimings, auto_initial_radius, bytes_per_hitpoint};
 pub use crate::renderer::{Aov, Renderer};
 pub use crate::rng::Sampler;
 pub use crate::state::{STATE_VERSION, StateError, StateHeader, scene_fingerprint};

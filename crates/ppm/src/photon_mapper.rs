@@ -8,6 +8,8 @@
 use geometry::{Bsdf, EmitterShape, Hit, Lobe as MaterialLobe, Ray, Rgb, Scene, TransportMode};
 use glam::{Vec2, Vec3};
 use photon::{AcceptParams, GridParams, HitPointGrid, HitPoints, NewHitPoint, Photon};
+use std::time::Instant;
+
 use rayon::prelude::*;
 use spectrum::{Caps, FrequencyEstimate, Lobe, Spectrum};
 
@@ -55,6 +57,33 @@ pub struct PassStats {
     pub max_radius: f64,
     /// Share of valid slots whose radius is held by the frequency floor (R ≤ r_freq).
     pub frequency_held: f64,
+    /// Photons stored on non-specular surfaces this pass: the gather queries.
+    pub photons_stored: u64,
+    /// Wall-clock time of each phase (the only field that differs between identical runs).
+    pub timings: PassTimings,
+}
+
+/// Wall-clock seconds spent in each phase of a pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PassTimings {
+    /// Camera paths (visible points, directly seen emission).
+    pub camera: f64,
+    /// Building or refreshing the hash grid.
+    pub index: f64,
+    /// Tracing photon paths (including the frequency bookkeeping and occlusion probes).
+    pub trace: f64,
+    /// Sorting and gathering photons into hitpoints, and the frequency deposits.
+    pub gather: f64,
+    /// Folding the pass into the hitpoint statistics.
+    pub update: f64,
+}
+
+impl PassTimings {
+    /// The whole pass.
+    #[must_use]
+    pub fn total(&self) -> f64 {
+        self.camera + self.index + self.trace + self.gather + self.update
+    }
 }
 
 /// Frequency state of one hitpoint slot: the merged estimate plus what a deposit needs to
@@ -87,6 +116,16 @@ pub(crate) struct PhotonMapper<'s> {
     pub(crate) grid: Option<HitPointGrid>,
     /// Slot index of each grid entry (the grid indexes the valid slots only).
     pub(crate) grid_slots: Vec<u32>,
+}
+
+/// Memory per hitpoint slot of the photon mappers: the hitpoint record (`photon::HitPoints`
+/// with the frequency state) plus the renderer's per-slot validity flag and direct-emission
+/// sum. The hash grid comes on top (about 80 bytes per hitpoint at the default cell size).
+#[must_use]
+pub fn bytes_per_hitpoint() -> usize {
+    HitPoints::<SlotFrequency>::bytes_per_hitpoint()
+        + std::mem::size_of::<bool>()
+        + std::mem::size_of::<[f64; 3]>()
 }
 
 /// The smallppm choice of initial radius: twice the mean extent of the scene's bounding box
@@ -164,13 +203,25 @@ impl<'s> PhotonMapper<'s> {
     /// Runs one pass: camera pass (the first time, or every time for SPPM), hash grid,
     /// photon pass, hitpoint update.
     pub(crate) fn iterate(&mut self) -> PassStats {
+        let clock = Instant::now();
         let retrace = self.slots.is_empty() || self.params.method.is_stochastic();
         self.camera_pass(retrace);
         let camera_paths = self.slots.len() as u64;
+        let camera = clock.elapsed().as_secs_f64();
         self.build_index();
+        let index = clock.elapsed().as_secs_f64() - camera;
         let deposits = self.photon_pass();
+        let photons_done = clock.elapsed().as_secs_f64();
         let mut stats = self.update_hitpoints(&deposits);
         stats.camera_paths = camera_paths;
+        stats.photons_stored = deposits.photons_stored;
+        stats.timings = PassTimings {
+            camera,
+            index,
+            trace: deposits.trace_seconds,
+            gather: photons_done - camera - index - deposits.trace_seconds,
+            update: clock.elapsed().as_secs_f64() - photons_done,
+        };
         self.pass += 1;
         stats
     }
@@ -391,6 +442,7 @@ impl<'s> PhotonMapper<'s> {
     fn photon_pass(&mut self) -> PassDeposits {
         let n = u64::from(self.params.photons_per_pass);
         let first_index = self.n_emitted;
+        let clock = Instant::now();
         let chunks: Vec<TracedPhotons> = (0..n.div_ceil(PHOTON_CHUNK))
             .into_par_iter()
             .map(|chunk| {
@@ -413,6 +465,7 @@ impl<'s> PhotonMapper<'s> {
             frequency.extend(chunk.frequency);
             frequency_photons += chunk.frequency_photons;
         }
+        let trace_seconds = clock.elapsed().as_secs_f64();
         let Some(grid) = &self.grid else {
             return PassDeposits::empty(self.slots.len(), frequency_photons);
         };
@@ -445,6 +498,8 @@ impl<'s> PhotonMapper<'s> {
             },
         );
         let mut deposits = PassDeposits::empty(self.slots.len(), frequency_photons);
+        deposits.trace_seconds = trace_seconds;
+        deposits.photons_stored = sorted.len() as u64;
         for (entry, (m, phi)) in per_entry.into_iter().enumerate() {
             let slot = grid_slots[entry] as usize;
             deposits.count[slot] = m;
@@ -689,6 +744,8 @@ impl<'s> PhotonMapper<'s> {
             min_radius: f64::INFINITY,
             max_radius: 0.0,
             frequency_held: 0.0,
+            photons_stored: 0,
+            timings: PassTimings::default(),
         };
         let mut sum = 0.0;
         let mut n_held = 0u64;
@@ -746,6 +803,8 @@ struct PassDeposits {
     flux: Vec<[f64; 3]>,
     photons_deposited: u64,
     frequency_photons: u64,
+    photons_stored: u64,
+    trace_seconds: f64,
 }
 
 impl PassDeposits {
@@ -755,6 +814,8 @@ impl PassDeposits {
             flux: vec![[0.0; 3]; n_slots],
             photons_deposited: 0,
             frequency_photons,
+            photons_stored: 0,
+            trace_seconds: 0.0,
         }
     }
 }

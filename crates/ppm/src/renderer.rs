@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use crate::params::{Method, ParamError, RenderParams};
 use crate::path::PathTracer;
-use crate::photon_mapper::{PassStats, PhotonMapper};
+use crate::photon_mapper::{PassStats, PassTimings, PhotonMapper};
 use crate::update::FrequencyRadius;
 
 /// A progressive render in progress: create it, call [`Renderer::iterate`] as often as the
@@ -133,8 +133,14 @@ impl<'s> Renderer<'s> {
             Engine::Photons(p) => p.iterate(),
             Engine::Path(p) => {
                 let pass = p.passes;
+                let clock = std::time::Instant::now();
                 let paths = p.iterate();
                 PassStats {
+                    photons_stored: 0,
+                    timings: PassTimings {
+                        camera: clock.elapsed().as_secs_f64(),
+                        ..PassTimings::default()
+                    },
                     pass,
                     camera_paths: paths,
                     photons_traced: 0,

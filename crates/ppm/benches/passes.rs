@@ -1,0 +1,106 @@
+//! Throughput of the photon mappers on the Cornell box with spheres at 512×512:
+//! `cargo bench -p ppm --bench passes`.
+//!
+//! Prints, for 1 and 2 threads: photon paths per second (tracing only, and whole passes),
+//! gather queries per second, hitpoints per pixel, bytes per hitpoint, and the extra cost of
+//! frequency photons at the default fraction. Times are wall-clock medians over a few passes,
+//! measured side by side in one run (absolute numbers on a shared machine are noisy).
+
+#![allow(clippy::print_stdout, clippy::unwrap_used, missing_docs)]
+
+use std::path::Path;
+
+use ppm::{Method, PassStats, RenderParams, Renderer};
+
+const PHOTONS_PER_PASS: u32 = 1_000_000;
+const PASSES: usize = 5;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn run(scene: &geometry::Scene, method: Method, threads: usize) -> Vec<PassStats> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let mut params = RenderParams::preview();
+        params.method = method;
+        params.photons_per_pass = PHOTONS_PER_PASS;
+        let mut renderer = Renderer::new(scene, params).unwrap();
+        // The first pass traces the hitpoints and builds the grid: not part of the steady state.
+        renderer.iterate();
+        (0..PASSES).map(|_| renderer.iterate()).collect()
+    })
+}
+
+fn main() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/scenes/cornell_box/CornellBox-Sphere.obj");
+    let mut description = geometry::load(&path).unwrap();
+    description.film = geometry::Film {
+        width: 512,
+        height: 512,
+    };
+    let scene = geometry::Scene::new(description).unwrap();
+    println!(
+        "CornellBox-Sphere, 512x512, {PHOTONS_PER_PASS} photons per pass, median of {PASSES} passes"
+    );
+    println!(
+        "{:<10} {:>7} {:>16} {:>16} {:>16} {:>12}",
+        "method", "threads", "trace paths/s", "pass paths/s", "gather q/s", "pass s"
+    );
+    let mut pass_seconds = Vec::new();
+    for method in [Method::Ppm, Method::FreqPpm, Method::Sppm] {
+        for threads in [1, 2] {
+            let stats = run(&scene, method, threads);
+            let trace = median(stats.iter().map(|s| s.timings.trace).collect());
+            let gather = median(stats.iter().map(|s| s.timings.gather).collect());
+            let total = median(stats.iter().map(|s| s.timings.total()).collect());
+            let stored = stats.iter().map(|s| s.photons_stored).sum::<u64>() as f64 / PASSES as f64;
+            let photons = f64::from(PHOTONS_PER_PASS);
+            println!(
+                "{:<10} {:>7} {:>16.0} {:>16.0} {:>16.0} {:>12.3}",
+                method.name(),
+                threads,
+                photons / trace,
+                photons / total,
+                stored / gather,
+                total
+            );
+            pass_seconds.push((method, threads, total, trace));
+        }
+    }
+    let find = |m: Method, t: usize| {
+        pass_seconds
+            .iter()
+            .find(|&&(method, threads, _, _)| method == m && threads == t)
+            .map(|&(_, _, total, trace)| (total, trace))
+            .unwrap()
+    };
+    for method in [Method::Ppm, Method::FreqPpm] {
+        let (one, _) = find(method, 1);
+        let (two, _) = find(method, 2);
+        println!(
+            "{}: parallel speed-up 1 -> 2 threads: {:.2}x",
+            method.name(),
+            one / two
+        );
+    }
+    let (ppm, _) = find(Method::Ppm, 2);
+    let (freq, _) = find(Method::FreqPpm, 2);
+    println!(
+        "frequency photons (default fraction {}): {:+.1} % pass time vs classical PPM (2 threads)",
+        RenderParams::preview().freq_fraction,
+        (freq / ppm - 1.0) * 100.0
+    );
+    let n_slots = 512 * 512 * RenderParams::preview().samples_per_pixel as usize;
+    println!(
+        "hitpoints per pixel: {} ({} slots); bytes per hitpoint: {} (+ grid)",
+        RenderParams::preview().samples_per_pixel,
+        n_slots,
+        ppm::bytes_per_hitpoint()
+    );
+}
