@@ -241,6 +241,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         return sweep(&scene, entry, &reference, &flags, &out);
     }
     let masks = build_masks(&scene, &reference);
+    let transport = suite::transport_mask(&scene);
     write_masks(
         &out.join(format!("{}-masks.png", entry.name)),
         &masks,
@@ -266,7 +267,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
                 elapsed += start.elapsed();
             }
             let image = Image::new(reference.width, reference.height, renderer.image());
-            let all = image_io::errors(&image, &reference, None)?;
+            let all = image_io::errors(&image, &reference, Some(&transport))?;
             let masked = [0, 1, 2].map(|i| {
                 image_io::errors(&image, &reference, Some(&masks.masks[i])).expect("sizes match")
             });
@@ -364,7 +365,8 @@ fn slope(points: &[(f64, f64)]) -> f64 {
 ///   contact edges);
 /// - low-frequency: every other diffuse pixel (smoothly lit, directly or indirectly).
 ///
-/// Pixels that see no surface or an emitter belong to no mask.
+/// Pixels that see no surface or an emitter (or neighbour one, see
+/// [`suite::transport_mask`]) belong to no mask.
 fn build_masks(scene: &geometry::Scene, reference: &Image) -> Masks {
     let (w, h) = (reference.width, reference.height);
     let lum: Vec<f64> = reference
@@ -408,6 +410,12 @@ fn build_masks(scene: &geometry::Scene, reference: &Image) -> Masks {
                 }
                 _ => glossy[idx] = true,
             }
+        }
+    }
+    let transport = suite::transport_mask(scene);
+    for mask in [&mut low, &mut caustic, &mut glossy] {
+        for (m, t) in mask.iter_mut().zip(&transport) {
+            *m &= *t;
         }
     }
     Masks {
@@ -596,6 +604,7 @@ fn sweep(
     out: &Path,
 ) -> Result<bool> {
     let masks = build_masks(scene, reference);
+    let transport = suite::transport_mask(scene);
     let mut variants: Vec<Overrides> = vec![Overrides::default()];
     for alpha in [0.5, 2.0 / 3.0, 0.8] {
         variants.push(Overrides {
@@ -638,7 +647,7 @@ fn sweep(
                 elapsed += start.elapsed();
             }
             let image = Image::new(reference.width, reference.height, renderer.image());
-            let e = image_io::errors(&image, reference, None)?;
+            let e = image_io::errors(&image, reference, Some(&transport))?;
             let m = [0, 1, 2].map(|i| {
                 image_io::errors(&image, reference, Some(&masks.masks[i])).expect("sizes match")
             });

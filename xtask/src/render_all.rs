@@ -245,13 +245,14 @@ fn check_scene(
     )?;
     report.sheet_row.push(scale(&reference, exposure));
     let scene = suite::load_scene(root, entry)?;
+    let mask = suite::transport_mask(&scene);
     let factor = if flags.full { FULL_FACTOR } else { 1 };
     for method in ppm::Method::ALL {
         let passes = suite::passes(entry, method) * factor;
         let rendered = suite::render(&scene, suite::params(entry, method, CHECK_SEED), passes)?;
-        let errors = image_io::errors(&rendered.image, &reference, None)?;
+        let errors = image_io::errors(&rendered.image, &reference, Some(&mask))?;
         let tolerance = entry.tolerance.get(method.name()).copied();
-        let perturbed = image_io::errors(&scale(&rendered.image, 1.1), &reference, None)?;
+        let perturbed = image_io::errors(&scale(&rendered.image, 1.1), &reference, Some(&mask))?;
         let stem = format!("{}-{}", entry.name, method.name());
         image_io::write_png(
             &out_dir.join(format!("{stem}.png")),
@@ -309,6 +310,7 @@ fn calibrate(root: &Path, entry: &SuiteScene, seeds: &[u64]) -> Result<()> {
     let reference = image_io::read_exr(&golden)
         .with_context(|| format!("run `cargo xtask render-all --bless {}` first", entry.name))?;
     let scene = suite::load_scene(root, entry)?;
+    let mask = suite::transport_mask(&scene);
     println!("# {}: calibration over seeds {seeds:?}", entry.name);
     let mut lines = Vec::new();
     for method in ppm::Method::ALL {
@@ -320,7 +322,7 @@ fn calibrate(root: &Path, entry: &SuiteScene, seeds: &[u64]) -> Result<()> {
                 suite::params(entry, method, seed),
                 suite::passes(entry, method),
             )?;
-            let e = image_io::errors(&rendered.image, &reference, None)?;
+            let e = image_io::errors(&rendered.image, &reference, Some(&mask))?;
             rel.push(e.rel_mse);
             dev.push(e.mean_ratio - 1.0);
         }
@@ -387,7 +389,8 @@ fn write_report(
          figcaption{{font-size:small;text-align:center}}</style></head><body>\
          <h1>cargo xtask render-all</h1><p>Mode {mode}; {} scene(s) in {seconds:.1} s. Golden references are \
          path-traced (NEE + MIS); relMSE = mean (x − ref)² / (ref² + {}); error maps show per-pixel relMSE, \
-         0 (blue) to 0.25 (red). A method passes when relMSE ≤ tol and |mean ratio − 1| ≤ mean tol. \
+         0 (blue) to 0.25 (red). The figures leave out pixels that see an emitter directly (and their \
+         neighbours): they measure light transport, not the lamp's outline. A method passes when relMSE ≤ tol and |mean ratio − 1| ≤ mean tol. \
          “×1.1 trips” says whether the same image scaled by 1.1 would fail (the check catches a 10 % regression).</p>",
         reports.len(),
         image_io::REL_MSE_EPSILON
