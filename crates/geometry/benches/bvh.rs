@@ -45,8 +45,8 @@ fn main() {
         .collect();
     let paths: Vec<PathBuf> = if args.is_empty() {
         vec![
-            "/work/shared/scenes/stanford_bunny/stanford-bunny.obj".into(),
-            "/work/shared/scenes/gltf/MetalRoughSpheresNoTextures/glTF/MetalRoughSpheresNoTextures.gltf".into(),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/scenes/stanford_bunny/stanford-bunny.obj").into(),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/scenes/gltf/MetalRoughSpheresNoTextures/glTF/MetalRoughSpheresNoTextures.gltf").into(),
         ]
     } else {
         args.into_iter().map(PathBuf::from).collect()

@@ -32,7 +32,10 @@ fn time<F: Fn(&BRay) -> bool>(rays: &[BRay], f: F) -> f64 {
 }
 
 fn main() {
-    let path = Path::new("/work/shared/scenes/stanford_bunny/stanford-bunny.obj");
+    let path = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/scenes/stanford_bunny/stanford-bunny.obj"
+    ));
     let desc = common::load_triangles(path);
     let tris: Vec<Triangle> = desc
         .triangles
@@ -92,9 +95,10 @@ fn main() {
         }
     }
     // Build times alone on the 1M-triangle scene.
-    let path = Path::new(
-        "/work/shared/scenes/gltf/MetalRoughSpheresNoTextures/glTF/MetalRoughSpheresNoTextures.gltf",
-    );
+    let path = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/scenes/gltf/MetalRoughSpheresNoTextures/glTF/MetalRoughSpheresNoTextures.gltf"
+    ));
     if !path.exists() {
         return;
     }

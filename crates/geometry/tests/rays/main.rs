@@ -1,60 +1,19 @@
-//! Ray-query robustness on real data: McGuire's Cornell box (OBJ), loaded with a minimal reader
-//! (replaced by geometry::load after the loaders land).
+//! Ray-query robustness on real data: McGuire's Cornell box (OBJ).
 #![allow(clippy::unwrap_used, missing_docs)]
 
-use geometry::{
-    Camera, Film, Frame, Light, LoadNotes, Material, MaterialKind, Ray, RenderDefaults, Scene,
-    SceneDescription, Triangle,
-};
+use geometry::{Film, Frame, Ray, Scene};
 use glam::{Vec2, Vec3};
 
-const CORNELL: &str = "/work/shared/scenes/cornell_box/CornellBox-Original.obj";
-
-fn cornell() -> Option<Scene> {
-    let (models, _) = tobj::load_obj(CORNELL, &tobj::GPU_LOAD_OPTIONS).ok()?;
-    let mut triangles = Vec::new();
-    for m in models {
-        let p = |i: u32| Vec3::from_slice(&m.mesh.positions[3 * i as usize..3 * i as usize + 3]);
-        for f in m.mesh.indices.chunks_exact(3) {
-            triangles.push(Triangle {
-                positions: [p(f[0]), p(f[1]), p(f[2])],
-                normals: None,
-                material: 0,
-            });
-        }
-    }
-    Scene::new(SceneDescription {
-        source: CORNELL.into(),
-        camera: Camera {
-            position: Vec3::new(0.0, 1.0, 3.9),
-            look_at: Vec3::new(0.0, 1.0, 0.0),
-            up: Vec3::Y,
-            fov_y: 39.3f32.to_radians(),
-            aperture_radius: 0.0,
-            focus_distance: 3.9,
-        },
-        film: Film {
-            width: 64,
-            height: 64,
-        },
-        materials: vec![Material {
-            name: "white".into(),
-            kind: MaterialKind::Diffuse {
-                albedo: Vec3::splat(0.8),
-            },
-            emission: Vec3::ZERO,
-        }],
-        triangles,
-        spheres: vec![],
-        cylinders: vec![],
-        lights: vec![Light::Point {
-            position: Vec3::new(0.0, 1.9, 0.0),
-            intensity: Vec3::ONE,
-        }],
-        render: RenderDefaults::default(),
-        notes: LoadNotes::default(),
-    })
-    .ok()
+/// McGuire's Cornell box, read in place from the shared scenes beside the checkout.
+fn cornell() -> Scene {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/scenes/cornell_box/CornellBox-Original.obj");
+    let mut description = geometry::load(&path).unwrap();
+    description.film = Film {
+        width: 64,
+        height: 64,
+    };
+    Scene::new(description).unwrap()
 }
 
 /// A hash-based uniform number in [0, 1).
@@ -78,9 +37,7 @@ fn cosine_direction(normal: Vec3, u: Vec2) -> Vec3 {
 
 #[test]
 fn random_walks_leave_only_through_the_opening() {
-    let Some(scene) = cornell() else {
-        return; // The shared scenes are not available on this machine.
-    };
+    let scene = cornell();
     let (mut bounces, mut escaped) = (0u64, 0u64);
     for path in 0..20_000u64 {
         let u = |d: u64| uniform(path, d);
@@ -120,9 +77,7 @@ fn random_walks_leave_only_through_the_opening() {
 
 #[test]
 fn corner_shadow_rays_are_not_blocked() {
-    let Some(scene) = cornell() else {
-        return;
-    };
+    let scene = cornell();
     // Floor points near the right wall (x = 1.00) see wall points near the floor.
     for i in 0..5000u64 {
         let eps = 10f32.powf(-1.0 - 4.0 * uniform(i, 0));
