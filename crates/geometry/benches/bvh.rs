@@ -1,6 +1,6 @@
 //! BVH build time and closest-hit throughput (rays/s) on 1 and 2 threads.
 //!
-//! `cargo bench -p geometry` (scenes from `/work/shared/scenes`, or the paths given as arguments).
+//! `cargo bench -p geometry` (scenes from `../shared/scenes` beside the checkout, or the paths given as arguments).
 #![allow(clippy::unwrap_used, clippy::print_stdout, missing_docs)]
 
 mod common;
