@@ -1,0 +1,54 @@
+//! Every shared scene that has emitters loads, builds and renders a pass with every method:
+//! finite, non-negative, and not black.
+
+use std::path::{Path, PathBuf};
+
+use geometry::{Film, Scene};
+use ppm::{Method, RenderParams, Renderer};
+
+fn shared(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/scenes")
+        .join(relative)
+}
+
+const LIT_SCENES: &[&str] = &[
+    "cornell_box/CornellBox-Original.obj",
+    "cornell_box/CornellBox-Mirror.obj",
+    "cornell_box/CornellBox-Sphere.obj",
+    "cornell_box/CornellBox-Glossy.obj",
+    "cornell_box/CornellBox-Water.obj",
+    "cornell_box/CornellBox-Empty-CO.obj",
+    "cornell_box/CornellBox-Empty-RG.obj",
+    "cornell_box/CornellBox-Empty-Squashed.obj",
+    "cornell_box/CornellBox-Empty-White.obj",
+    "gltf/EmissiveStrengthTest/glTF/EmissiveStrengthTest.gltf",
+    "gltf/EmissiveStrengthTest/glTF-Binary/EmissiveStrengthTest.glb",
+    "gltf/LightsPunctualLamp/glTF/LightsPunctualLamp.gltf",
+];
+
+#[test]
+fn every_lit_shared_scene_renders_with_every_method() {
+    for relative in LIT_SCENES {
+        let mut description = geometry::load(&shared(relative)).unwrap();
+        description.film = Film {
+            width: 12,
+            height: 12,
+        };
+        let scene = Scene::new(description).unwrap();
+        for method in Method::ALL {
+            let mut params = RenderParams::preview();
+            params.method = method;
+            params.photons_per_pass = 3_000;
+            let mut renderer = Renderer::new(&scene, params).unwrap();
+            renderer.iterate();
+            let image = renderer.image();
+            assert!(
+                image.iter().flatten().all(|c| c.is_finite() && *c >= 0.0),
+                "{relative} with {method}: non-finite or negative pixel"
+            );
+            let total: f32 = image.iter().flatten().sum();
+            assert!(total > 0.0, "{relative} with {method}: black image");
+        }
+    }
+}
