@@ -16,6 +16,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
     name = "fppm",
     version,
     args_conflicts_with_subcommands = true,
+    args_override_self = true,
     after_help = "Examples:\n  \
         fppm                                   render the default scene to fppm.exr and fppm.png\n  \
         fppm render scene.toml --time 30s -o out.exr\n  \

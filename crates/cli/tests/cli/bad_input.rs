@@ -1,0 +1,388 @@
+//! Every bad input of the issue: the exit code, one line naming the file or the flag, and no
+//! output file left behind.
+
+use std::path::Path;
+
+use crate::{CORNELL, TINY, files, fppm, render_cornell, temp_dir};
+
+/// Runs `args` in a fresh directory and checks the failure; the directory must stay empty
+/// (apart from the `keep` files the test put there).
+#[track_caller]
+fn check(name: &str, args: &[&str], code: i32, needles: &[&str]) {
+    let dir = temp_dir(name);
+    check_in(&dir, args, code, needles, &[]);
+}
+
+#[track_caller]
+fn check_in(dir: &Path, args: &[&str], code: i32, needles: &[&str], keep: &[&str]) {
+    fppm(dir, args).fails(code, needles);
+    assert_eq!(files(dir), keep, "files left behind after {args:?}");
+}
+
+#[test]
+fn missing_scene() {
+    check(
+        "missing_scene",
+        &["render", "no-such-scene.toml"],
+        1,
+        &["no-such-scene.toml", "cannot read file"],
+    );
+}
+
+#[test]
+fn unknown_extension() {
+    check(
+        "unknown_extension",
+        &["render", "scene.blend"],
+        1,
+        &["scene.blend", "unsupported scene file extension"],
+    );
+}
+
+#[test]
+fn unwritable_output_directory() {
+    let dir = temp_dir("unwritable");
+    // A directory that does not exist, and a "directory" that is a file: unwritable even for root.
+    check_in(
+        &dir,
+        &[&["render", CORNELL, "-o", "missing-dir/out.exr"], TINY].concat(),
+        1,
+        &["missing-dir", "cannot write"],
+        &[],
+    );
+    std::fs::write(dir.join("plain-file"), "x").unwrap();
+    check_in(
+        &dir,
+        &[&["render", CORNELL, "--png", "plain-file/out.png"], TINY].concat(),
+        1,
+        &["plain-file", "--png", "cannot write"],
+        &["plain-file"],
+    );
+    check_in(
+        &dir,
+        &[
+            &["render", CORNELL, "--checkpoint", "missing-dir/state.fppm"],
+            TINY,
+        ]
+        .concat(),
+        1,
+        &["missing-dir", "--checkpoint"],
+        &["plain-file"],
+    );
+}
+
+#[test]
+fn zero_time() {
+    check(
+        "zero_time",
+        &["render", CORNELL, "--time", "0s"],
+        2,
+        &["--time", "0s", "longer than zero"],
+    );
+    check(
+        "bad_time",
+        &["render", CORNELL, "--time", "soon"],
+        2,
+        &["--time", "soon"],
+    );
+    check(
+        "zero_snapshot",
+        &["render", CORNELL, "--snapshot-every", "0ms"],
+        2,
+        &["--snapshot-every"],
+    );
+}
+
+#[test]
+fn negative_or_zero_photons() {
+    check(
+        "negative_photons",
+        &["render", CORNELL, "--photons-per-pass", "-5"],
+        2,
+        &["--photons-per-pass", "-5", "positive"],
+    );
+    check(
+        "zero_photons",
+        &["render", CORNELL, "--photons-per-pass", "0"],
+        2,
+        &["--photons-per-pass", "0", "positive"],
+    );
+    check(
+        "word_photons",
+        &["render", CORNELL, "--photons-per-pass", "many"],
+        2,
+        &["--photons-per-pass", "many"],
+    );
+}
+
+#[test]
+fn unknown_method() {
+    check(
+        "unknown_method",
+        &["render", CORNELL, "--method", "bdpt"],
+        2,
+        &["--method", "bdpt", "ppm", "freq-sppm"],
+    );
+}
+
+#[test]
+fn alpha_outside_its_range() {
+    check(
+        "alpha_high",
+        &["render", CORNELL, "--alpha", "1.5"],
+        2,
+        &["--alpha 1.5 is outside (0, 1]"],
+    );
+    check(
+        "alpha_zero",
+        &["render", CORNELL, "--alpha", "0"],
+        2,
+        &["--alpha 0 is outside (0, 1]"],
+    );
+    check(
+        "alpha_negative",
+        &["render", CORNELL, "--alpha", "-0.5"],
+        2,
+        &["--alpha -0.5 is outside (0, 1]"],
+    );
+}
+
+#[test]
+fn freq_fraction_outside_its_range() {
+    check(
+        "freq_fraction_high",
+        &["render", CORNELL, "--freq-fraction", "1.5"],
+        2,
+        &["--freq-fraction 1.5 is outside [0, 1]"],
+    );
+    check(
+        "freq_fraction_low",
+        &["render", CORNELL, "--freq-fraction", "-0.1"],
+        2,
+        &["--freq-fraction -0.1 is outside [0, 1]"],
+    );
+}
+
+#[test]
+fn other_flag_ranges() {
+    check(
+        "passes_zero",
+        &["render", CORNELL, "--passes", "0"],
+        2,
+        &["--passes 0"],
+    );
+    check(
+        "threads_zero",
+        &["render", CORNELL, "--threads", "0"],
+        2,
+        &["--threads 0"],
+    );
+    check(
+        "width_zero",
+        &["render", CORNELL, "--width", "0"],
+        2,
+        &["--width 0"],
+    );
+    check(
+        "spp_zero",
+        &["render", CORNELL, "--spp", "0"],
+        2,
+        &["--spp 0"],
+    );
+    check(
+        "max_depth_zero",
+        &["render", CORNELL, "--max-depth", "0"],
+        2,
+        &["--max-depth 0"],
+    );
+    check(
+        "radius_negative",
+        &["render", CORNELL, "--initial-radius", "-1"],
+        2,
+        &["--initial-radius -1"],
+    );
+    check(
+        "kernel_k_zero",
+        &["render", CORNELL, "--kernel-k", "0"],
+        2,
+        &["--kernel-k 0"],
+    );
+    check(
+        "merge",
+        &["render", CORNELL, "--freq-merge", "max"],
+        2,
+        &["--freq-merge", "max"],
+    );
+    check(
+        "aov",
+        &["render", CORNELL, "--aov", "depth,colour"],
+        2,
+        &["--aov", "colour"],
+    );
+    check(
+        "aov_method",
+        &["render", CORNELL, "--aov", "freq"],
+        2,
+        &["--aov freq", "frequency method"],
+    );
+    check(
+        "aov_path",
+        &["render", CORNELL, "--method", "path", "--aov", "radius"],
+        2,
+        &["--aov radius"],
+    );
+    check(
+        "exr_name",
+        &["render", CORNELL, "-o", "out.png"],
+        2,
+        &["-o out.png", ".exr"],
+    );
+    check(
+        "png_name",
+        &["render", CORNELL, "--png", "out.jpg"],
+        2,
+        &["--png out.jpg", ".png"],
+    );
+    check(
+        "unknown_flag",
+        &["render", CORNELL, "--colour", "red"],
+        2,
+        &["--colour"],
+    );
+    check("no_scene", &["render"], 2, &["SCENE"]);
+    check("unknown_command", &["paint"], 2, &["paint"]);
+    // A flag error wins over a missing scene: usage errors come first.
+    check(
+        "flag_before_scene",
+        &["render", "missing.toml", "--alpha", "2"],
+        2,
+        &["--alpha 2"],
+    );
+}
+
+#[test]
+fn bad_scene_file_names_the_file_and_line() {
+    let dir = temp_dir("bad_scene");
+    std::fs::write(
+        dir.join("bad.toml"),
+        "format = 1\n[camera]\nposition = [0, 1]\n",
+    )
+    .unwrap();
+    check_in(
+        &dir,
+        &["render", "bad.toml"],
+        1,
+        &["bad.toml"],
+        &["bad.toml"],
+    );
+    std::fs::write(
+        dir.join("render.toml"),
+        crate::small_default_scene().replace("alpha = 0.7", "alpha = 3.0"),
+    )
+    .unwrap();
+    check_in(
+        &dir,
+        &["render", "render.toml"],
+        1,
+        &["render.toml", "[render] alpha 3 is outside (0, 1]"],
+        &["bad.toml", "render.toml"],
+    );
+    // The flag overrides the bad scene value.
+    fppm(
+        &dir,
+        &[
+            "render",
+            "render.toml",
+            "--alpha",
+            "0.5",
+            "--width",
+            "8",
+            "--photons-per-pass",
+            "500",
+            "--passes",
+            "1",
+            "-o",
+            "ok.exr",
+        ],
+    )
+    .ok();
+}
+
+#[test]
+fn checkpoint_from_another_scene() {
+    let dir = temp_dir("checkpoint_other_scene");
+    std::fs::write(dir.join("scene.toml"), crate::small_default_scene()).unwrap();
+    fppm(
+        &dir,
+        &[
+            "render",
+            "scene.toml",
+            "--checkpoint",
+            "state.fppm",
+            "--passes",
+            "1",
+            "--photons-per-pass",
+            "500",
+            "-o",
+            "a.exr",
+        ],
+    )
+    .ok();
+    // The scene changes under the checkpoint.
+    let changed = crate::small_default_scene()
+        .replace("albedo = [0.75, 0.73, 0.70]", "albedo = [0.5, 0.5, 0.5]");
+    assert_ne!(changed, crate::small_default_scene());
+    std::fs::write(dir.join("scene.toml"), changed).unwrap();
+    let before = files(&dir);
+    fppm(&dir, &["resume", "state.fppm", "-o", "b.exr"]).fails(1, &["state.fppm", "another scene"]);
+    assert_eq!(files(&dir), before);
+}
+
+#[test]
+fn checkpoint_of_another_version_or_not_a_checkpoint() {
+    let dir = temp_dir("checkpoint_version");
+    let mut bytes = b"FPPMSTAT".to_vec();
+    bytes.extend_from_slice(&999u32.to_le_bytes());
+    bytes.extend_from_slice(&[0; 64]);
+    std::fs::write(dir.join("future.fppm"), &bytes).unwrap();
+    std::fs::write(dir.join("text.fppm"), "hello").unwrap();
+    let keep = ["future.fppm", "text.fppm"];
+    check_in(
+        &dir,
+        &["resume", "future.fppm"],
+        1,
+        &["future.fppm", "version 999"],
+        &keep,
+    );
+    check_in(
+        &dir,
+        &["resume", "text.fppm"],
+        1,
+        &["text.fppm", "not an fppm checkpoint"],
+        &keep,
+    );
+    check_in(
+        &dir,
+        &["resume", "none.fppm"],
+        1,
+        &["none.fppm", "cannot read checkpoint"],
+        &keep,
+    );
+    check_in(
+        &dir,
+        &["resume", "text.fppm", "--passes", "0"],
+        2,
+        &["--passes 0"],
+        &keep,
+    );
+}
+
+#[test]
+fn a_failed_render_keeps_an_existing_output() {
+    let dir = temp_dir("keep_existing");
+    render_cornell(&dir, &[]).ok();
+    let before = std::fs::read(dir.join("fppm.exr")).unwrap();
+    fppm(&dir, &["render", "missing.toml"]).fails(1, &["missing.toml"]);
+    assert_eq!(std::fs::read(dir.join("fppm.exr")).unwrap(), before);
+    assert_eq!(files(&dir), ["fppm.exr", "fppm.png"]);
+}

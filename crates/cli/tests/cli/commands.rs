@@ -1,0 +1,213 @@
+//! `fppm` alone, `scene`, `info`, `diff`, `--help`.
+
+use crate::{CORNELL, files, fppm, read_exr, temp_dir, write_flat_exr};
+
+#[test]
+fn without_a_subcommand_fppm_renders_the_default_scene_here() {
+    let dir = temp_dir("no_subcommand");
+    let run = fppm(
+        &dir,
+        &[
+            "--width",
+            "32",
+            "--photons-per-pass",
+            "3000",
+            "--passes",
+            "2",
+        ],
+    )
+    .ok();
+    assert_eq!(files(&dir), ["fppm.exr", "fppm.png"]);
+    assert!(run.stderr.contains("wrote fppm.exr"), "{}", run.stderr);
+    assert!(run.stderr.contains("wrote fppm.png"), "{}", run.stderr);
+    let exr = read_exr(&dir.join("fppm.exr"));
+    assert_eq!(exr.metadata["fppm.scene"], "<built-in default scene>");
+    // The scene's [render] table picks the method and the seed.
+    assert_eq!(exr.metadata["fppm.method"], "ppm");
+    assert_eq!(exr.metadata["fppm.seed"], "1");
+    assert!(exr.mean() > 0.0);
+}
+
+/// The full default render (the README's command), only when asked for: it takes about 25 s in
+/// release and much longer in the dev profile.
+#[test]
+fn full_default_render_when_slow_tests_are_on() {
+    if std::env::var_os("RUN_SLOW_TESTS").is_none() {
+        return;
+    }
+    let dir = temp_dir("full_default");
+    fppm(&dir, &[]).ok();
+    let exr = read_exr(&dir.join("fppm.exr"));
+    assert_eq!((exr.width, exr.height), (512, 384));
+    assert_eq!(exr.metadata["fppm.passes"], "24");
+}
+
+#[test]
+fn scene_default_prints_a_scene_that_renders() {
+    let dir = temp_dir("scene_default");
+    let run = fppm(&dir, &["scene", "default"]).ok();
+    assert!(
+        run.stdout.contains("type     = \"cylinder\""),
+        "{}",
+        run.stdout
+    );
+    std::fs::write(dir.join("default.toml"), &run.stdout).unwrap();
+    let info = fppm(&dir, &["info", "default.toml"]).ok();
+    assert!(info.stdout.contains("default.toml"), "{}", info.stdout);
+    fppm(
+        &dir,
+        &[
+            "render",
+            "default.toml",
+            "--width",
+            "16",
+            "--photons-per-pass",
+            "1000",
+            "--passes",
+            "1",
+        ],
+    )
+    .ok();
+    // The same scene as the built-in one: the same image.
+    fppm(
+        &dir,
+        &[
+            "--width",
+            "16",
+            "--photons-per-pass",
+            "1000",
+            "--passes",
+            "1",
+            "-o",
+            "builtin.exr",
+        ],
+    )
+    .ok();
+    let (a, b) = (
+        read_exr(&dir.join("fppm.exr")),
+        read_exr(&dir.join("builtin.exr")),
+    );
+    assert_eq!(a.rgb(), b.rgb());
+}
+
+#[test]
+fn info_describes_the_cornell_box() {
+    let dir = temp_dir("info");
+    let run = fppm(&dir, &["info", CORNELL]).ok();
+    let out = &run.stdout;
+    for needle in [
+        "CornellBox-Original.obj",
+        "triangles",
+        "materials",
+        "camera",
+        "bounds",
+        "light",
+    ] {
+        assert!(out.contains(needle), "{needle:?} not in:\n{out}");
+    }
+    assert!(!out.contains("no emitter"), "{out}");
+    assert_eq!(files(&dir), Vec::<String>::new());
+    let default = fppm(&dir, &["info"]).ok();
+    assert!(default.stdout.contains("cylinder"), "{}", default.stdout);
+}
+
+#[test]
+fn info_accepts_a_scene_without_emitters_and_says_so() {
+    let dir = temp_dir("info_dark");
+    let dark = crate::small_default_scene();
+    let dark = dark[..dark.find("[[lights]]").unwrap()].to_string();
+    std::fs::write(dir.join("dark.toml"), dark).unwrap();
+    let run = fppm(&dir, &["info", "dark.toml"]).ok();
+    assert!(run.stdout.contains("no emitter"), "{}", run.stdout);
+    fppm(&dir, &["render", "dark.toml"]).fails(1, &["dark.toml", "no emitter"]);
+    fppm(&dir, &["info", "missing.obj"]).fails(1, &["missing.obj"]);
+}
+
+#[test]
+fn diff_by_hand() {
+    let dir = temp_dir("diff");
+    // A: 1 everywhere; B: 0.5 on the left half, 1 on the right half (4 x 2 pixels).
+    write_flat_exr(&dir.join("a.exr"), 4, 2, |_, _| [1.0, 1.0, 1.0]);
+    write_flat_exr(&dir.join("b.exr"), 4, 2, |x, _| {
+        if x < 2 { [0.5; 3] } else { [1.0; 3] }
+    });
+    let run = fppm(&dir, &["diff", "a.exr", "b.exr", "--json"]).ok();
+    let m: serde_json::Value = serde_json::from_str(run.stdout.trim()).unwrap();
+    // Half the values differ by 0.5: MSE = 0.125, RMSE = 0.35355.
+    let close = |key: &str, expected: f64| {
+        let got = m[key].as_f64().unwrap();
+        assert!((got - expected).abs() < 1e-9, "{key}: {got} vs {expected}");
+    };
+    close("rmse", 0.125f64.sqrt());
+    // relMSE: half the values give 0.25 / (0.25 + 0.01).
+    close("rel_mse", 0.5 * 0.25 / 0.26);
+    // mean ratio: 1 / 0.75.
+    close("mean_ratio", 1.0 / 0.75);
+
+    let text = fppm(&dir, &["diff", "a.exr", "b.exr", "--out", "d.png"]).ok();
+    assert!(text.stdout.contains("rmse"), "{}", text.stdout);
+    assert!(text.stdout.contains("3.535534e-1"), "{}", text.stdout);
+    let png = image::open(dir.join("d.png")).unwrap().to_rgb8();
+    assert_eq!(png.dimensions(), (4, 2));
+    // Zero error is the dark end of the ramp, a large one the bright end.
+    assert_eq!(png.get_pixel(3, 0).0, [68, 1, 84]);
+    assert_ne!(png.get_pixel(0, 0).0, [68, 1, 84]);
+
+    let same = fppm(&dir, &["diff", "a.exr", "a.exr", "--json"]).ok();
+    let m: serde_json::Value = serde_json::from_str(same.stdout.trim()).unwrap();
+    assert_eq!(m["rmse"], 0.0);
+    assert_eq!(m["mean_ratio"], 1.0);
+}
+
+#[test]
+fn diff_refuses_mismatched_or_missing_images() {
+    let dir = temp_dir("diff_bad");
+    write_flat_exr(&dir.join("a.exr"), 4, 2, |_, _| [1.0; 3]);
+    write_flat_exr(&dir.join("c.exr"), 2, 2, |_, _| [1.0; 3]);
+    fppm(&dir, &["diff", "a.exr", "c.exr", "--out", "d.png"]).fails(1, &["a.exr", "4x2", "2x2"]);
+    fppm(&dir, &["diff", "a.exr", "nope.exr"]).fails(1, &["nope.exr"]);
+    std::fs::write(dir.join("text.exr"), "not an image").unwrap();
+    fppm(&dir, &["diff", "text.exr", "a.exr"]).fails(1, &["text.exr"]);
+    assert_eq!(files(&dir), ["a.exr", "c.exr", "text.exr"]);
+}
+
+#[test]
+fn help_and_version() {
+    let dir = temp_dir("help");
+    let help = fppm(&dir, &["--help"]).ok();
+    for flag in [
+        "--method",
+        "--time",
+        "--passes",
+        "--photons-per-pass",
+        "--alpha",
+        "--initial-radius",
+        "--freq-fraction",
+        "--freq-merge",
+        "--kernel-k",
+        "--max-depth",
+        "--spp",
+        "--seed",
+        "--threads",
+        "--width",
+        "--height",
+        "--output",
+        "--png",
+        "--exposure",
+        "--tonemap",
+        "--aov",
+        "--snapshot-every",
+        "--checkpoint",
+        "--quiet",
+        "--json",
+    ] {
+        assert!(help.stdout.contains(flag), "{flag} missing from --help");
+    }
+    let render_help = fppm(&dir, &["render", "--help"]).ok();
+    assert!(render_help.stdout.contains("SCENE"));
+    let resume_help = fppm(&dir, &["resume", "--help"]).ok();
+    assert!(resume_help.stdout.contains("CHECKPOINT"));
+    let version = fppm(&dir, &["--version"]).ok();
+    assert!(version.stdout.starts_with("fppm "));
+    assert_eq!(files(&dir), Vec::<String>::new());
+}
