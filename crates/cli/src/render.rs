@@ -67,6 +67,15 @@ pub(crate) fn resume(args: &ResumeArgs) -> anyhow::Result<Outcome> {
         run,
         earlier_seconds: note.render_seconds,
     };
+    // ppm's scene fingerprint does not cover cylinders yet: check them here.
+    if let Some(stored) = note.cylinders
+        && stored != settings::cylinder_fingerprint(&job.description)
+    {
+        anyhow::bail!(
+            "{}: checkpoint was made for another scene (its cylinders differ)",
+            path.display()
+        );
+    }
     let scene = geometry::Scene::new(job.description.clone())?;
     in_pool(job.run.threads, || {
         let renderer = Renderer::restore(&scene, &bytes)
@@ -275,6 +284,7 @@ fn write_checkpoint(
         passes: job.budget.passes,
         time_seconds: job.budget.time.map(|t| t.as_secs_f64()),
         render_seconds: job.earlier_seconds + elapsed.as_secs_f64(),
+        cylinders: Some(settings::cylinder_fingerprint(&job.description)),
     };
     let note = serde_json::to_string(&note)
         .context("internal error: cannot encode the checkpoint note")?;
@@ -347,6 +357,14 @@ impl Progress {
                 "min_radius": finite_or_null(stats.min_radius),
                 "max_radius": finite_or_null(stats.max_radius),
                 "frequency_held": finite_or_null(stats.frequency_held),
+                "photons_stored": stats.photons_stored,
+                "timings": {
+                    "camera": stats.timings.camera,
+                    "index": stats.timings.index,
+                    "trace": stats.timings.trace,
+                    "gather": stats.timings.gather,
+                    "update": stats.timings.update,
+                },
                 "photons_emitted": renderer.photons_emitted(),
                 "elapsed_seconds": elapsed.as_secs_f64(),
             });

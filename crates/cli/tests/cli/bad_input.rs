@@ -336,6 +336,12 @@ fn checkpoint_from_another_scene() {
     let before = files(&dir);
     fppm(&dir, &["resume", "state.fppm", "-o", "b.exr"]).fails(1, &["state.fppm", "another scene"]);
     assert_eq!(files(&dir), before);
+    // The same for a change of the curved mirror alone.
+    let changed = crate::small_default_scene().replace("radius   = 1.0", "radius   = 0.9");
+    assert_ne!(changed, crate::small_default_scene());
+    std::fs::write(dir.join("scene.toml"), changed).unwrap();
+    fppm(&dir, &["resume", "state.fppm", "-o", "b.exr"]).fails(1, &["state.fppm", "another scene"]);
+    assert_eq!(files(&dir), before);
 }
 
 #[test]
