@@ -211,3 +211,56 @@ fn help_and_version() {
     assert!(version.stdout.starts_with("fppm "));
     assert_eq!(files(&dir), Vec::<String>::new());
 }
+
+/// A shared glTF scene, by its path under `shared/scenes/gltf`.
+fn gltf(path: &str) -> String {
+    format!(
+        "{}/../../../shared/scenes/gltf/{path}",
+        env!("CARGO_MANIFEST_DIR")
+    )
+}
+
+#[test]
+fn gltf_and_glb_scenes_render() {
+    let dir = temp_dir("gltf");
+    for (name, path) in [
+        (
+            "gltf",
+            "EmissiveStrengthTest/glTF/EmissiveStrengthTest.gltf",
+        ),
+        (
+            "glb",
+            "EmissiveStrengthTest/glTF-Binary/EmissiveStrengthTest.glb",
+        ),
+    ] {
+        let out = format!("{name}.exr");
+        let scene = gltf(path);
+        let args = [
+            "render",
+            &scene,
+            "--width",
+            "24",
+            "--height",
+            "16",
+            "--photons-per-pass",
+            "3000",
+            "--passes",
+            "2",
+        ];
+        fppm(&dir, &[&args[..], &["-o", &out]].concat()).ok();
+        let exr = read_exr(&dir.join(&out));
+        assert_eq!((exr.width, exr.height), (24, 16));
+        assert!(exr.mean() > 0.0, "{path}");
+    }
+    // The glTF and its binary twin are the same scene.
+    assert_eq!(
+        read_exr(&dir.join("gltf.exr")).rgb(),
+        read_exr(&dir.join("glb.exr")).rgb()
+    );
+    // A glTF without lights can be inspected but not rendered.
+    let dark = gltf("Box/glTF-Binary/Box.glb");
+    let info = fppm(&dir, &["info", &dark]).ok();
+    assert!(info.stdout.contains("no emitter"), "{}", info.stdout);
+    fppm(&dir, &["render", &dark, "-o", "box.exr"]).fails(1, &["Box.glb", "no emitter"]);
+    assert_eq!(files(&dir), ["glb.exr", "glb.png", "gltf.exr", "gltf.png"]);
+}
