@@ -77,7 +77,7 @@ fn main() -> ExitCode {
             } else {
                 1
             };
-            report_error(&format!("{err:#}"));
+            report_error(&error_chain(&err));
             ExitCode::from(code)
         }
     }
@@ -124,6 +124,22 @@ pub(crate) fn print_stdout(text: &str) -> anyhow::Result<()> {
     }
 }
 
+/// The error and its causes joined by `: `, skipping a cause whose text the message already
+/// holds (library errors such as `geometry::LoadError` quote their source).
+fn error_chain(err: &anyhow::Error) -> String {
+    let mut message = String::new();
+    for cause in err.chain() {
+        let text = cause.to_string();
+        if message.is_empty() {
+            message = text;
+        } else if !message.to_lowercase().contains(&text.to_lowercase()) {
+            message.push_str(": ");
+            message.push_str(&text);
+        }
+    }
+    message
+}
+
 /// Prints `fppm: message` on one line.
 fn report_error(message: &str) {
     let one_line: Vec<&str> = message
@@ -159,7 +175,9 @@ fn clap_error(err: &clap::Error) -> ExitCode {
         .lines()
         .take_while(|l| !l.starts_with("Usage:"))
         .map(str::trim)
-        .filter(|l| !l.is_empty() && !l.starts_with("tip:"))
+        .filter(|l| {
+            !l.is_empty() && !l.starts_with("tip:") && !l.starts_with("For more information")
+        })
         .collect();
     let message = problem.join(" ");
     let message = message.strip_prefix("error: ").unwrap_or(&message);

@@ -61,6 +61,7 @@ impl Run {
         let lines: Vec<&str> = self.stderr.lines().collect();
         assert_eq!(lines.len(), 1, "expected one line, got:\n{}", self.stderr);
         assert!(lines[0].starts_with("fppm: "), "{}", lines[0]);
+        assert!(!lines[0].contains("For more information"), "{}", lines[0]);
         for needle in needles {
             assert!(
                 lines[0].contains(needle),
