@@ -67,15 +67,6 @@ pub(crate) fn resume(args: &ResumeArgs) -> anyhow::Result<Outcome> {
         run,
         earlier_seconds: note.render_seconds,
     };
-    // ppm's scene fingerprint does not cover cylinders yet: check them here.
-    if let Some(stored) = note.cylinders
-        && stored != settings::cylinder_fingerprint(&job.description)
-    {
-        anyhow::bail!(
-            "{}: checkpoint was made for another scene (its cylinders differ)",
-            path.display()
-        );
-    }
     let scene = geometry::Scene::new(job.description.clone())?;
     in_pool(job.run.threads, || {
         let renderer = Renderer::restore(&scene, &bytes)
@@ -284,7 +275,6 @@ fn write_checkpoint(
         passes: job.budget.passes,
         time_seconds: job.budget.time.map(|t| t.as_secs_f64()),
         render_seconds: job.earlier_seconds + elapsed.as_secs_f64(),
-        cylinders: Some(settings::cylinder_fingerprint(&job.description)),
     };
     let note = serde_json::to_string(&note)
         .context("internal error: cannot encode the checkpoint note")?;

@@ -81,29 +81,6 @@ pub(crate) struct Note {
     pub(crate) time_seconds: Option<f64>,
     /// Render time up to this checkpoint.
     pub(crate) render_seconds: f64,
-    /// [`cylinder_fingerprint`] of the scene.
-    #[serde(default)]
-    pub(crate) cylinders: Option<u64>,
-}
-
-/// FNV-1a over the bits of every cylinder (ppm's scene fingerprint leaves them out).
-pub(crate) fn cylinder_fingerprint(description: &SceneDescription) -> u64 {
-    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
-    let mut eat = |word: u32| {
-        for byte in word.to_le_bytes() {
-            hash = (hash ^ u64::from(byte)).wrapping_mul(0x0000_0100_0000_01b3);
-        }
-    };
-    for c in &description.cylinders {
-        for v in [c.center, c.axis, c.facing] {
-            v.to_array().iter().for_each(|x| eat(x.to_bits()));
-        }
-        [c.radius, c.height, c.arc]
-            .iter()
-            .for_each(|x| eat(x.to_bits()));
-        eat(c.material);
-    }
-    hash
 }
 
 /// `fppm render [SCENE]` (the default scene when `scene` is `None`).

@@ -332,7 +332,8 @@ fn read_path_tracer(
 }
 
 /// A 64-bit fingerprint of everything in a scene that affects rendering (camera, film,
-/// materials, geometry, lights), so that a checkpoint is never resumed on another scene.
+/// materials, triangles, spheres, cylinders, lights), so that a checkpoint is never resumed on
+/// another scene.
 #[must_use]
 pub fn scene_fingerprint(d: &SceneDescription) -> u64 {
     let mut w = Writer::hashing();
@@ -380,6 +381,14 @@ pub fn scene_fingerprint(d: &SceneDescription) -> u64 {
         s.center.to_array().iter().for_each(|&c| w.f32(c));
         w.f32(s.radius);
         w.u32(s.material);
+    }
+    w.u64(d.cylinders.len() as u64);
+    for c in &d.cylinders {
+        [c.center, c.axis, c.facing]
+            .iter()
+            .for_each(|v| v.to_array().iter().for_each(|&x| w.f32(x)));
+        [c.radius, c.height, c.arc].iter().for_each(|&x| w.f32(x));
+        w.u32(c.material);
     }
     w.u64(d.lights.len() as u64);
     for light in &d.lights {
