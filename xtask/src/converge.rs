@@ -16,7 +16,7 @@ use crate::suite::{self, SuiteScene};
 pub(crate) const HELP: &str = "\
 cargo xtask converge --scene NAME [--budgets 2,4,8,16,32] [--methods ppm,sppm,freq,freq-sppm,path]
                      [--photons N] [--seed S] [--out DIR] [--quick]
-                     [--alpha A] [--freq-fraction F] [--kernel-k poster|strict|K] [--freq-merge min|poster-max]
+                     [--replot] [--alpha A] [--freq-fraction F] [--kernel-k poster|strict|K] [--freq-merge min|poster-max]
 cargo xtask converge --scene NAME --sweep [--budget SECONDS] [--methods freq]
 
 Runs each method alone (one after another) on the suite scene NAME at its suite film size and
@@ -28,6 +28,7 @@ goes to DIR/NAME.csv; DIR/NAME-time.svg and DIR/NAME-photons.svg plot relMSE on 
 masks and, for each photon mapper, the final radius map (and for the frequency methods the
 map of the share of hitpoints held by the frequency floor) are written as PNGs. DIR defaults
 to docs/convergence. --quick uses budgets 1,2 and writes to target/converge.
+--replot redraws the SVGs from DIR/NAME.csv.
 --sweep renders the methods (default freq and ppm) at one budget (default 8 s) with one
 parameter varied at a time around the defaults (alpha, freq-fraction, kernel-k, freq-merge)
 and writes DIR/NAME-sweep.csv.";
@@ -50,6 +51,7 @@ struct Flags {
     out: Option<PathBuf>,
     quick: bool,
     sweep: bool,
+    replot: bool,
     budget: f64,
     overrides: Overrides,
 }
@@ -131,6 +133,7 @@ impl Flags {
             out: None,
             quick: false,
             sweep: false,
+            replot: false,
             budget: 8.0,
             overrides: Overrides::default(),
         };
@@ -153,6 +156,7 @@ impl Flags {
                 "--out" => flags.out = Some(PathBuf::from(value()?)),
                 "--quick" => flags.quick = true,
                 "--sweep" => flags.sweep = true,
+                "--replot" => flags.replot = true,
                 "--alpha" => flags.overrides.alpha = Some(value()?.parse()?),
                 "--freq-fraction" => flags.overrides.freq_fraction = Some(value()?.parse()?),
                 "--kernel-k" => {
@@ -236,6 +240,22 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         |o| if o.is_absolute() { o } else { root.join(o) },
     );
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    if flags.replot {
+        let rows = read_csv(&out.join(format!("{}.csv", entry.name)))?;
+        plot(
+            &out.join(format!("{}-time.svg", entry.name)),
+            &rows,
+            |r| r.seconds,
+            false,
+        )?;
+        plot(
+            &out.join(format!("{}-photons.svg", entry.name)),
+            &rows,
+            |r| r.photons as f64,
+            true,
+        )?;
+        return Ok(true);
+    }
     let scene = suite::load_scene(root, entry)?;
     if flags.sweep {
         return sweep(&scene, entry, &reference, &flags, &out);
@@ -512,6 +532,39 @@ fn write_csv(path: &Path, entry: &SuiteScene, masks: &Masks, rows: &[Row]) -> Re
     std::fs::write(path, csv).with_context(|| format!("writing {}", path.display()))
 }
 
+/// Reads the rows back from a CSV written by [`write_csv`] (for `--replot`).
+fn read_csv(path: &Path) -> Result<Vec<Row>> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let none = Errors {
+        rmse: f64::NAN,
+        rel_mse: f64::NAN,
+        mean_ratio: f64::NAN,
+    };
+    let mut rows = Vec::new();
+    for line in text.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        if f.len() < 9 {
+            continue;
+        }
+        rows.push(Row {
+            method: ppm::Method::from_name(f[1])
+                .with_context(|| format!("unknown method `{}`", f[1]))?,
+            budget: f[2].parse()?,
+            seconds: f[3].parse()?,
+            passes: f[4].parse()?,
+            photons: f[5].parse()?,
+            all: Errors {
+                rmse: f[6].parse()?,
+                rel_mse: f[7].parse()?,
+                mean_ratio: f[8].parse()?,
+            },
+            masked: [none; 3],
+        });
+    }
+    Ok(rows)
+}
+
 /// relMSE against `x(row)` on log-log axes, one line per method; `photon_mappers_only` drops
 /// the path tracer (which emits no photons).
 fn plot(
@@ -521,6 +574,11 @@ fn plot(
     photon_mappers_only: bool,
 ) -> Result<()> {
     use plotters::prelude::*;
+    let x_label = if photon_mappers_only {
+        "photons emitted"
+    } else {
+        "seconds"
+    };
     let pts = |m: ppm::Method| -> Vec<(f64, f64)> {
         rows.iter()
             .filter(|r| r.method == m && x(r) > 0.0 && r.all.rel_mse > 0.0)
@@ -538,9 +596,12 @@ fn plot(
     }
     let (x0, x1) = bounds(all.iter().map(|p| p.0));
     let (y0, y1) = bounds(all.iter().map(|p| p.1));
+    // Text is added to the SVG by hand afterwards: plotters' text needs a font backend, and
+    // the workspace builds plotters without fonts.
+    let mut texts: Vec<(i32, i32, &'static str, String, String)> = Vec::new();
     let root = SVGBackend::new(path, (640, 480)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e:?}"))?;
-    let area = root.margin(20, 20, 20, 20);
+    let area = root.margin(20, 50, 70, 20);
     let mut chart = ChartBuilder::on(&area)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
@@ -552,6 +613,8 @@ fn plot(
             chart
                 .draw_series(LineSeries::new([(d, y0), (d, y1)], BLACK.mix(0.25)))
                 .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+            let (px, py) = chart.backend_coord(&(d, y0));
+            texts.push((px, py + 16, "middle", "#000".into(), format!("1e{d}")));
         }
     }
     for d in (y0.floor() as i32)..=(y1.ceil() as i32) {
@@ -560,6 +623,8 @@ fn plot(
             chart
                 .draw_series(LineSeries::new([(x0, d), (x1, d)], BLACK.mix(0.25)))
                 .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+            let (px, py) = chart.backend_coord(&(x0, d));
+            texts.push((px - 4, py + 4, "end", "#000".into(), format!("1e{d}")));
         }
     }
     chart
@@ -568,8 +633,32 @@ fn plot(
             BLACK,
         ))
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-    for m in methods {
+    let (bx, by) = chart.backend_coord(&(x1, y0));
+    texts.push((
+        bx,
+        by + 34,
+        "end",
+        "#000".into(),
+        format!("{x_label} (log scale)"),
+    ));
+    let (tx, ty) = chart.backend_coord(&(x0, y1));
+    texts.push((
+        tx + 4,
+        ty - 6,
+        "start",
+        "#000".into(),
+        "relMSE (log scale)".into(),
+    ));
+    for (i, m) in methods.iter().copied().enumerate() {
         let (r, g, b) = COLOURS[ppm::Method::ALL.iter().position(|x| *x == m).unwrap_or(0)];
+        let (lx, ly) = chart.backend_coord(&(x1, y1));
+        texts.push((
+            lx - 8,
+            ly + 18 + 16 * i as i32,
+            "end",
+            format!("#{r:02x}{g:02x}{b:02x}"),
+            m.name().to_string(),
+        ));
         let colour = RGBColor(r, g, b);
         chart
             .draw_series(LineSeries::new(pts(m), colour.stroke_width(2)))
@@ -583,7 +672,19 @@ fn plot(
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
     }
     root.present().map_err(|e| anyhow::anyhow!("{e:?}"))?;
-    Ok(())
+    drop(chart);
+    drop(root);
+    let svg =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let mut text = String::new();
+    for (x, y, anchor, colour, label) in texts {
+        let _ = write!(
+            text,
+            "<text x=\"{x}\" y=\"{y}\" font-family=\"sans-serif\" font-size=\"13\" text-anchor=\"{anchor}\" fill=\"{colour}\">{label}</text>\n"
+        );
+    }
+    let svg = svg.replace("</svg>", &format!("{text}</svg>"));
+    std::fs::write(path, svg).with_context(|| format!("writing {}", path.display()))
 }
 
 /// Padded bounds of log values.
