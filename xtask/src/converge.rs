@@ -678,9 +678,9 @@ fn plot(
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let mut text = String::new();
     for (x, y, anchor, colour, label) in texts {
-        let _ = write!(
+        let _ = writeln!(
             text,
-            "<text x=\"{x}\" y=\"{y}\" font-family=\"sans-serif\" font-size=\"13\" text-anchor=\"{anchor}\" fill=\"{colour}\">{label}</text>\n"
+            "<text x=\"{x}\" y=\"{y}\" font-family=\"sans-serif\" font-size=\"13\" text-anchor=\"{anchor}\" fill=\"{colour}\">{label}</text>"
         );
     }
     let svg = svg.replace("</svg>", &format!("{text}</svg>"));
