@@ -292,7 +292,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
                 image_io::errors(&image, &reference, Some(&masks.masks[i])).expect("sizes match")
             });
             println!(
-                "  {:>6.1} s ({:>5} passes): relMSE {:.5}  RMSE {:.5}  mean ratio {:.4}  [low {:.5} caustic {:.5} glossy {:.5}]",
+                "  {:>6.1} s ({:>5} passes): relMSE {:.5}  RMSE {:.5}  mean ratio {:.4}  [low {:.5} caustic {:.5} glossy {:.5}] [mean ratio low {:.4} caustic {:.4} glossy {:.4}]",
                 elapsed.as_secs_f64(),
                 renderer.passes(),
                 all.rel_mse,
@@ -300,7 +300,10 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
                 all.mean_ratio,
                 masked[0].rel_mse,
                 masked[1].rel_mse,
-                masked[2].rel_mse
+                masked[2].rel_mse,
+                masked[0].mean_ratio,
+                masked[1].mean_ratio,
+                masked[2].mean_ratio
             );
             rows.push(Row {
                 method,

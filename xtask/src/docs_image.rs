@@ -9,11 +9,13 @@ use anyhow::{Context, Result, bail};
 pub(crate) const HELP: &str = "\
 cargo xtask docs-image [-- EXTRA FPPM FLAGS]
 
-Runs `cargo run --release -p cli -- --png docs/default-scene.png [EXTRA]` from the workspace
-root: the default scene of the CLI rendered with its default settings.";
+Runs `cargo run --release -p cli -- -o target/docs-image/default-scene.exr --png
+docs/default-scene.png [EXTRA]` from the workspace root: the built-in default scene of the CLI
+rendered with its default settings (the EXR stays under target/).";
 
 pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
     let extra: Vec<&String> = args.iter().skip_while(|a| *a == "--").collect();
+    std::fs::create_dir_all(root.join("target/docs-image"))?;
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string());
     let mut command = Command::new(cargo);
     command
