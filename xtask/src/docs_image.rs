@@ -26,6 +26,8 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
             "-p",
             "cli",
             "--",
+            "-o",
+            "target/docs-image/default-scene.exr",
             "--png",
             "docs/default-scene.png",
         ])
