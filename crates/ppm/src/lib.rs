@@ -51,4 +51,4 @@ pub use crate::renderer::{Aov, Renderer};
 pub use crate::rng::Sampler;
 pub use crate::state::{STATE_VERSION, StateError, StateHeader, scene_fingerprint};
 pub use crate::update::{FrequencyFloor, FrequencyRadius, GatherStats};
-pub use spectrum::MergePolicy;
+pub use spectrum::{K_POSTER, K_STRICT, MergePolicy};

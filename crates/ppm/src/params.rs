@@ -2,7 +2,7 @@
 
 use std::fmt;
 
-use spectrum::{K_POSTER, MergePolicy};
+use spectrum::{K_STRICT, MergePolicy};
 
 use crate::update::FrequencyFloor;
 
@@ -99,7 +99,8 @@ pub struct RenderParams {
     pub freq_fraction: f64,
     /// How a hitpoint merges frequency deposits.
     pub freq_merge: MergePolicy,
-    /// The kernel radius constant K (poster: [`spectrum::K_POSTER`]).
+    /// The kernel radius constant K: [`spectrum::K_STRICT`] (the 95 %-of-peak radius, the
+    /// default chosen by the convergence study) or the poster's [`spectrum::K_POSTER`].
     pub kernel_k: f64,
     /// What happens once the PPM radius reaches the frequency radius.
     pub freq_floor: FrequencyFloor,
@@ -141,7 +142,9 @@ pub enum ParamError {
 }
 
 impl RenderParams {
-    /// A quick preview: classical PPM, 100 000 photons per pass, α = 0.7, one hitpoint per pixel.
+    /// A quick preview: classical PPM, 100 000 photons per pass, α = 0.7, one hitpoint per
+    /// pixel; for the frequency methods 10 % frequency photons, K = K_STRICT, min-radius merge
+    /// and occlusion probes (the defaults of `docs/convergence.md` and `docs/integrators.md`).
     #[must_use]
     pub fn preview() -> Self {
         Self {
@@ -154,7 +157,7 @@ impl RenderParams {
             seed: 0,
             freq_fraction: 0.1,
             freq_merge: MergePolicy::MinRadius,
-            kernel_k: K_POSTER,
+            kernel_k: K_STRICT,
             freq_floor: FrequencyFloor::Keep,
             freq_occlusion: true,
             direct_lighting: false,

@@ -610,7 +610,8 @@ impl<'s> PhotonMapper<'s> {
             let Some(sample) = bsdf.sample(incoming, u_lobe, u, TransportMode::Importance) else {
                 break;
             };
-            let new_power = power * sample.weight;
+            let new_power =
+                power * sample.weight * shading_normal_correction(&hit, incoming, sample.incoming);
             // Russian roulette (pbrt-v4 SPPM): keep the photon's power roughly constant.
             let mut survive = 1.0f32;
             if depth + 1 >= ROULETTE_DEPTH {
@@ -817,6 +818,23 @@ impl PassDeposits {
             photons_stored: 0,
             trace_seconds: 0.0,
         }
+    }
+}
+
+/// Veach's correction for shading normals on light paths (thesis §5.3; pbrt's
+/// `CorrectShadingNormal`): the BSDF is not symmetric once the shading normal differs from the
+/// geometric one, and flux carried by photons must be multiplied by
+/// |ωo·n_s|·|ωi·n_g| / (|ωo·n_g|·|ωi·n_s|) at every bounce (ωo toward where the photon came
+/// from, ωi the new direction). Without it photons through smooth-shaded meshes (the water
+/// surface of the Cornell box) carry a few per cent too much or too little light.
+fn shading_normal_correction(hit: &Hit, from: Vec3, to: Vec3) -> f32 {
+    let (ns, ng) = (hit.shading_normal, hit.geometric_normal);
+    let numerator = from.dot(ns).abs() * to.dot(ng).abs();
+    let denominator = from.dot(ng).abs() * to.dot(ns).abs();
+    if denominator > 0.0 {
+        numerator / denominator
+    } else {
+        0.0
     }
 }
 

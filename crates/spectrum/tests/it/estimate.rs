@@ -114,7 +114,9 @@ proptest! {
 #[test]
 fn bits_round_trip_exactly_and_reject_invalid_values() {
     let caps = Caps::for_scene_size(2.0);
-    let diffuse = Spectrum::point_light(&caps).travel(1.3, &caps).bandlimit(Lobe::Lambert, &caps);
+    let diffuse = Spectrum::point_light(&caps)
+        .travel(1.3, &caps)
+        .bandlimit(Lobe::Lambert, &caps);
     let glossy = Spectrum::area_light(0.2, 0.7, &caps)
         .travel(0.9, &caps)
         .reflect(0.8, 0.6, 0.5, Lobe::Ggx { roughness: 0.1 }, &caps);
@@ -131,5 +133,8 @@ fn bits_round_trip_exactly_and_reject_invalid_values() {
     for bits in [nan, not_psd, bad_flag] {
         assert_eq!(Spectrum::from_bits(bits), None);
     }
-    assert_eq!(FrequencyEstimate::from_spectrum(None), FrequencyEstimate::EMPTY);
+    assert_eq!(
+        FrequencyEstimate::from_spectrum(None),
+        FrequencyEstimate::EMPTY
+    );
 }
