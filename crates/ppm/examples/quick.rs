@@ -1,5 +1,6 @@
 //! Renders a scene with the library alone and writes a tone-mapped PNG:
-//! `cargo run --release -p ppm --example quick -- SCENE [METHOD] [PASSES] [OUT.png]`.
+//! `cargo run --release -p ppm --example quick -- SCENE [METHOD] [PASSES] [OUT.png]`
+//! (environment: `QUICK_FILM=64` square film, `QUICK_MAX_DEPTH`, `QUICK_SPP`).
 
 #![allow(clippy::print_stdout, clippy::print_stderr, clippy::unwrap_used)]
 
@@ -14,14 +15,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let passes: u32 = args.get(3).map_or(Ok(10), |s| s.parse())?;
     let out = args.get(4).map_or("quick.png", String::as_str);
 
-    let scene = geometry::Scene::new(geometry::load(Path::new(scene_path))?)?;
+    let mut description = geometry::load(Path::new(scene_path))?;
+    if let Ok(size) = std::env::var("QUICK_FILM") {
+        let size: u32 = size.parse()?;
+        description.film = geometry::Film {
+            width: size,
+            height: size,
+        };
+    }
+    let scene = geometry::Scene::new(description)?;
     let mut params = ppm::RenderParams::preview();
     params.method = ppm::Method::from_name(method).ok_or("unknown method")?;
+    if let Ok(depth) = std::env::var("QUICK_MAX_DEPTH") {
+        params.max_depth = depth.parse()?;
+    }
+    if let Ok(spp) = std::env::var("QUICK_SPP") {
+        params.samples_per_pixel = spp.parse()?;
+    }
     let mut renderer = ppm::Renderer::new(&scene, params)?;
     let start = std::time::Instant::now();
     for _ in 0..passes {
-        let stats = renderer.iterate();
-        eprintln!("{stats:?}");
+        renderer.iterate();
     }
     eprintln!("{passes} passes in {:.2?}", start.elapsed());
 
