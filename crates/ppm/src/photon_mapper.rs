@@ -24,6 +24,8 @@ const PHOTON_CHUNK: u64 = 2048;
 const SLOT_CHUNK: usize = 1024;
 /// Camera streams live in their own half of the sampler's index space.
 const CAMERA_STREAM: u64 = 1 << 63;
+/// Frequency photons per parallel work item of the frequency deposits.
+const FREQUENCY_CHUNK: usize = 1024;
 /// Share of an occlusion probe, at its far end, where blockers are ignored.
 const CONTACT_FRACTION: f32 = 0.05;
 /// Extra probes that locate a shadow edge found by the occlusion probe.
@@ -507,31 +509,43 @@ impl<'s> PhotonMapper<'s> {
             deposits.photons_deposited += u64::from(m);
         }
 
-        // Frequency deposits: few photons, and min/max merges do not depend on the order.
+        // Frequency deposits: the queries run in parallel over fixed chunks; the merges (min or
+        // max per coefficient) do not depend on the order, and run serially.
         let policy = self.params.freq_merge;
-        let mut estimates: Vec<(usize, Spectrum)> = Vec::new();
-        for (photon, curvature, spectrum) in &frequency {
-            grid.for_each_containing(photon.position, |entry| {
-                let slot = grid_slots[entry as usize] as usize;
-                if !self.accepts(photon, slot) {
-                    return;
+        let estimates: Vec<Vec<(usize, Spectrum)>> = frequency
+            .par_chunks(FREQUENCY_CHUNK)
+            .map(|chunk| {
+                let mut out = Vec::new();
+                for (photon, curvature, spectrum) in chunk {
+                    grid.for_each_containing(photon.position, |entry| {
+                        let slot = grid_slots[entry as usize] as usize;
+                        if !self.accepts(photon, slot) {
+                            return;
+                        }
+                        let Some(material) = self.scene.material(slots.material_idx()[slot]) else {
+                            return;
+                        };
+                        // The field the hitpoint's radius reads (design §8.1): the photon's
+                        // spectrum reflected by the hitpoint's lobe, with μo = 1 so that a stays
+                        // in surface units (b does not depend on μo) and μi = 1 for the
+                        // conservative 3D collapse (§8.5: the out-of-plane axis keeps its width).
+                        let lobe = spectrum_lobe(material.kind.lobe());
+                        out.push((
+                            slot,
+                            spectrum.reflect_isotropic(
+                                1.0,
+                                f64::from(*curvature),
+                                lobe,
+                                &self.caps,
+                            ),
+                        ));
+                    });
                 }
-                let Some(material) = self.scene.material(slots.material_idx()[slot]) else {
-                    return;
-                };
-                // The field the hitpoint's radius reads (design §8.1): the photon's spectrum
-                // reflected by the hitpoint's lobe, with μo = 1 so that a stays in surface
-                // units (b does not depend on μo) and μi = 1 for the conservative 3D
-                // collapse (§8.5: the out-of-plane axis is not stretched).
-                let lobe = spectrum_lobe(material.kind.lobe());
-                estimates.push((
-                    slot,
-                    spectrum.reflect_isotropic(1.0, f64::from(*curvature), lobe, &self.caps),
-                ));
-            });
-        }
+                out
+            })
+            .collect();
         let columns = self.slots.columns_mut();
-        for (slot, spectrum) in estimates {
+        for (slot, spectrum) in estimates.into_iter().flatten() {
             columns.freq[slot].estimate.deposit(spectrum, policy);
             columns.has_freq[slot] = true;
         }
