@@ -242,18 +242,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     if flags.replot {
         let rows = read_csv(&out.join(format!("{}.csv", entry.name)))?;
-        plot(
-            &out.join(format!("{}-time.svg", entry.name)),
-            &rows,
-            |r| r.seconds,
-            false,
-        )?;
-        plot(
-            &out.join(format!("{}-photons.svg", entry.name)),
-            &rows,
-            |r| r.photons as f64,
-            true,
-        )?;
+        plot_error_curves(&out, &entry.name, &rows)?;
         return Ok(true);
     }
     let scene = suite::load_scene(root, entry)?;
@@ -337,18 +326,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         &masks,
         &rows,
     )?;
-    plot(
-        &out.join(format!("{}-time.svg", entry.name)),
-        &rows,
-        |r| r.seconds,
-        false,
-    )?;
-    plot(
-        &out.join(format!("{}-photons.svg", entry.name)),
-        &rows,
-        |r| r.photons as f64,
-        true,
-    )?;
+    plot_error_curves(&out, &entry.name, &rows)?;
     println!("converge: slopes of log relMSE versus log seconds (least squares over the budgets):");
     for &method in &flags.methods {
         let points: Vec<(f64, f64)> = rows
@@ -566,6 +544,23 @@ fn read_csv(path: &Path) -> Result<Vec<Row>> {
         });
     }
     Ok(rows)
+}
+
+/// The two error plots of a scene: relMSE against seconds (`NAME-time.svg`) and against photons
+/// emitted (`NAME-photons.svg`, the equal-photon-count comparison).
+fn plot_error_curves(out: &Path, name: &str, rows: &[Row]) -> Result<()> {
+    plot(
+        &out.join(format!("{name}-time.svg")),
+        rows,
+        |r| r.seconds,
+        false,
+    )?;
+    plot(
+        &out.join(format!("{name}-photons.svg")),
+        rows,
+        |r| r.photons as f64,
+        true,
+    )
 }
 
 /// relMSE against `x(row)` on log-log axes, one line per method; `photon_mappers_only` drops

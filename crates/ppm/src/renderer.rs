@@ -7,7 +7,6 @@ use rayon::prelude::*;
 use crate::params::{Method, ParamError, RenderParams};
 use crate::path::PathTracer;
 use crate::photon_mapper::{PassStats, PassTimings, PhotonMapper};
-use crate::update::FrequencyRadius;
 
 /// A progressive render in progress: create it, call [`Renderer::iterate`] as often as the
 /// budget allows, read [`Renderer::image`] (and [`Renderer::aov`]) at any time, and save or
@@ -254,10 +253,9 @@ fn slot_aov(mapper: &PhotonMapper<'_>, aov: Aov) -> Vec<f32> {
                     Aov::Radius => Some(slots.radius()[slot]),
                     Aov::PhotonCount => Some(slots.photon_count()[slot]),
                     Aov::FreqRadius => r_freq,
-                    _ => Some(f64::from(u8::from(matches!(
-                        r_freq.map_or(FrequencyRadius::None, FrequencyRadius::Predicted),
-                        FrequencyRadius::Predicted(r) if slots.radius()[slot] <= r
-                    )))),
+                    _ => {
+                        Some(r_freq.map_or(0.0, |r| f64::from(u8::from(slots.radius()[slot] <= r))))
+                    }
                 };
                 if let Some(v) = value {
                     sum += v.min(f64::from(f32::MAX));
