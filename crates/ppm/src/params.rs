@@ -89,7 +89,11 @@ pub struct RenderParams {
     /// Initial gather radius in scene units; `None` picks it from the scene (see
     /// [`crate::auto_initial_radius`]).
     pub initial_radius: Option<f64>,
-    /// Maximum number of path segments for camera and photon paths (≥ 1).
+    /// Maximum number of scattering events on a light path from the emitter to the camera
+    /// (≥ 1), as pbrt's `maxdepth`: paths have at most `max_depth + 1` segments. Every method
+    /// bounds the same paths: a photon mapper counts the photon's bounces, the hitpoint's
+    /// scattering and the camera path's specular bounces; the path tracer the bounces before
+    /// an emitter is hit or sampled.
     pub max_depth: u32,
     /// Hitpoint slots per pixel (jittered; ≥ 1); for the path tracer, paths per pixel per pass.
     pub samples_per_pixel: u32,

@@ -84,7 +84,9 @@ impl<'s> PathTracer<'s> {
         // The previous vertex and the solid-angle density of the direction sampled there
         // (`None` after a specular bounce or at the camera: emission then counts in full).
         let mut previous: Option<(Hit, f32)> = None;
-        for depth in 0..self.params.max_depth {
+        // `depth`: scattering events before this hit. Emission found here ends a path with
+        // `depth` bounces, light sampled here one with depth + 1: both at most max_depth.
+        for depth in 0..=self.params.max_depth {
             let Some(hit) = self.scene.intersect(&ray) else {
                 break;
             };
@@ -97,6 +99,9 @@ impl<'s> PathTracer<'s> {
                     }
                 };
                 radiance += beta * emitted * weight;
+            }
+            if depth == self.params.max_depth {
+                break;
             }
             let Some(bsdf) = self.scene.bsdf(&hit) else {
                 break;

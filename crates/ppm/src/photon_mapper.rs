@@ -112,6 +112,10 @@ pub(crate) struct PhotonMapper<'s> {
     pub(crate) slots: HitPoints<SlotFrequency>,
     /// Whether a slot holds a visible point in the current pass.
     pub(crate) valid: Vec<bool>,
+    /// Per slot: the most bounces a photon may have made and still count there,
+    /// `max_depth − 1 − (specular bounces of the camera path)`, so that no light path has more
+    /// than `max_depth` scattering events (the hitpoint's own scattering is the 1).
+    pub(crate) photon_bounces: Vec<u16>,
     /// Per slot: sum of directly seen emission (and direct lighting) over camera passes.
     pub(crate) direct: Vec<[f64; 3]>,
     pub(crate) camera_passes: u32,
@@ -121,12 +125,13 @@ pub(crate) struct PhotonMapper<'s> {
 }
 
 /// Memory per hitpoint slot of the photon mappers: the hitpoint record (`photon::HitPoints`
-/// with the frequency state) plus the renderer's per-slot validity flag and direct-emission
-/// sum. The hash grid comes on top (about 80 bytes per hitpoint at the default cell size).
+/// with the frequency state) plus the renderer's per-slot validity flag, photon-bounce budget
+/// and direct-emission sum. The hash grid comes on top (about 80 bytes per hitpoint at the default cell size).
 #[must_use]
 pub fn bytes_per_hitpoint() -> usize {
     HitPoints::<SlotFrequency>::bytes_per_hitpoint()
         + std::mem::size_of::<bool>()
+        + std::mem::size_of::<u16>()
         + std::mem::size_of::<[f64; 3]>()
 }
 
@@ -177,6 +182,7 @@ impl<'s> PhotonMapper<'s> {
             n_emitted: 0,
             slots: HitPoints::with_capacity(0),
             valid: Vec::new(),
+            photon_bounces: Vec::new(),
             direct: Vec::new(),
             camera_passes: 0,
             grid: None,
@@ -283,6 +289,7 @@ impl<'s> PhotonMapper<'s> {
             self.slots = HitPoints::with_capacity(n_slots);
             self.direct = vec![[0.0; 3]; n_slots];
             self.valid = vec![false; n_slots];
+            self.photon_bounces = vec![0; n_slots];
         }
         for (slot, sample) in traced.into_iter().enumerate() {
             for c in 0..3 {
@@ -299,8 +306,12 @@ impl<'s> PhotonMapper<'s> {
                 material: 0,
                 weight: Vec3::ZERO,
                 normal_distance: 0.0,
+                bounces: 0,
             });
             self.valid[slot] = sample.visible.is_some();
+            // Visible points have bounces < max_depth ≤ 1024 (`trace_camera_path`).
+            let budget = (self.params.max_depth - 1).saturating_sub(point.bounces);
+            self.photon_bounces[slot] = u16::try_from(budget).unwrap_or(u16::MAX);
             let freq = SlotFrequency {
                 estimate: FrequencyEstimate::EMPTY,
                 normal_distance: point.normal_distance,
@@ -336,11 +347,17 @@ impl<'s> PhotonMapper<'s> {
         let weight_scale = 1.0 / spp as f32;
         let mut throughput = Rgb::ONE;
         let mut direct = Rgb::ZERO;
-        for _depth in 0..self.params.max_depth {
+        // `bounces`: scattering events of the camera path before this hit. Emission seen here
+        // ends a light path with that many; a hitpoint adds one (its own scattering) to the
+        // photon's, so it needs bounces < max_depth.
+        for bounces in 0..=self.params.max_depth {
             let Some(hit) = self.scene.intersect(&ray) else {
                 break;
             };
             direct += throughput * self.scene.emitted(&hit);
+            if bounces == self.params.max_depth {
+                break;
+            }
             let Some(material) = self.scene.material(hit.material) else {
                 break;
             };
@@ -373,6 +390,7 @@ impl<'s> PhotonMapper<'s> {
                     material: hit.material,
                     weight: throughput * weight_scale,
                     normal_distance: hit.t * mu,
+                    bounces,
                 }),
             };
         }
@@ -552,16 +570,18 @@ impl<'s> PhotonMapper<'s> {
         deposits
     }
 
-    /// Whether `photon` counts for `slot`: inside the radius, on the hitpoint's side, with
-    /// agreeing normals (see `photon::accepts`).
+    /// Whether `photon` counts for `slot`: the light path they make has at most `max_depth`
+    /// bounces, and the photon is inside the radius, on the hitpoint's side, with agreeing
+    /// normals (see `photon::accepts`).
     fn accepts(&self, photon: &Photon, slot: usize) -> bool {
-        photon::accepts(
-            photon,
-            self.slots.position()[slot],
-            self.slots.geometric_normal()[slot],
-            self.slots.radius()[slot],
-            AcceptParams::COS_60,
-        )
+        photon.bounces <= u32::from(self.photon_bounces[slot])
+            && photon::accepts(
+                photon,
+                self.slots.position()[slot],
+                self.slots.geometric_normal()[slot],
+                self.slots.radius()[slot],
+                AcceptParams::COS_60,
+            )
     }
 
     fn is_frequency_photon(&self, index: u64) -> bool {
@@ -590,6 +610,8 @@ impl<'s> PhotonMapper<'s> {
         if spectrum.is_some() {
             out.frequency_photons += 1;
         }
+        // `depth`: the photon's bounces before this hit. A hitpoint adds one more, so hits at
+        // depth max_depth − 1 are the last that can count.
         for depth in 0..self.params.max_depth {
             let Some(hit) = self.scene.intersect(&ray) else {
                 break;
@@ -611,6 +633,7 @@ impl<'s> PhotonMapper<'s> {
                     incoming,
                     power,
                     normal: hit.geometric_normal,
+                    bounces: depth,
                 };
                 out.photons.push(photon);
                 if let Some(s) = spectrum {
@@ -801,6 +824,8 @@ struct VisiblePoint {
     material: u32,
     weight: Rgb,
     normal_distance: f32,
+    /// Specular bounces of the camera path before this point.
+    bounces: u32,
 }
 
 /// Photons of one chunk, in trace order.

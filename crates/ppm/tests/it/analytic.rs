@@ -56,6 +56,75 @@ fn furnace_sphere_gives_the_analytic_radiance_for_every_method() {
     );
 }
 
+/// A closed cube whose inward-facing walls all emit Le = 0.5 and reflect ρ = 0.5, with a small
+/// mirror ball at its centre; `camera` is the TOML camera table.
+///
+/// In a closed enclosure of uniform emission and albedo the radiance is uniform, and paths with
+/// j bounces bring Le·ρ^j, so a bound of k bounces gives L_k = Le·Σ_{j=0..k} ρ^j = 1 − 0.5^(k+1).
+/// Seen in the mirror, the walls lose one bounce to it: L_(k−1). (The ball, 0.1 across a cube
+/// of side 2, changes the walls' radiance by well under 1 %.)
+fn emissive_box(camera: &str) -> String {
+    let mut toml = format!(
+        "format = 1\n{camera}\n[film]\nwidth = 16\nheight = 16\n\
+         [materials.wall]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\nemission = [0.5, 0.5, 0.5]\n\
+         [materials.silver]\ntype = \"mirror\"\n\
+         [[shapes]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 0.1\nmaterial = \"silver\"\n"
+    );
+    // Corner and edges of each face, edge1 × edge2 pointing into the cube.
+    let faces: [[[f64; 3]; 3]; 6] = [
+        [[-1.0, -1.0, -1.0], [0.0, 0.0, 2.0], [2.0, 0.0, 0.0]],
+        [[-1.0, 1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]],
+        [[-1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]],
+        [[1.0, -1.0, -1.0], [0.0, 0.0, 2.0], [0.0, 2.0, 0.0]],
+        [[-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
+        [[-1.0, -1.0, 1.0], [0.0, 2.0, 0.0], [2.0, 0.0, 0.0]],
+    ];
+    for [corner, edge1, edge2] in faces {
+        toml += &format!(
+            "[[shapes]]\ntype = \"quad\"\ncorner = {corner:?}\nedge1 = {edge1:?}\nedge2 = {edge2:?}\nmaterial = \"wall\"\n"
+        );
+    }
+    toml
+}
+
+/// `max_depth` bounds the scattering events of the whole light path, the same way for every
+/// method: emission seen directly or found by a path (the path tracer), photons and the
+/// camera path's specular bounces (the photon mappers) all count.
+#[test]
+fn max_depth_bounds_the_bounces_of_the_whole_light_path() {
+    let wall = scene(&emissive_box(
+        "[camera]\nposition = [0.0, 0.0, 0.5]\nlook_at = [1.0, 0.0, 0.5]\nfov_y = 40.0",
+    ));
+    let mirror = scene(&emissive_box(
+        "[camera]\nposition = [0.0, 0.0, 0.5]\nlook_at = [0.0, 0.0, 0.0]\nfov_y = 5.0",
+    ));
+    let bounded = |k: u32| 1.0 - 0.5f64.powi(k as i32 + 1);
+    for k in 1..=3u32 {
+        for (view, scene, expected) in [
+            ("wall", &wall, bounded(k)),
+            ("mirror", &mirror, bounded(k - 1)),
+        ] {
+            for method in PHOTON_METHODS {
+                let mut p = params(method, 20_000);
+                p.max_depth = k;
+                let m = mean(&render(scene, p, 8));
+                assert!(
+                    (m / expected - 1.0).abs() < 0.02,
+                    "{method}, {view}, max_depth {k}: mean radiance {m}, expected {expected}"
+                );
+            }
+            let mut p = params(Method::Path, 1);
+            p.samples_per_pixel = 16;
+            p.max_depth = k;
+            let m = mean(&render(scene, p, 4));
+            assert!(
+                (m / expected - 1.0).abs() < 0.02,
+                "path, {view}, max_depth {k}: mean radiance {m}, expected {expected}"
+            );
+        }
+    }
+}
+
 /// A point light of intensity I at height h over a large diffuse floor of albedo ρ: the floor
 /// radiance at distance d and incidence cosine cos θ is L = ρ/π · I·cos θ/d² (no other surface).
 const PLANE: &str = r#"
