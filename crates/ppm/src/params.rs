@@ -143,6 +143,13 @@ pub enum ParamError {
         /// Samples per pixel.
         samples_per_pixel: u32,
     },
+    /// A pointwise reference was asked for a method without fixed hitpoints, or with direct
+    /// lighting at the hitpoints (whose estimate re-jitters every pass).
+    #[error("a pointwise reference needs ppm or freq without direct lighting, not {method}")]
+    NoFixedHitpoints {
+        /// The method's name.
+        method: &'static str,
+    },
 }
 
 impl RenderParams {

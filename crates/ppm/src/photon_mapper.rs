@@ -338,13 +338,44 @@ impl<'s> PhotonMapper<'s> {
     }
 
     fn trace_camera_path(&self, slot: u32, pass: u32) -> CameraSample {
+        let weight_scale = 1.0 / self.params.samples_per_pixel as f32;
+        let chain = self.camera_chain(slot, pass);
+        let mut direct = chain.direct;
+        let visible = chain.end.map(|mut end| {
+            let hit = &end.hit;
+            if self.params.direct_lighting
+                && let Some(bsdf) = self.scene.bsdf(hit)
+            {
+                direct += end.throughput
+                    * self.direct_lighting(hit, &bsdf, end.outgoing, &mut end.sampler);
+            }
+            let mu = end.outgoing.dot(hit.shading_normal).abs();
+            VisiblePoint {
+                position: hit.position,
+                shading_normal: hit.shading_normal,
+                geometric_normal: hit.geometric_normal,
+                outgoing: end.outgoing,
+                material: hit.material,
+                weight: end.throughput * weight_scale,
+                normal_distance: hit.t * mu,
+                bounces: end.bounces,
+            }
+        });
+        CameraSample {
+            direct: direct * weight_scale,
+            visible,
+        }
+    }
+
+    /// The camera path of `slot` in `pass` through specular bounces to its first non-specular
+    /// hit, with the emission it sees on the way (unweighted by 1/spp).
+    pub(crate) fn camera_chain(&self, slot: u32, pass: u32) -> CameraChain {
         let spp = self.params.samples_per_pixel;
         let pixel = slot / spp;
         let (x, y) = (pixel % self.width, pixel / self.width);
         let mut sampler = Sampler::new(self.params.seed, pass, CAMERA_STREAM | u64::from(slot));
         let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
         let mut ray = self.scene.camera().generate_ray(film, sampler.next_2d());
-        let weight_scale = 1.0 / spp as f32;
         let mut throughput = Rgb::ONE;
         let mut direct = Rgb::ZERO;
         // `bounces`: scattering events of the camera path before this hit. Emission seen here
@@ -376,28 +407,18 @@ impl<'s> PhotonMapper<'s> {
                 ray = hit.spawn_ray(sample.incoming);
                 continue;
             }
-            if self.params.direct_lighting {
-                direct += throughput * self.direct_lighting(&hit, &bsdf, outgoing, &mut sampler);
-            }
-            let mu = outgoing.dot(hit.shading_normal).abs();
-            return CameraSample {
-                direct: direct * weight_scale,
-                visible: Some(VisiblePoint {
-                    position: hit.position,
-                    shading_normal: hit.shading_normal,
-                    geometric_normal: hit.geometric_normal,
+            return CameraChain {
+                direct,
+                end: Some(ChainEnd {
+                    hit,
                     outgoing,
-                    material: hit.material,
-                    weight: throughput * weight_scale,
-                    normal_distance: hit.t * mu,
+                    throughput,
                     bounces,
+                    sampler,
                 }),
             };
         }
-        CameraSample {
-            direct: direct * weight_scale,
-            visible: None,
-        }
+        CameraChain { direct, end: None }
     }
 
     /// One light sample of next-event estimation at a non-specular camera hit.
@@ -805,6 +826,27 @@ impl<'s> PhotonMapper<'s> {
         }
         stats
     }
+}
+
+/// A camera path up to its first non-specular hit ([`PhotonMapper::camera_chain`]).
+pub(crate) struct CameraChain {
+    /// Emission seen along the path (not divided by the slots per pixel).
+    pub(crate) direct: Rgb,
+    /// The first non-specular hit, if the path reached one within `max_depth`.
+    pub(crate) end: Option<ChainEnd>,
+}
+
+/// Where a camera path meets its first non-specular surface.
+pub(crate) struct ChainEnd {
+    pub(crate) hit: Hit,
+    /// Unit direction back toward the camera (or the last specular vertex).
+    pub(crate) outgoing: Vec3,
+    /// Product of the specular weights along the way.
+    pub(crate) throughput: Rgb,
+    /// Specular bounces before `hit`.
+    pub(crate) bounces: u32,
+    /// The path's sampler, positioned after the chain's draws.
+    pub(crate) sampler: Sampler,
 }
 
 /// What one camera path produced.
