@@ -1,6 +1,7 @@
 //! Renders a scene with the library alone and writes a tone-mapped PNG:
 //! `cargo run --release -p ppm --example quick -- SCENE [METHOD] [PASSES] [OUT.png]`
-//! (environment: `QUICK_FILM=64` square film, `QUICK_MAX_DEPTH`, `QUICK_SPP`).
+//! (environment: `QUICK_FILM=64` square film, `QUICK_MAX_DEPTH`, `QUICK_SPP`, `QUICK_RADIUS`,
+//! `QUICK_PHOTONS`, `QUICK_SEED`).
 
 #![allow(clippy::print_stdout, clippy::print_stderr, clippy::unwrap_used)]
 
@@ -31,6 +32,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     if let Ok(spp) = std::env::var("QUICK_SPP") {
         params.samples_per_pixel = spp.parse()?;
+    }
+    if let Ok(radius) = std::env::var("QUICK_RADIUS") {
+        params.initial_radius = Some(radius.parse()?);
+    }
+    if let Ok(photons) = std::env::var("QUICK_PHOTONS") {
+        params.photons_per_pass = photons.parse()?;
+    }
+    if let Ok(seed) = std::env::var("QUICK_SEED") {
+        params.seed = seed.parse()?;
     }
     let mut renderer = ppm::Renderer::new(&scene, params)?;
     let start = std::time::Instant::now();

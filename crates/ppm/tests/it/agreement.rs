@@ -6,8 +6,17 @@ use ppm::Method;
 use crate::support::{PHOTON_METHODS, cornell, mean, params, render, rmse};
 
 #[test]
-fn photon_mappers_converge_to_the_path_traced_reference() {
-    let scene = cornell("CornellBox-Original.obj", 24, 24);
+fn photon_mappers_converge_to_the_path_traced_reference_on_cornell_original() {
+    converge_to_the_path_tracer("CornellBox-Original.obj");
+}
+
+// Cornell Sphere and Water are not in this test: at test budgets their image means carry
+// caustic noise of a few per cent (measured: ppm 20k photons x 64 passes at 24x24, seeds 7, 8, 9:
+// 0.1045, 0.1009, 0.0992 on Sphere). Their agreement is checked against the 16 384-path goldens
+// by `cargo xtask render-all`, and measured at long budgets in docs/convergence.md.
+
+fn converge_to_the_path_tracer(name: &str) {
+    let scene = cornell(name, 24, 24);
     let mut reference_params = params(Method::Path, 1);
     reference_params.samples_per_pixel = 128;
     reference_params.max_depth = 16;
@@ -29,11 +38,13 @@ fn photon_mappers_converge_to_the_path_traced_reference() {
                 (passes, rmse(&image, &reference), mean(&image))
             })
             .collect();
-        eprintln!("{method}: reference mean {reference_mean:.5}, (passes, rmse, mean) {errors:?}");
+        eprintln!(
+            "{name} {method}: reference mean {reference_mean:.5}, (passes, rmse, mean) {errors:?}"
+        );
         for pair in errors.windows(2) {
             assert!(
                 pair[1].1 < pair[0].1,
-                "{method}: error does not shrink from {} to {} passes: {errors:?}",
+                "{name} {method}: error does not shrink from {} to {} passes: {errors:?}",
                 pair[0].0,
                 pair[1].0
             );
@@ -42,7 +53,7 @@ fn photon_mappers_converge_to_the_path_traced_reference() {
         let ratio = final_mean / reference_mean;
         assert!(
             (ratio - 1.0).abs() < 0.01,
-            "{method}: mean ratio to the path tracer {ratio}"
+            "{name} {method}: mean ratio to the path tracer {ratio}"
         );
     }
 }
