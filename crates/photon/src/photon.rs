@@ -61,9 +61,16 @@ pub fn accepts(
     radius: f64,
     params: AcceptParams,
 ) -> bool {
-    within_radius(photon.position, position, radius * radius)
-        && photon.incoming.dot(normal) > 0.0
-        && photon.normal.dot(normal) > params.min_normal_cos
+    within_radius(photon.position, position, radius * radius) && faces(photon, normal, params)
+}
+
+/// Conditions 2 and 3 of [`accepts`] (side and normal agreement) without the distance test:
+/// for photons that [`crate::HitPointGrid::for_each_containing`] reported, whose distance test
+/// is already exactly condition 1 (same predicate, same radius).
+#[must_use]
+#[inline]
+pub fn faces(photon: &Photon, normal: Vec3, params: AcceptParams) -> bool {
+    photon.incoming.dot(normal) > 0.0 && photon.normal.dot(normal) > params.min_normal_cos
 }
 
 /// The distance predicate every query in this crate uses: `|p − x|² ≤ r²`, with the squared

@@ -7,7 +7,9 @@
 
 use geometry::{Bsdf, EmitterShape, Hit, Lobe as MaterialLobe, Ray, Rgb, Scene, TransportMode};
 use glam::{Vec2, Vec3};
-use photon::{AcceptParams, GridParams, HitPointGrid, HitPoints, NewHitPoint, Photon};
+use photon::{
+    AcceptParams, GatherScratch, GridParams, HitPointGrid, HitPoints, NewHitPoint, Photon,
+};
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -116,8 +118,12 @@ pub(crate) struct PhotonMapper<'s> {
     pub(crate) direct: Vec<[f64; 3]>,
     pub(crate) camera_passes: u32,
     pub(crate) grid: Option<HitPointGrid>,
-    /// Slot index of each grid entry (the grid indexes the valid slots only).
+    /// Slot index of each grid entry (the grid indexes the valid slots only, in the Morton
+    /// order of their positions, so that the gather of Morton-sorted photons touches nearby
+    /// entries).
     pub(crate) grid_slots: Vec<u32>,
+    /// Buffers of the photon pass, kept across passes (not part of the render state).
+    scratch: PhotonScratch,
 }
 
 /// Memory per hitpoint slot of the photon mappers: the hitpoint record (`photon::HitPoints`
@@ -181,6 +187,7 @@ impl<'s> PhotonMapper<'s> {
             camera_passes: 0,
             grid: None,
             grid_slots: Vec::new(),
+            scratch: PhotonScratch::default(),
         })
     }
 
@@ -217,11 +224,15 @@ impl<'s> PhotonMapper<'s> {
         let mut stats = self.update_hitpoints(&deposits);
         stats.camera_paths = camera_paths;
         stats.photons_stored = deposits.photons_stored;
+        let trace_seconds = deposits.trace_seconds;
+        // Hand the per-slot buffers back for the next pass.
+        self.scratch.count = deposits.count;
+        self.scratch.flux = deposits.flux;
         stats.timings = PassTimings {
             camera,
             index,
-            trace: deposits.trace_seconds,
-            gather: photons_done - camera - index - deposits.trace_seconds,
+            trace: trace_seconds,
+            gather: photons_done - camera - index - trace_seconds,
             update: clock.elapsed().as_secs_f64() - photons_done,
         };
         self.pass += 1;
@@ -415,8 +426,16 @@ impl<'s> PhotonMapper<'s> {
         if keep {
             return;
         }
-        self.grid_slots = (0..self.slots.len() as u32)
+        let valid: Vec<u32> = (0..self.slots.len() as u32)
             .filter(|&s| self.valid[s as usize])
+            .collect();
+        let positions: Vec<Vec3> = valid
+            .iter()
+            .map(|&s| self.slots.position()[s as usize])
+            .collect();
+        self.grid_slots = photon::morton_order(&positions)
+            .into_iter()
+            .map(|i| valid[i as usize])
             .collect();
         let positions: Vec<Vec3> = self
             .grid_slots
@@ -445,43 +464,63 @@ impl<'s> PhotonMapper<'s> {
         let n = u64::from(self.params.photons_per_pass);
         let first_index = self.n_emitted;
         let clock = Instant::now();
-        let chunks: Vec<TracedPhotons> = (0..n.div_ceil(PHOTON_CHUNK))
-            .into_par_iter()
-            .map(|chunk| {
-                let start = chunk * PHOTON_CHUNK;
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let n_chunks = usize::try_from(n.div_ceil(PHOTON_CHUNK)).unwrap_or(usize::MAX);
+        scratch.traced.resize_with(n_chunks, TracedPhotons::default);
+        scratch
+            .traced
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(chunk, out)| {
+                out.clear();
+                let start = chunk as u64 * PHOTON_CHUNK;
                 let end = (start + PHOTON_CHUNK).min(n);
-                let mut out = TracedPhotons::default();
                 for idx in start..end {
-                    self.trace_photon(first_index + idx, &mut out);
+                    self.trace_photon(first_index + idx, out);
                 }
-                out
-            })
-            .collect();
+            });
         self.n_emitted += n;
 
-        let mut photons = Vec::new();
-        let mut frequency = Vec::new();
+        // The frequency photons, concatenated in trace order.
+        scratch.frequency.clear();
         let mut frequency_photons = 0;
-        for chunk in chunks {
-            photons.extend(chunk.photons);
-            frequency.extend(chunk.frequency);
+        for chunk in &scratch.traced {
+            scratch.frequency.extend_from_slice(&chunk.frequency);
             frequency_photons += chunk.frequency_photons;
         }
         let trace_seconds = clock.elapsed().as_secs_f64();
-        let Some(grid) = &self.grid else {
-            return PassDeposits::empty(self.slots.len(), frequency_photons);
+        let n_slots = self.slots.len();
+        let mut deposits = PassDeposits {
+            count: std::mem::take(&mut scratch.count),
+            flux: std::mem::take(&mut scratch.flux),
+            photons_deposited: 0,
+            frequency_photons,
+            photons_stored: 0,
+            trace_seconds,
         };
-        let positions: Vec<Vec3> = photons.iter().map(|p| p.position).collect();
-        let sorted: Vec<Photon> = photon::morton_order(&positions)
-            .into_iter()
-            .map(|i| photons[i as usize])
-            .collect();
+        deposits.count.clear();
+        deposits.count.resize(n_slots, 0);
+        deposits.flux.clear();
+        deposits.flux.resize(n_slots, [0.0; 3]);
+        let Some(grid) = &self.grid else {
+            self.scratch = scratch;
+            return deposits;
+        };
+        // Morton order (of the photons' positions, ties in trace order).
+        photon::morton_sort(
+            &scratch.traced,
+            |p: &Photon| p.position,
+            &mut scratch.keys,
+            &mut scratch.sorted,
+        );
 
         let slots = &self.slots;
         let grid_slots = &self.grid_slots;
-        let per_entry: Vec<(u32, [f64; 3])> = photon::gather(
+        photon::gather_with(
+            &mut scratch.gather,
             grid,
-            &sorted,
+            &scratch.sorted,
+            &mut scratch.per_entry,
             grid_slots.len(),
             |photon, entry| {
                 let slot = grid_slots[entry as usize] as usize;
@@ -499,10 +538,8 @@ impl<'s> PhotonMapper<'s> {
                 acc.1[2] += f64::from(flux.z);
             },
         );
-        let mut deposits = PassDeposits::empty(self.slots.len(), frequency_photons);
-        deposits.trace_seconds = trace_seconds;
-        deposits.photons_stored = sorted.len() as u64;
-        for (entry, (m, phi)) in per_entry.into_iter().enumerate() {
+        deposits.photons_stored = scratch.sorted.len() as u64;
+        for (entry, &(m, phi)) in scratch.per_entry.iter().enumerate() {
             let slot = grid_slots[entry] as usize;
             deposits.count[slot] = m;
             deposits.flux[slot] = phi;
@@ -512,7 +549,8 @@ impl<'s> PhotonMapper<'s> {
         // Frequency deposits: the queries run in parallel over fixed chunks; the merges (min or
         // max per coefficient) do not depend on the order, and run serially.
         let policy = self.params.freq_merge;
-        let estimates: Vec<Vec<(usize, Spectrum)>> = frequency
+        let estimates: Vec<Vec<(usize, Spectrum)>> = scratch
+            .frequency
             .par_chunks(FREQUENCY_CHUNK)
             .map(|chunk| {
                 let mut out = Vec::new();
@@ -544,6 +582,7 @@ impl<'s> PhotonMapper<'s> {
                 out
             })
             .collect();
+        self.scratch = scratch;
         let columns = self.slots.columns_mut();
         for (slot, spectrum) in estimates.into_iter().flatten() {
             columns.freq[slot].estimate.deposit(spectrum, policy);
@@ -552,14 +591,13 @@ impl<'s> PhotonMapper<'s> {
         deposits
     }
 
-    /// Whether `photon` counts for `slot`: inside the radius, on the hitpoint's side, with
-    /// agreeing normals (see `photon::accepts`).
+    /// Whether `photon`, which the grid reported for `slot` (so it lies within the slot's
+    /// radius: the grid's test is exactly that of `photon::accepts`), counts for it: on the
+    /// hitpoint's side, with agreeing normals (see `photon::faces`).
     fn accepts(&self, photon: &Photon, slot: usize) -> bool {
-        photon::accepts(
+        photon::faces(
             photon,
-            self.slots.position()[slot],
             self.slots.geometric_normal()[slot],
-            self.slots.radius()[slot],
             AcceptParams::COS_60,
         )
     }
@@ -812,6 +850,42 @@ struct TracedPhotons {
     frequency_photons: u64,
 }
 
+impl TracedPhotons {
+    /// Empties the chunk for the next pass, keeping the allocations.
+    fn clear(&mut self) {
+        self.photons.clear();
+        self.frequency.clear();
+        self.frequency_photons = 0;
+    }
+}
+
+impl AsRef<[Photon]> for TracedPhotons {
+    fn as_ref(&self) -> &[Photon] {
+        &self.photons
+    }
+}
+
+/// The photon pass's buffers, kept from one pass to the next: a pass of a million photons
+/// fills about a hundred megabytes of them, which freshly allocated would cost page faults
+/// (10 % of a pass in the profile) and serial copies. None of it carries state between passes.
+#[derive(Default)]
+struct PhotonScratch {
+    /// Per chunk of [`PHOTON_CHUNK`] photon paths, what they stored.
+    traced: Vec<TracedPhotons>,
+    /// The frequency photons of all chunks, concatenated.
+    frequency: Vec<(Photon, f32, Spectrum)>,
+    /// Morton keys of the stored photons.
+    keys: Vec<(u64, u64)>,
+    /// The stored photons in Morton order.
+    sorted: Vec<Photon>,
+    gather: GatherScratch<Rgb>,
+    /// Per grid entry: M and Φ of the pass.
+    per_entry: Vec<(u32, [f64; 3])>,
+    /// Per slot M and Φ, lent to [`PassDeposits`] during a pass.
+    count: Vec<u32>,
+    flux: Vec<[f64; 3]>,
+}
+
 /// What one photon pass brings to each hitpoint slot: M and Φ.
 struct PassDeposits {
     count: Vec<u32>,
@@ -820,19 +894,6 @@ struct PassDeposits {
     frequency_photons: u64,
     photons_stored: u64,
     trace_seconds: f64,
-}
-
-impl PassDeposits {
-    fn empty(n_slots: usize, frequency_photons: u64) -> Self {
-        Self {
-            count: vec![0; n_slots],
-            flux: vec![[0.0; 3]; n_slots],
-            photons_deposited: 0,
-            frequency_photons,
-            photons_stored: 0,
-            trace_seconds: 0.0,
-        }
-    }
 }
 
 /// Veach's correction for shading normals on light paths (thesis §5.3; pbrt's
