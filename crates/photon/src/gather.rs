@@ -16,6 +16,10 @@ const MIN_RANGE_LEN: usize = 512;
 
 /// Gathers `photons` into per-hitpoint accumulators, in parallel and bit-reproducibly.
 ///
+/// The items are photons, or records that carry one (`AsRef<Photon>`, e.g. a photon with
+/// extra state the contribution reads); the values are `Copy` (what a photon brings, e.g. a
+/// flux or a frequency spectrum).
+///
 /// For every photon p (in slice order) and every hitpoint h whose sphere contains it
 /// ([`HitPointGrid::for_each_containing`], in its fixed order), `contribution(p, h)` decides
 /// whether the photon counts (e.g. [`crate::accepts`]) and what it brings (e.g. the BSDF-weighted
@@ -34,14 +38,15 @@ const MIN_RANGE_LEN: usize = 512;
 ///
 /// # Panics
 /// If the grid reports a hitpoint index ≥ `n_hitpoints`.
-pub fn gather<T, A>(
+pub fn gather<P, T, A>(
     grid: &HitPointGrid,
-    photons: &[Photon],
+    photons: &[P],
     n_hitpoints: usize,
-    contribution: impl Fn(&Photon, u32) -> Option<T> + Sync,
+    contribution: impl Fn(&P, u32) -> Option<T> + Sync,
     accumulate: impl Fn(&mut A, T) + Sync,
 ) -> Vec<A>
 where
+    P: AsRef<Photon> + Sync,
     T: Copy + Send + Sync,
     A: Default + Clone + Send,
 {
@@ -79,15 +84,16 @@ impl<T> Default for GatherScratch<T> {
 ///
 /// # Panics
 /// If the grid reports a hitpoint index ≥ `n_hitpoints`.
-pub fn gather_with<T, A>(
+pub fn gather_with<P, T, A>(
     scratch: &mut GatherScratch<T>,
     grid: &HitPointGrid,
-    photons: &[Photon],
+    photons: &[P],
     accumulators: &mut Vec<A>,
     n_hitpoints: usize,
-    contribution: impl Fn(&Photon, u32) -> Option<T> + Sync,
+    contribution: impl Fn(&P, u32) -> Option<T> + Sync,
     accumulate: impl Fn(&mut A, T) + Sync,
 ) where
+    P: AsRef<Photon> + Sync,
     T: Copy + Send + Sync,
     A: Default + Clone + Send,
 {
@@ -107,7 +113,7 @@ pub fn gather_with<T, A>(
                 bin.clear();
             }
             for photon in chunk {
-                grid.for_each_containing(photon.position, |idx| {
+                grid.for_each_containing(photon.as_ref().position, |idx| {
                     if let Some(value) = contribution(photon, idx) {
                         bins[idx as usize / range_len].push((idx, value));
                     }

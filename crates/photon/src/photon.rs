@@ -18,6 +18,12 @@ pub struct Photon {
     pub normal: Vec3,
 }
 
+impl AsRef<Photon> for Photon {
+    fn as_ref(&self) -> &Photon {
+        self
+    }
+}
+
 /// Parameters of the photon acceptance test [`accepts`].
 ///
 /// No `Default` on purpose: the threshold is a choice the caller makes and documents.

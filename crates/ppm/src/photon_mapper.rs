@@ -26,8 +26,6 @@ const PHOTON_CHUNK: u64 = 2048;
 const SLOT_CHUNK: usize = 1024;
 /// Camera streams live in their own half of the sampler's index space.
 const CAMERA_STREAM: u64 = 1 << 63;
-/// Frequency photons per parallel work item of the frequency deposits.
-const FREQUENCY_CHUNK: usize = 1024;
 /// Share of an occlusion probe, at its far end, where blockers are ignored.
 const CONTACT_FRACTION: f32 = 0.05;
 /// Extra probes that locate a shadow edge found by the occlusion probe.
@@ -285,6 +283,23 @@ impl<'s> PhotonMapper<'s> {
         let initial_radius = self.kernel_scale;
         let first = self.slots.is_empty();
         let pass = self.pass;
+        if !update_hitpoints && !first {
+            // Only the directly seen emission changes: accumulate it in place, in parallel.
+            let mut direct = std::mem::take(&mut self.direct);
+            direct
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(SLOT_CHUNK)
+                .for_each(|(slot, sum)| {
+                    let sample = self.trace_camera_path(slot as u32, pass);
+                    for (c, sum) in sum.iter_mut().enumerate() {
+                        *sum += f64::from(sample.direct[c]);
+                    }
+                });
+            self.direct = direct;
+            self.camera_passes += 1;
+            return;
+        }
         let traced: Vec<CameraSample> = (0..n_slots)
             .into_par_iter()
             .with_min_len(SLOT_CHUNK)
@@ -485,7 +500,13 @@ impl<'s> PhotonMapper<'s> {
         scratch.frequency.clear();
         let mut frequency_photons = 0;
         for chunk in &scratch.traced {
-            scratch.frequency.extend_from_slice(&chunk.frequency);
+            scratch.frequency.extend(chunk.frequency.iter().map(
+                |&(photon, curvature, spectrum)| FrequencyPhoton {
+                    photon,
+                    curvature,
+                    spectrum,
+                },
+            ));
             frequency_photons += chunk.frequency_photons;
         }
         let trace_seconds = clock.elapsed().as_secs_f64();
@@ -516,7 +537,7 @@ impl<'s> PhotonMapper<'s> {
 
         let slots = &self.slots;
         let grid_slots = &self.grid_slots;
-        photon::gather_with(
+        photon::gather_with::<Photon, _, _>(
             &mut scratch.gather,
             grid,
             &scratch.sorted,
@@ -546,48 +567,45 @@ impl<'s> PhotonMapper<'s> {
             deposits.photons_deposited += u64::from(m);
         }
 
-        // Frequency deposits: the queries run in parallel over fixed chunks; the merges (min or
-        // max per coefficient) do not depend on the order, and run serially.
+        // Frequency deposits, gathered like the flux: each grid entry merges the field of its
+        // frequency photons in photon order (the merges, a min or max per coefficient, do not
+        // depend on the order anyway), then that pass estimate is merged into the slot's.
         let policy = self.params.freq_merge;
-        let estimates: Vec<Vec<(usize, Spectrum)>> = scratch
-            .frequency
-            .par_chunks(FREQUENCY_CHUNK)
-            .map(|chunk| {
-                let mut out = Vec::new();
-                for (photon, curvature, spectrum) in chunk {
-                    grid.for_each_containing(photon.position, |entry| {
-                        let slot = grid_slots[entry as usize] as usize;
-                        if !self.accepts(photon, slot) {
-                            return;
-                        }
-                        let Some(material) = self.scene.material(slots.material_idx()[slot]) else {
-                            return;
-                        };
-                        // The field the hitpoint's radius reads (design §8.1): the photon's
-                        // spectrum reflected by the hitpoint's lobe, with μo = 1 so that a stays
-                        // in surface units (b does not depend on μo) and μi = 1 for the
-                        // conservative 3D collapse (§8.5: the out-of-plane axis keeps its width).
-                        let lobe = spectrum_lobe(material.kind.lobe());
-                        out.push((
-                            slot,
-                            spectrum.reflect_isotropic(
-                                1.0,
-                                f64::from(*curvature),
-                                lobe,
-                                &self.caps,
-                            ),
-                        ));
-                    });
+        photon::gather_with(
+            &mut scratch.frequency_gather,
+            grid,
+            &scratch.frequency,
+            &mut scratch.frequency_per_entry,
+            grid_slots.len(),
+            |photon: &FrequencyPhoton, entry| {
+                let slot = grid_slots[entry as usize] as usize;
+                if !self.accepts(&photon.photon, slot) {
+                    return None;
                 }
-                out
-            })
-            .collect();
-        self.scratch = scratch;
+                let material = self.scene.material(slots.material_idx()[slot])?;
+                // The field the hitpoint's radius reads (design §8.1): the photon's spectrum
+                // reflected by the hitpoint's lobe, with μo = 1 so that a stays in surface units
+                // (b does not depend on μo) and μi = 1 for the conservative 3D collapse (§8.5:
+                // the out-of-plane axis keeps its width).
+                let lobe = spectrum_lobe(material.kind.lobe());
+                Some(photon.spectrum.reflect_isotropic(
+                    1.0,
+                    f64::from(photon.curvature),
+                    lobe,
+                    &self.caps,
+                ))
+            },
+            |acc: &mut FrequencyEstimate, spectrum| acc.deposit(spectrum, policy),
+        );
         let columns = self.slots.columns_mut();
-        for (slot, spectrum) in estimates.into_iter().flatten() {
-            columns.freq[slot].estimate.deposit(spectrum, policy);
-            columns.has_freq[slot] = true;
+        for (entry, estimate) in scratch.frequency_per_entry.iter().enumerate() {
+            if let Some(spectrum) = estimate.spectrum() {
+                let slot = grid_slots[entry] as usize;
+                columns.freq[slot].estimate.deposit(spectrum, policy);
+                columns.has_freq[slot] = true;
+            }
         }
+        self.scratch = scratch;
         deposits
     }
 
@@ -865,6 +883,21 @@ impl AsRef<[Photon]> for TracedPhotons {
     }
 }
 
+/// A frequency photon as the gather reads it: the stored photon, the curvature at its hit and
+/// its spectrum on arrival.
+#[derive(Clone, Copy)]
+struct FrequencyPhoton {
+    photon: Photon,
+    curvature: f32,
+    spectrum: Spectrum,
+}
+
+impl AsRef<Photon> for FrequencyPhoton {
+    fn as_ref(&self) -> &Photon {
+        &self.photon
+    }
+}
+
 /// The photon pass's buffers, kept from one pass to the next: a pass of a million photons
 /// fills about a hundred megabytes of them, which freshly allocated would cost page faults
 /// (10 % of a pass in the profile) and serial copies. None of it carries state between passes.
@@ -873,7 +906,7 @@ struct PhotonScratch {
     /// Per chunk of [`PHOTON_CHUNK`] photon paths, what they stored.
     traced: Vec<TracedPhotons>,
     /// The frequency photons of all chunks, concatenated.
-    frequency: Vec<(Photon, f32, Spectrum)>,
+    frequency: Vec<FrequencyPhoton>,
     /// Morton keys of the stored photons.
     keys: Vec<(u64, u64)>,
     /// The stored photons in Morton order.
@@ -881,6 +914,9 @@ struct PhotonScratch {
     gather: GatherScratch<Rgb>,
     /// Per grid entry: M and Φ of the pass.
     per_entry: Vec<(u32, [f64; 3])>,
+    frequency_gather: GatherScratch<Spectrum>,
+    /// Per grid entry: the merged frequency deposits of the pass.
+    frequency_per_entry: Vec<FrequencyEstimate>,
     /// Per slot M and Φ, lent to [`PassDeposits`] during a pass.
     count: Vec<u32>,
     flux: Vec<[f64; 3]>,
