@@ -16,7 +16,7 @@ use crate::suite::{self, SuiteScene};
 pub(crate) const HELP: &str = "\
 cargo xtask converge --scene NAME [--budgets 2,4,8,16,32] [--methods ppm,sppm,freq,freq-sppm,path]
                      [--photons N] [--seed S] [--out DIR] [--quick]
-                     [--replot] [--alpha A] [--freq-fraction F] [--kernel-k poster|strict|K] [--freq-merge min|poster-max]
+                     [--pointwise PATHS] [--replot] [--alpha A] [--freq-fraction F] [--kernel-k poster|strict|K] [--freq-merge min|poster-max]
 cargo xtask converge --scene NAME --sweep [--budget SECONDS] [--methods freq]
 
 Runs each method alone (one after another) on the suite scene NAME at its suite film size and
@@ -28,10 +28,18 @@ goes to DIR/NAME.csv; DIR/NAME-time.svg and DIR/NAME-photons.svg plot relMSE on 
 masks and, for each photon mapper, the final radius map (and for the frequency methods the
 map of the share of hitpoints held by the frequency floor) are written as PNGs. DIR defaults
 to docs/convergence. --quick uses budgets 1,2 and writes to target/converge.
+--pointwise PATHS measures ppm and freq (the fixed-hitpoint methods, the only ones allowed
+with it) against the image they converge to instead of the golden pixel average: the
+path-traced radiance at each hitpoint of their first camera pass (PATHS paths per hitpoint,
+ppm::pointwise_reference), so that their rate of convergence can be read. Write it to its
+own --out DIR.
 --replot redraws the SVGs from DIR/NAME.csv.
 --sweep renders the methods (default freq and ppm) at one budget (default 8 s) with one
 parameter varied at a time around the defaults (alpha, freq-fraction, kernel-k, freq-merge)
 and writes DIR/NAME-sweep.csv.";
+
+/// Camera passes averaged for the directly seen emission of the pointwise reference.
+const POINTWISE_EMISSION_PASSES: u32 = 256;
 
 /// Line colours of the plots, per method in `ppm::Method::ALL` order.
 const COLOURS: [(u8, u8, u8); 5] = [
@@ -53,6 +61,7 @@ struct Flags {
     sweep: bool,
     replot: bool,
     budget: f64,
+    pointwise: Option<u32>,
     overrides: Overrides,
 }
 
@@ -135,6 +144,7 @@ impl Flags {
             sweep: false,
             replot: false,
             budget: 8.0,
+            pointwise: None,
             overrides: Overrides::default(),
         };
         let mut methods_given = false;
@@ -157,6 +167,7 @@ impl Flags {
                 "--quick" => flags.quick = true,
                 "--sweep" => flags.sweep = true,
                 "--replot" => flags.replot = true,
+                "--pointwise" => flags.pointwise = Some(value()?.parse()?),
                 "--alpha" => flags.overrides.alpha = Some(value()?.parse()?),
                 "--freq-fraction" => flags.overrides.freq_fraction = Some(value()?.parse()?),
                 "--kernel-k" => {
@@ -195,6 +206,14 @@ impl Flags {
             bail!("converge: budgets must be positive seconds");
         }
         flags.budgets.sort_by(f64::total_cmp);
+        if flags.pointwise.is_some()
+            && flags
+                .methods
+                .iter()
+                .any(|m| !matches!(m, ppm::Method::Ppm | ppm::Method::FreqPpm))
+        {
+            bail!("converge: --pointwise needs --methods ppm,freq (the fixed-hitpoint methods)");
+        }
         Ok(flags)
     }
 }
@@ -250,6 +269,21 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         return sweep(&scene, entry, &reference, &flags, &out);
     }
     let masks = build_masks(&scene, &reference);
+    let reference = match flags.pointwise {
+        None => reference,
+        Some(paths) => {
+            let mut params = base_params(entry, ppm::Method::Ppm, &flags);
+            flags.overrides.apply(&mut params);
+            let start = Instant::now();
+            let pixels = ppm::pointwise_reference(&scene, params, paths, POINTWISE_EMISSION_PASSES)
+                .context("pointwise reference")?;
+            println!(
+                "converge: pointwise reference, {paths} paths per hitpoint, {:.1} s",
+                start.elapsed().as_secs_f64()
+            );
+            Image::new(reference.width, reference.height, pixels)
+        }
+    };
     let transport = suite::transport_mask(&scene);
     write_masks(
         &out.join(format!("{}-masks.png", entry.name)),

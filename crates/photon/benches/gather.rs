@@ -286,6 +286,7 @@ fn gather_pass_sorted(bencher: Bencher, threads: usize) {
             incoming: position,
             power: Vec3::ONE,
             normal: position,
+            bounces: 0,
         })
         .collect();
     let pool = pool(threads);

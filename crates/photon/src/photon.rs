@@ -4,7 +4,7 @@ use glam::Vec3;
 
 /// A photon stored on a surface: plain data, public fields.
 ///
-/// 48 bytes.
+/// 52 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Photon {
     /// Where the photon hit the surface.
@@ -16,6 +16,9 @@ pub struct Photon {
     /// Unit geometric normal of the surface at the photon hit, faced toward the side the photon
     /// arrived from: `normal.dot(incoming) ≥ 0`.
     pub normal: Vec3,
+    /// Scattering events on the photon's path before this hit (0 for a hit straight from the
+    /// emitter), so that a renderer can bound the bounces of the whole light path.
+    pub bounces: u32,
 }
 
 impl AsRef<Photon> for Photon {
@@ -101,6 +104,7 @@ mod tests {
 
     fn photon(position: Vec3, incoming: Vec3, normal: Vec3) -> Photon {
         Photon {
+            bounces: 0,
             position,
             incoming: incoming.normalize(),
             power: Vec3::ONE,

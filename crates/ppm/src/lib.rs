@@ -40,6 +40,7 @@
 mod params;
 mod path;
 mod photon_mapper;
+mod pointwise;
 mod renderer;
 mod rng;
 mod state;
@@ -47,6 +48,7 @@ mod update;
 
 pub use crate::params::{Method, ParamError, RenderParams};
 pub use crate::photon_mapper::{PassStats, PassTimings, auto_initial_radius, bytes_per_hitpoint};
+pub use crate::pointwise::pointwise_reference;
 pub use crate::renderer::{Aov, Renderer};
 pub use crate::rng::Sampler;
 pub use crate::state::{STATE_VERSION, StateError, StateHeader, scene_fingerprint};

@@ -89,7 +89,11 @@ pub struct RenderParams {
     /// Initial gather radius in scene units; `None` picks it from the scene (see
     /// [`crate::auto_initial_radius`]).
     pub initial_radius: Option<f64>,
-    /// Maximum number of path segments for camera and photon paths (≥ 1).
+    /// Maximum number of scattering events on a light path from the emitter to the camera
+    /// (≥ 1), as pbrt's `maxdepth`: paths have at most `max_depth + 1` segments. Every method
+    /// bounds the same paths: a photon mapper counts the photon's bounces, the hitpoint's
+    /// scattering and the camera path's specular bounces; the path tracer the bounces before
+    /// an emitter is hit or sampled.
     pub max_depth: u32,
     /// Hitpoint slots per pixel (jittered; ≥ 1); for the path tracer, paths per pixel per pass.
     pub samples_per_pixel: u32,
@@ -138,6 +142,13 @@ pub enum ParamError {
         height: u32,
         /// Samples per pixel.
         samples_per_pixel: u32,
+    },
+    /// A pointwise reference was asked for a method without fixed hitpoints, or with direct
+    /// lighting at the hitpoints (whose estimate re-jitters every pass).
+    #[error("a pointwise reference needs ppm or freq without direct lighting, not {method}")]
+    NoFixedHitpoints {
+        /// The method's name.
+        method: &'static str,
     },
 }
 

@@ -77,31 +77,33 @@ impl<'s> PathTracer<'s> {
     fn trace(&self, pixel: u32, mut sampler: Sampler) -> Rgb {
         let (x, y) = (pixel % self.width, pixel / self.width);
         let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-        let mut ray = self.scene.camera().generate_ray(film, sampler.next_2d());
+        let ray = self.scene.camera().generate_ray(film, sampler.next_2d());
+        let Some(hit) = self.scene.intersect(&ray) else {
+            return Rgb::ZERO;
+        };
+        self.scene.emitted(&hit) + self.scattered(hit, -ray.direction, 0, &mut sampler)
+    }
+
+    /// The radiance a path continued from `hit` (reached with `depth` bounces, looking back
+    /// along `outgoing`) brings back, without the emission of `hit` itself: light sampling at
+    /// every non-specular vertex and BSDF sampling, MIS-combined, up to `max_depth` bounces.
+    pub(crate) fn scattered(
+        &self,
+        mut hit: Hit,
+        mut outgoing: glam::Vec3,
+        mut depth: u32,
+        sampler: &mut Sampler,
+    ) -> Rgb {
         let lights = self.scene.lights();
         let mut radiance = Rgb::ZERO;
         let mut beta = Rgb::ONE;
-        // The previous vertex and the solid-angle density of the direction sampled there
-        // (`None` after a specular bounce or at the camera: emission then counts in full).
-        let mut previous: Option<(Hit, f32)> = None;
-        for depth in 0..self.params.max_depth {
-            let Some(hit) = self.scene.intersect(&ray) else {
-                break;
-            };
-            let emitted = self.scene.emitted(&hit);
-            if emitted != Rgb::ZERO {
-                let weight = match &previous {
-                    None => 1.0,
-                    Some((from, bsdf_pdf)) => {
-                        power_heuristic(*bsdf_pdf, lights.pdf_direct(from.position, &hit))
-                    }
-                };
-                radiance += beta * emitted * weight;
-            }
+        // Each iteration scatters at `hit` (the vertex after `depth` bounces), then finds the
+        // next vertex and its emission: emission found there ends a path with depth + 1 bounces,
+        // light sampled at `hit` one with depth + 1, both at most max_depth.
+        while depth < self.params.max_depth {
             let Some(bsdf) = self.scene.bsdf(&hit) else {
                 break;
             };
-            let outgoing = -ray.direction;
             let u_light = sampler.next_f32();
             let u_light_2d = sampler.next_2d();
             if !bsdf.is_specular() {
@@ -124,8 +126,24 @@ impl<'s> PathTracer<'s> {
             if beta == Rgb::ZERO || !beta.is_finite() {
                 break;
             }
-            previous = (!sample.is_specular).then_some((hit, sample.pdf));
-            ray = hit.spawn_ray(sample.incoming);
+            let ray = hit.spawn_ray(sample.incoming);
+            let Some(next) = self.scene.intersect(&ray) else {
+                break;
+            };
+            let emitted = self.scene.emitted(&next);
+            if emitted != Rgb::ZERO {
+                // After a specular bounce emission counts in full (light sampling cannot find
+                // it); otherwise it shares the path with light sampling at `hit`.
+                let weight = if sample.is_specular {
+                    1.0
+                } else {
+                    power_heuristic(sample.pdf, lights.pdf_direct(hit.position, &next))
+                };
+                radiance += beta * emitted * weight;
+            }
+            hit = next;
+            outgoing = -ray.direction;
+            depth += 1;
         }
         radiance
     }

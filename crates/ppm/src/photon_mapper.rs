@@ -113,6 +113,10 @@ pub(crate) struct PhotonMapper<'s> {
     pub(crate) slots: HitPoints<SlotFrequency>,
     /// Whether a slot holds a visible point in the current pass.
     pub(crate) valid: Vec<bool>,
+    /// Per slot: the most bounces a photon may have made and still count there,
+    /// `max_depth − 1 − (specular bounces of the camera path)`, so that no light path has more
+    /// than `max_depth` scattering events (the hitpoint's own scattering is the 1).
+    pub(crate) photon_bounces: Vec<u16>,
     /// Per slot: sum of directly seen emission (and direct lighting) over camera passes.
     pub(crate) direct: Vec<[f64; 3]>,
     pub(crate) camera_passes: u32,
@@ -126,13 +130,14 @@ pub(crate) struct PhotonMapper<'s> {
 }
 
 /// Memory per hitpoint slot of the photon mappers: the hitpoint record (`photon::HitPoints`
-/// with the frequency state) plus the renderer's per-slot validity flag and direct-emission
-/// sum. The hash grid comes on top (about 39 bytes per hitpoint at the default cell size,
-/// `photon::GridStats::bytes`).
+/// with the frequency state) plus the renderer's per-slot validity flag, photon-bounce budget
+/// and direct-emission sum. The hash grid comes on top (about 39 bytes per hitpoint at the
+/// default cell size, `photon::GridStats::bytes`).
 #[must_use]
 pub fn bytes_per_hitpoint() -> usize {
     HitPoints::<SlotFrequency>::bytes_per_hitpoint()
         + std::mem::size_of::<bool>()
+        + std::mem::size_of::<u16>()
         + std::mem::size_of::<[f64; 3]>()
 }
 
@@ -183,6 +188,7 @@ impl<'s> PhotonMapper<'s> {
             n_emitted: 0,
             slots: HitPoints::with_capacity(0),
             valid: Vec::new(),
+            photon_bounces: Vec::new(),
             direct: Vec::new(),
             camera_passes: 0,
             grid: None,
@@ -311,6 +317,7 @@ impl<'s> PhotonMapper<'s> {
             self.slots = HitPoints::with_capacity(n_slots);
             self.direct = vec![[0.0; 3]; n_slots];
             self.valid = vec![false; n_slots];
+            self.photon_bounces = vec![0; n_slots];
         }
         for (slot, sample) in traced.into_iter().enumerate() {
             for c in 0..3 {
@@ -327,8 +334,12 @@ impl<'s> PhotonMapper<'s> {
                 material: 0,
                 weight: Vec3::ZERO,
                 normal_distance: 0.0,
+                bounces: 0,
             });
             self.valid[slot] = sample.visible.is_some();
+            // Visible points have bounces < max_depth ≤ 1024 (`trace_camera_path`).
+            let budget = (self.params.max_depth - 1).saturating_sub(point.bounces);
+            self.photon_bounces[slot] = u16::try_from(budget).unwrap_or(u16::MAX);
             let freq = SlotFrequency {
                 estimate: FrequencyEstimate::EMPTY,
                 normal_distance: point.normal_distance,
@@ -355,20 +366,57 @@ impl<'s> PhotonMapper<'s> {
     }
 
     fn trace_camera_path(&self, slot: u32, pass: u32) -> CameraSample {
+        let weight_scale = 1.0 / self.params.samples_per_pixel as f32;
+        let chain = self.camera_chain(slot, pass);
+        let mut direct = chain.direct;
+        let visible = chain.end.map(|mut end| {
+            let hit = &end.hit;
+            if self.params.direct_lighting
+                && let Some(bsdf) = self.scene.bsdf(hit)
+            {
+                direct += end.throughput
+                    * self.direct_lighting(hit, &bsdf, end.outgoing, &mut end.sampler);
+            }
+            let mu = end.outgoing.dot(hit.shading_normal).abs();
+            VisiblePoint {
+                position: hit.position,
+                shading_normal: hit.shading_normal,
+                geometric_normal: hit.geometric_normal,
+                outgoing: end.outgoing,
+                material: hit.material,
+                weight: end.throughput * weight_scale,
+                normal_distance: hit.t * mu,
+                bounces: end.bounces,
+            }
+        });
+        CameraSample {
+            direct: direct * weight_scale,
+            visible,
+        }
+    }
+
+    /// The camera path of `slot` in `pass` through specular bounces to its first non-specular
+    /// hit, with the emission it sees on the way (unweighted by 1/spp).
+    pub(crate) fn camera_chain(&self, slot: u32, pass: u32) -> CameraChain {
         let spp = self.params.samples_per_pixel;
         let pixel = slot / spp;
         let (x, y) = (pixel % self.width, pixel / self.width);
         let mut sampler = Sampler::new(self.params.seed, pass, CAMERA_STREAM | u64::from(slot));
         let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
         let mut ray = self.scene.camera().generate_ray(film, sampler.next_2d());
-        let weight_scale = 1.0 / spp as f32;
         let mut throughput = Rgb::ONE;
         let mut direct = Rgb::ZERO;
-        for _depth in 0..self.params.max_depth {
+        // `bounces`: scattering events of the camera path before this hit. Emission seen here
+        // ends a light path with that many; a hitpoint adds one (its own scattering) to the
+        // photon's, so it needs bounces < max_depth.
+        for bounces in 0..=self.params.max_depth {
             let Some(hit) = self.scene.intersect(&ray) else {
                 break;
             };
             direct += throughput * self.scene.emitted(&hit);
+            if bounces == self.params.max_depth {
+                break;
+            }
             let Some(material) = self.scene.material(hit.material) else {
                 break;
             };
@@ -387,27 +435,18 @@ impl<'s> PhotonMapper<'s> {
                 ray = hit.spawn_ray(sample.incoming);
                 continue;
             }
-            if self.params.direct_lighting {
-                direct += throughput * self.direct_lighting(&hit, &bsdf, outgoing, &mut sampler);
-            }
-            let mu = outgoing.dot(hit.shading_normal).abs();
-            return CameraSample {
-                direct: direct * weight_scale,
-                visible: Some(VisiblePoint {
-                    position: hit.position,
-                    shading_normal: hit.shading_normal,
-                    geometric_normal: hit.geometric_normal,
+            return CameraChain {
+                direct,
+                end: Some(ChainEnd {
+                    hit,
                     outgoing,
-                    material: hit.material,
-                    weight: throughput * weight_scale,
-                    normal_distance: hit.t * mu,
+                    throughput,
+                    bounces,
+                    sampler,
                 }),
             };
         }
-        CameraSample {
-            direct: direct * weight_scale,
-            visible: None,
-        }
+        CameraChain { direct, end: None }
     }
 
     /// One light sample of next-event estimation at a non-specular camera hit.
@@ -620,14 +659,16 @@ impl<'s> PhotonMapper<'s> {
     }
 
     /// Whether `photon`, which the grid reported for `slot` (so it lies within the slot's
-    /// radius: the grid's test is exactly that of `photon::accepts`), counts for it: on the
-    /// hitpoint's side, with agreeing normals (see `photon::faces`).
+    /// radius: the grid's test is exactly that of `photon::accepts`), counts for it: the light
+    /// path they make has at most `max_depth` bounces, and the photon is on the hitpoint's
+    /// side, with agreeing normals (see `photon::faces`).
     fn accepts(&self, photon: &Photon, slot: usize) -> bool {
-        photon::faces(
-            photon,
-            self.slots.geometric_normal()[slot],
-            AcceptParams::COS_60,
-        )
+        photon.bounces <= u32::from(self.photon_bounces[slot])
+            && photon::faces(
+                photon,
+                self.slots.geometric_normal()[slot],
+                AcceptParams::COS_60,
+            )
     }
 
     fn is_frequency_photon(&self, index: u64) -> bool {
@@ -656,6 +697,8 @@ impl<'s> PhotonMapper<'s> {
         if spectrum.is_some() {
             out.frequency_photons += 1;
         }
+        // `depth`: the photon's bounces before this hit. A hitpoint adds one more, so hits at
+        // depth max_depth − 1 are the last that can count.
         for depth in 0..self.params.max_depth {
             let Some(hit) = self.scene.intersect(&ray) else {
                 break;
@@ -677,6 +720,7 @@ impl<'s> PhotonMapper<'s> {
                     incoming,
                     power,
                     normal: hit.geometric_normal,
+                    bounces: depth,
                 };
                 out.photons.push(photon);
                 if let Some(s) = spectrum {
@@ -850,6 +894,27 @@ impl<'s> PhotonMapper<'s> {
     }
 }
 
+/// A camera path up to its first non-specular hit ([`PhotonMapper::camera_chain`]).
+pub(crate) struct CameraChain {
+    /// Emission seen along the path (not divided by the slots per pixel).
+    pub(crate) direct: Rgb,
+    /// The first non-specular hit, if the path reached one within `max_depth`.
+    pub(crate) end: Option<ChainEnd>,
+}
+
+/// Where a camera path meets its first non-specular surface.
+pub(crate) struct ChainEnd {
+    pub(crate) hit: Hit,
+    /// Unit direction back toward the camera (or the last specular vertex).
+    pub(crate) outgoing: Vec3,
+    /// Product of the specular weights along the way.
+    pub(crate) throughput: Rgb,
+    /// Specular bounces before `hit`.
+    pub(crate) bounces: u32,
+    /// The path's sampler, positioned after the chain's draws.
+    pub(crate) sampler: Sampler,
+}
+
 /// What one camera path produced.
 #[derive(Clone, Copy, Debug)]
 struct CameraSample {
@@ -867,6 +932,8 @@ struct VisiblePoint {
     material: u32,
     weight: Rgb,
     normal_distance: f32,
+    /// Specular bounces of the camera path before this point.
+    bounces: u32,
 }
 
 /// Photons of one chunk, in trace order.

@@ -20,7 +20,7 @@ use crate::update::FrequencyFloor;
 const MAGIC: &[u8; 8] = b"FPPMSTAT";
 /// Version of the checkpoint layout; bump it whenever the layout or the meaning of a field
 /// changes, so that old checkpoints are refused rather than misread.
-pub const STATE_VERSION: u32 = 1;
+pub const STATE_VERSION: u32 = 2;
 
 /// Why a checkpoint could not be restored.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -246,6 +246,7 @@ fn write_photon_mapper(w: &mut Writer, p: &PhotonMapper<'_>) {
             }
         }
         w.u32(u32::from(p.valid[i]));
+        w.u32(u32::from(p.photon_bounces[i]));
         p.direct[i].iter().for_each(|&c| w.f64(c));
     }
 }
@@ -266,6 +267,7 @@ fn read_photon_mapper(
     let mut slots = HitPoints::with_capacity(n);
     let mut stats = Vec::with_capacity(n);
     p.valid = Vec::with_capacity(n);
+    p.photon_bounces = Vec::with_capacity(n);
     p.direct = Vec::with_capacity(n);
     for _ in 0..n {
         let mut v = [Vec3::ZERO; 5];
@@ -288,6 +290,8 @@ fn read_photon_mapper(
             _ => return Err(StateError::Corrupt),
         };
         p.valid.push(r.bool()?);
+        let budget = u16::try_from(r.u32()?).map_err(|_| StateError::Corrupt)?;
+        p.photon_bounces.push(budget);
         p.direct.push([r.f64()?, r.f64()?, r.f64()?]);
         slots.push(NewHitPoint {
             position: v[0],

@@ -46,6 +46,7 @@ fn scene(seed: u64) -> Scene {
                 incoming,
                 power,
                 normal,
+                bounces: 0,
             }
         })
         .collect();

@@ -5,7 +5,7 @@ use std::f64::consts::PI;
 use glam::Vec2;
 use ppm::Method;
 
-use crate::support::{PHOTON_METHODS, mean, params, render, scene};
+use crate::support::{PHOTON_METHODS, mean, params, render, rmse, scene};
 
 /// Inside a closed diffuse sphere of albedo ρ and radius R with a point light of intensity I at
 /// its centre, every wall point has radiance L = ρ·I / (π·R²·(1 − ρ)) (direct E = I/R², and the
@@ -54,6 +54,75 @@ fn furnace_sphere_gives_the_analytic_radiance_for_every_method() {
         (m - 1.0).abs() < 0.02,
         "path: mean radiance {m}, expected 1"
     );
+}
+
+/// A closed cube whose inward-facing walls all emit Le = 0.5 and reflect ρ = 0.5, with a small
+/// mirror ball at its centre; `camera` is the TOML camera table.
+///
+/// In a closed enclosure of uniform emission and albedo the radiance is uniform, and paths with
+/// j bounces bring Le·ρ^j, so a bound of k bounces gives L_k = Le·Σ_{j=0..k} ρ^j = 1 − 0.5^(k+1).
+/// Seen in the mirror, the walls lose one bounce to it: L_(k−1). (The ball, 0.1 across a cube
+/// of side 2, changes the walls' radiance by well under 1 %.)
+fn emissive_box(camera: &str) -> String {
+    let mut toml = format!(
+        "format = 1\n{camera}\n[film]\nwidth = 16\nheight = 16\n\
+         [materials.wall]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\nemission = [0.5, 0.5, 0.5]\n\
+         [materials.silver]\ntype = \"mirror\"\n\
+         [[shapes]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 0.1\nmaterial = \"silver\"\n"
+    );
+    // Corner and edges of each face, edge1 × edge2 pointing into the cube.
+    let faces: [[[f64; 3]; 3]; 6] = [
+        [[-1.0, -1.0, -1.0], [0.0, 0.0, 2.0], [2.0, 0.0, 0.0]],
+        [[-1.0, 1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]],
+        [[-1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]],
+        [[1.0, -1.0, -1.0], [0.0, 0.0, 2.0], [0.0, 2.0, 0.0]],
+        [[-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
+        [[-1.0, -1.0, 1.0], [0.0, 2.0, 0.0], [2.0, 0.0, 0.0]],
+    ];
+    for [corner, edge1, edge2] in faces {
+        toml += &format!(
+            "[[shapes]]\ntype = \"quad\"\ncorner = {corner:?}\nedge1 = {edge1:?}\nedge2 = {edge2:?}\nmaterial = \"wall\"\n"
+        );
+    }
+    toml
+}
+
+/// `max_depth` bounds the scattering events of the whole light path, the same way for every
+/// method: emission seen directly or found by a path (the path tracer), photons and the
+/// camera path's specular bounces (the photon mappers) all count.
+#[test]
+fn max_depth_bounds_the_bounces_of_the_whole_light_path() {
+    let wall = scene(&emissive_box(
+        "[camera]\nposition = [0.0, 0.0, 0.5]\nlook_at = [1.0, 0.0, 0.5]\nfov_y = 40.0",
+    ));
+    let mirror = scene(&emissive_box(
+        "[camera]\nposition = [0.0, 0.0, 0.5]\nlook_at = [0.0, 0.0, 0.0]\nfov_y = 5.0",
+    ));
+    let bounded = |k: u32| 1.0 - 0.5f64.powi(k as i32 + 1);
+    for k in 1..=3u32 {
+        for (view, scene, expected) in [
+            ("wall", &wall, bounded(k)),
+            ("mirror", &mirror, bounded(k - 1)),
+        ] {
+            for method in PHOTON_METHODS {
+                let mut p = params(method, 20_000);
+                p.max_depth = k;
+                let m = mean(&render(scene, p, 8));
+                assert!(
+                    (m / expected - 1.0).abs() < 0.02,
+                    "{method}, {view}, max_depth {k}: mean radiance {m}, expected {expected}"
+                );
+            }
+            let mut p = params(Method::Path, 1);
+            p.samples_per_pixel = 16;
+            p.max_depth = k;
+            let m = mean(&render(scene, p, 4));
+            assert!(
+                (m / expected - 1.0).abs() < 0.02,
+                "path, {view}, max_depth {k}: mean radiance {m}, expected {expected}"
+            );
+        }
+    }
 }
 
 /// A point light of intensity I at height h over a large diffuse floor of albedo ρ: the floor
@@ -169,4 +238,90 @@ fn point_light_over_a_plane_matches_the_inverse_square_law_pixel_by_pixel() {
             "{method}: worst pixel off by {worst}"
         );
     }
+}
+
+/// The analytic radiance of the plane scene at film position `film`.
+fn plane_radiance_at(scene: &geometry::Scene, film: Vec2) -> f64 {
+    let ray = scene.camera().generate_ray(film, Vec2::splat(0.5));
+    let t = -ray.origin.y / ray.direction.y;
+    if t <= 0.0 {
+        return 0.0;
+    }
+    let to_light = glam::Vec3::new(0.0, 1.0, 0.0) - ray.at(t);
+    let d2 = f64::from(to_light.length_squared());
+    0.8 / PI * 10.0 * f64::from(to_light.y) / d2.sqrt() / d2
+}
+
+/// Over a plane lit by a point light, light sampling is exact, so the pointwise reference is
+/// the analytic radiance at each slot's hitpoint: inside the range the pixel's footprint spans,
+/// and (the slots being single points) not the pixel average.
+#[test]
+fn pointwise_reference_is_the_radiance_at_the_hitpoints() {
+    let scene = scene(PLANE);
+    let average = plane_reference(&scene);
+    let reference = ppm::pointwise_reference(&scene, params(Method::Ppm, 1), 2, 1).unwrap();
+    let (width, _) = scene.camera().resolution();
+    let mut off_average = 0;
+    for (i, (pixel, &mean)) in reference.iter().zip(&average).enumerate() {
+        let (x, y) = ((i as u32 % width) as f32, (i as u32 / width) as f32);
+        let samples: Vec<f64> = (0..=16)
+            .flat_map(|j| {
+                (0..=16).map(move |k| Vec2::new(x + j as f32 / 16.0, y + k as f32 / 16.0))
+            })
+            .map(|film| plane_radiance_at(&scene, film))
+            .collect();
+        let lo = samples.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = samples.iter().copied().fold(0.0, f64::max);
+        let got = f64::from(pixel[1]);
+        assert!(
+            got >= lo * 0.999 - 1e-6 && got <= hi * 1.001 + 1e-6,
+            "pixel {i}: {got} outside the footprint's range [{lo}, {hi}]"
+        );
+        if (got - mean).abs() > 1e-3 * mean {
+            off_average += 1;
+        }
+    }
+    assert!(
+        off_average > reference.len() / 2,
+        "only {off_average} slots differ from the pixel average"
+    );
+    let mut sppm = params(Method::Sppm, 1);
+    assert!(ppm::pointwise_reference(&scene, sppm, 1, 1).is_err());
+    sppm.method = Method::Ppm;
+    sppm.direct_lighting = true;
+    assert!(ppm::pointwise_reference(&scene, sppm, 1, 1).is_err());
+}
+
+/// PPM's error against the pointwise reference keeps falling with the passes, where against the
+/// pixel average it stops at the in-pixel variation.
+#[test]
+fn ppm_converges_to_the_pointwise_reference() {
+    let scene = scene(PLANE);
+    let average: Vec<[f32; 3]> = plane_reference(&scene)
+        .into_iter()
+        .map(|v| [v as f32; 3])
+        .collect();
+    let mut p = params(Method::Ppm, 100_000);
+    p.initial_radius = Some(0.05);
+    let pointwise = ppm::pointwise_reference(&scene, p, 2, 1).unwrap();
+    let mut renderer = ppm::Renderer::new(&scene, p).unwrap();
+    let mut errors = Vec::new();
+    for passes in [4, 16, 64] {
+        while renderer.passes() < passes {
+            renderer.iterate();
+        }
+        let image = renderer.image();
+        errors.push((rmse(&image, &pointwise), rmse(&image, &average)));
+    }
+    eprintln!("rmse (pointwise, pixel average) at 4, 16, 64 passes: {errors:?}");
+    assert!(
+        errors[0].0 > errors[1].0 && errors[1].0 > errors[2].0,
+        "{errors:?}"
+    );
+    // Measured: pointwise 0.108, 0.068, 0.042; pixel average 0.122, 0.089, 0.073 (flattening).
+    assert!(
+        errors[1].0 / errors[2].0 > errors[1].1 / errors[2].1,
+        "{errors:?}"
+    );
+    assert!(errors[2].0 < 0.7 * errors[2].1, "{errors:?}");
 }
