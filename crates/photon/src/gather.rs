@@ -16,6 +16,10 @@ const MIN_RANGE_LEN: usize = 512;
 
 /// Gathers `photons` into per-hitpoint accumulators, in parallel and bit-reproducibly.
 ///
+/// The items are photons, or records that carry one (`AsRef<Photon>`, e.g. a photon with
+/// extra state the contribution reads); the values are `Copy` (what a photon brings, e.g. a
+/// flux or a frequency spectrum).
+///
 /// For every photon p (in slice order) and every hitpoint h whose sphere contains it
 /// ([`HitPointGrid::for_each_containing`], in its fixed order), `contribution(p, h)` decides
 /// whether the photon counts (e.g. [`crate::accepts`]) and what it brings (e.g. the BSDF-weighted
@@ -34,53 +38,100 @@ const MIN_RANGE_LEN: usize = 512;
 ///
 /// # Panics
 /// If the grid reports a hitpoint index ≥ `n_hitpoints`.
-pub fn gather<T, A>(
+pub fn gather<P, T, A>(
     grid: &HitPointGrid,
-    photons: &[Photon],
+    photons: &[P],
     n_hitpoints: usize,
-    contribution: impl Fn(&Photon, u32) -> Option<T> + Sync,
+    contribution: impl Fn(&P, u32) -> Option<T> + Sync,
     accumulate: impl Fn(&mut A, T) + Sync,
 ) -> Vec<A>
 where
-    T: Send,
+    P: AsRef<Photon> + Sync,
+    T: Copy + Send + Sync,
+    A: Default + Clone + Send,
+{
+    let mut accumulators = Vec::new();
+    gather_with(
+        &mut GatherScratch::default(),
+        grid,
+        photons,
+        &mut accumulators,
+        n_hitpoints,
+        contribution,
+        accumulate,
+    );
+    accumulators
+}
+
+/// The buffers of [`gather_with`]: the `(hitpoint, value)` bins of every photon chunk. Kept by
+/// the caller across passes, they are cleared but not freed, so a steady state of similar
+/// passes neither allocates nor page-faults (the bins of a 1M-photon pass are tens of MB).
+#[derive(Debug)]
+pub struct GatherScratch<T> {
+    /// Per photon chunk, per hitpoint range.
+    bins: Vec<Vec<Vec<(u32, T)>>>,
+}
+
+impl<T> Default for GatherScratch<T> {
+    fn default() -> Self {
+        Self { bins: Vec::new() }
+    }
+}
+
+/// [`gather`] with caller-kept buffers: the bins in `scratch`, and the accumulators in
+/// `accumulators`, which is overwritten with `n_hitpoints` accumulators (reusing its
+/// allocation). Same results as [`gather`], bit for bit.
+///
+/// # Panics
+/// If the grid reports a hitpoint index ≥ `n_hitpoints`.
+pub fn gather_with<P, T, A>(
+    scratch: &mut GatherScratch<T>,
+    grid: &HitPointGrid,
+    photons: &[P],
+    accumulators: &mut Vec<A>,
+    n_hitpoints: usize,
+    contribution: impl Fn(&P, u32) -> Option<T> + Sync,
+    accumulate: impl Fn(&mut A, T) + Sync,
+) where
+    P: AsRef<Photon> + Sync,
+    T: Copy + Send + Sync,
     A: Default + Clone + Send,
 {
     // Hitpoint ranges: a function of `n_hitpoints` only.
     let range_len = n_hitpoints.div_ceil(MAX_RANGES).max(MIN_RANGE_LEN);
     let n_ranges = n_hitpoints.div_ceil(range_len).max(1);
-    let chunks: Vec<Vec<Vec<(u32, T)>>> = photons
-        .par_chunks(GATHER_CHUNK)
-        .map(|chunk| {
-            let mut bins: Vec<Vec<(u32, T)>> = (0..n_ranges).map(|_| Vec::new()).collect();
+    let n_chunks = photons.len().div_ceil(GATHER_CHUNK);
+    if scratch.bins.len() < n_chunks {
+        scratch.bins.resize_with(n_chunks, Vec::new);
+    }
+    let bins = &mut scratch.bins[..n_chunks];
+    bins.par_iter_mut()
+        .zip(photons.par_chunks(GATHER_CHUNK))
+        .for_each(|(bins, chunk)| {
+            bins.resize_with(n_ranges, Vec::new);
+            for bin in bins.iter_mut() {
+                bin.clear();
+            }
             for photon in chunk {
-                grid.for_each_containing(photon.position, |idx| {
+                grid.for_each_containing(photon.as_ref().position, |idx| {
                     if let Some(value) = contribution(photon, idx) {
                         bins[idx as usize / range_len].push((idx, value));
                     }
                 });
             }
-            bins
-        })
-        .collect();
-    // Transpose to one list of bins per range, in chunk order (moves only the Vec headers).
-    let mut per_range: Vec<Vec<Vec<(u32, T)>>> = (0..n_ranges)
-        .map(|_| Vec::with_capacity(chunks.len()))
-        .collect();
-    for bins in chunks {
-        for (range_bins, bin) in per_range.iter_mut().zip(bins) {
-            range_bins.push(bin);
-        }
-    }
-    let mut accumulators = vec![A::default(); n_hitpoints];
+        });
+    accumulators.clear();
+    accumulators.resize(n_hitpoints, A::default());
+    let bins = &*bins;
     accumulators
         .par_chunks_mut(range_len)
-        .zip(per_range.into_par_iter())
         .enumerate()
-        .for_each(|(range_idx, (accs, bins))| {
+        .for_each(|(range_idx, accs)| {
             let first = range_idx * range_len;
-            for (idx, value) in bins.into_iter().flatten() {
-                accumulate(&mut accs[idx as usize - first], value);
+            for chunk_bins in bins {
+                for &(idx, value) in &chunk_bins[range_idx] {
+                    accumulate(&mut accs[idx as usize - first], value);
+                }
             }
         });
-    accumulators
 }

@@ -29,8 +29,8 @@ mod hitpoints;
 mod morton;
 mod photon;
 
-pub use crate::gather::gather;
+pub use crate::gather::{GatherScratch, gather, gather_with};
 pub use crate::grid::{CellSize, GridParams, GridStats, HitPointGrid};
 pub use crate::hitpoints::{HitPointColumnsMut, HitPoints, NewHitPoint};
-pub use crate::morton::morton_order;
-pub use crate::photon::{AcceptParams, Photon, accepts, within_radius};
+pub use crate::morton::{MortonScratch, morton_order, morton_sort};
+pub use crate::photon::{AcceptParams, Photon, accepts, faces, within_radius};

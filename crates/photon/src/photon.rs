@@ -4,7 +4,7 @@ use glam::Vec3;
 
 /// A photon stored on a surface: plain data, public fields.
 ///
-/// 48 bytes.
+/// 52 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Photon {
     /// Where the photon hit the surface.
@@ -19,6 +19,12 @@ pub struct Photon {
     /// Scattering events on the photon's path before this hit (0 for a hit straight from the
     /// emitter), so that a renderer can bound the bounces of the whole light path.
     pub bounces: u32,
+}
+
+impl AsRef<Photon> for Photon {
+    fn as_ref(&self) -> &Photon {
+        self
+    }
 }
 
 /// Parameters of the photon acceptance test [`accepts`].
@@ -64,9 +70,16 @@ pub fn accepts(
     radius: f64,
     params: AcceptParams,
 ) -> bool {
-    within_radius(photon.position, position, radius * radius)
-        && photon.incoming.dot(normal) > 0.0
-        && photon.normal.dot(normal) > params.min_normal_cos
+    within_radius(photon.position, position, radius * radius) && faces(photon, normal, params)
+}
+
+/// Conditions 2 and 3 of [`accepts`] (side and normal agreement) without the distance test:
+/// for photons that [`crate::HitPointGrid::for_each_containing`] reported, whose distance test
+/// is already exactly condition 1 (same predicate, same radius).
+#[must_use]
+#[inline]
+pub fn faces(photon: &Photon, normal: Vec3, params: AcceptParams) -> bool {
+    photon.incoming.dot(normal) > 0.0 && photon.normal.dot(normal) > params.min_normal_cos
 }
 
 /// The distance predicate every query in this crate uses: `|p − x|² ≤ r²`, with the squared

@@ -5,6 +5,11 @@
 //! gather queries per second, hitpoints per pixel, bytes per hitpoint, and the extra cost of
 //! frequency photons at the default fraction. Times are wall-clock medians over a few passes,
 //! measured side by side in one run (absolute numbers on a shared machine are noisy).
+//!
+//! `FPPM_BENCH_METHODS=ppm,freq` restricts the methods, `FPPM_BENCH_THREADS=1,2` the thread
+//! counts (the summary lines need both 1 and 2 threads of ppm and freq). A second table gives
+//! the median seconds of each phase of a pass. "pass CPU s" is the process CPU time of a pass
+//! (all threads): with 1 thread it is the work itself, whatever else runs on the machine.
 
 #![allow(clippy::print_stdout, clippy::unwrap_used, missing_docs)]
 
@@ -20,7 +25,24 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-fn run(scene: &geometry::Scene, method: Method, threads: usize) -> Vec<PassStats> {
+/// CPU seconds (user + system) used by this process so far, from `/proc/self/stat` (10 ms
+/// ticks); 0 where unavailable. Robust to other jobs on the machine, unlike wall time.
+fn process_cpu_seconds() -> f64 {
+    std::fs::read_to_string("/proc/self/stat")
+        .ok()
+        .and_then(|stat| {
+            // Fields after the parenthesised command name; utime and stime are fields 14, 15.
+            let rest = &stat[stat.rfind(')')? + 2..];
+            let fields: Vec<&str> = rest.split_whitespace().collect();
+            let ticks =
+                fields.get(11)?.parse::<f64>().ok()? + fields.get(12)?.parse::<f64>().ok()?;
+            Some(ticks / 100.0)
+        })
+        .unwrap_or(0.0)
+}
+
+/// Per-pass statistics and the process CPU seconds of each pass.
+fn run(scene: &geometry::Scene, method: Method, threads: usize) -> (Vec<PassStats>, Vec<f64>) {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -32,7 +54,13 @@ fn run(scene: &geometry::Scene, method: Method, threads: usize) -> Vec<PassStats
         let mut renderer = Renderer::new(scene, params).unwrap();
         // The first pass traces the hitpoints and builds the grid: not part of the steady state.
         renderer.iterate();
-        (0..PASSES).map(|_| renderer.iterate()).collect()
+        (0..PASSES)
+            .map(|_| {
+                let cpu = process_cpu_seconds();
+                let stats = renderer.iterate();
+                (stats, process_cpu_seconds() - cpu)
+            })
+            .unzip()
     })
 }
 
@@ -49,53 +77,102 @@ fn main() {
         "CornellBox-Sphere, 512x512, {PHOTONS_PER_PASS} photons per pass, median of {PASSES} passes"
     );
     println!(
-        "{:<10} {:>7} {:>16} {:>16} {:>16} {:>12}",
-        "method", "threads", "trace paths/s", "pass paths/s", "gather q/s", "pass s"
+        "{:<10} {:>7} {:>16} {:>16} {:>16} {:>12} {:>12}",
+        "method", "threads", "trace paths/s", "pass paths/s", "gather q/s", "pass s", "pass CPU s"
     );
+    let methods: Vec<Method> = [Method::Ppm, Method::FreqPpm, Method::Sppm]
+        .into_iter()
+        .filter(|m| {
+            std::env::var("FPPM_BENCH_METHODS")
+                .map_or(true, |list| list.split(',').any(|name| name == m.name()))
+        })
+        .collect();
+    let thread_counts: Vec<usize> = std::env::var("FPPM_BENCH_THREADS")
+        .map_or(vec![1, 2], |list| {
+            list.split(',').map(|t| t.parse().unwrap()).collect()
+        });
     let mut pass_seconds = Vec::new();
-    for method in [Method::Ppm, Method::FreqPpm, Method::Sppm] {
-        for threads in [1, 2] {
-            let stats = run(&scene, method, threads);
+    let mut phases = Vec::new();
+    for &method in &methods {
+        for &threads in &thread_counts {
+            let (stats, cpu) = run(&scene, method, threads);
+            let cpu = median(cpu);
             let trace = median(stats.iter().map(|s| s.timings.trace).collect());
             let gather = median(stats.iter().map(|s| s.timings.gather).collect());
             let total = median(stats.iter().map(|s| s.timings.total()).collect());
             let stored = stats.iter().map(|s| s.photons_stored).sum::<u64>() as f64 / PASSES as f64;
             let photons = f64::from(PHOTONS_PER_PASS);
             println!(
-                "{:<10} {:>7} {:>16.0} {:>16.0} {:>16.0} {:>12.3}",
+                "{:<10} {:>7} {:>16.0} {:>16.0} {:>16.0} {:>12.3} {:>12.2}",
                 method.name(),
                 threads,
                 photons / trace,
                 photons / total,
                 stored / gather,
-                total
+                total,
+                cpu
             );
             pass_seconds.push((method, threads, total, trace));
+            let phase = |f: fn(&ppm::PassTimings) -> f64| {
+                median(stats.iter().map(|s| f(&s.timings)).collect())
+            };
+            phases.push((
+                method,
+                threads,
+                [
+                    phase(|t| t.camera),
+                    phase(|t| t.index),
+                    phase(|t| t.trace),
+                    phase(|t| t.gather),
+                    phase(|t| t.update),
+                ],
+            ));
         }
+    }
+    println!(
+        "{:<10} {:>7} {:>9} {:>9} {:>9} {:>9} {:>9}   (median seconds per phase)",
+        "method", "threads", "camera", "index", "trace", "gather", "update"
+    );
+    for (method, threads, p) in &phases {
+        println!(
+            "{:<10} {:>7} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
+            method.name(),
+            threads,
+            p[0],
+            p[1],
+            p[2],
+            p[3],
+            p[4]
+        );
     }
     let find = |m: Method, t: usize| {
         pass_seconds
             .iter()
             .find(|&&(method, threads, _, _)| method == m && threads == t)
             .map(|&(_, _, total, trace)| (total, trace))
-            .unwrap()
     };
     for method in [Method::Ppm, Method::FreqPpm] {
-        let (one, _) = find(method, 1);
-        let (two, _) = find(method, 2);
-        println!(
-            "{}: parallel speed-up 1 -> 2 threads: {:.2}x",
-            method.name(),
-            one / two
-        );
+        if let (Some((one, trace_one)), Some((two, trace_two))) = (find(method, 1), find(method, 2))
+        {
+            println!(
+                "{}: parallel speed-up 1 -> 2 threads: {:.2}x pass, {:.2}x trace",
+                method.name(),
+                one / two,
+                trace_one / trace_two
+            );
+        }
     }
-    let (ppm, _) = find(Method::Ppm, 2);
-    let (freq, _) = find(Method::FreqPpm, 2);
-    println!(
-        "frequency photons (default fraction {}): {:+.1} % pass time vs classical PPM (2 threads)",
-        RenderParams::preview().freq_fraction,
-        (freq / ppm - 1.0) * 100.0
-    );
+    for threads in [1, 2] {
+        if let (Some((ppm, _)), Some((freq, _))) =
+            (find(Method::Ppm, threads), find(Method::FreqPpm, threads))
+        {
+            println!(
+                "frequency photons (default fraction {}): {:+.1} % pass time vs classical PPM ({threads} threads)",
+                RenderParams::preview().freq_fraction,
+                (freq / ppm - 1.0) * 100.0
+            );
+        }
+    }
     let n_slots = 512 * 512 * RenderParams::preview().samples_per_pixel as usize;
     println!(
         "hitpoints per pixel: {} ({} slots); bytes per hitpoint: {} (+ grid)",

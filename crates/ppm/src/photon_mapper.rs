@@ -7,7 +7,10 @@
 
 use geometry::{Bsdf, EmitterShape, Hit, Lobe as MaterialLobe, Ray, Rgb, Scene, TransportMode};
 use glam::{Vec2, Vec3};
-use photon::{AcceptParams, GridParams, HitPointGrid, HitPoints, NewHitPoint, Photon};
+use photon::{
+    AcceptParams, GatherScratch, GridParams, HitPointGrid, HitPoints, MortonScratch, NewHitPoint,
+    Photon,
+};
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -24,8 +27,6 @@ const PHOTON_CHUNK: u64 = 2048;
 const SLOT_CHUNK: usize = 1024;
 /// Camera streams live in their own half of the sampler's index space.
 const CAMERA_STREAM: u64 = 1 << 63;
-/// Frequency photons per parallel work item of the frequency deposits.
-const FREQUENCY_CHUNK: usize = 1024;
 /// Share of an occlusion probe, at its far end, where blockers are ignored.
 const CONTACT_FRACTION: f32 = 0.05;
 /// Extra probes that locate a shadow edge found by the occlusion probe.
@@ -120,13 +121,18 @@ pub(crate) struct PhotonMapper<'s> {
     pub(crate) direct: Vec<[f64; 3]>,
     pub(crate) camera_passes: u32,
     pub(crate) grid: Option<HitPointGrid>,
-    /// Slot index of each grid entry (the grid indexes the valid slots only).
+    /// Slot index of each grid entry (the grid indexes the valid slots only, in the Morton
+    /// order of their positions, so that the gather of Morton-sorted photons touches nearby
+    /// entries).
     pub(crate) grid_slots: Vec<u32>,
+    /// Buffers of the photon pass, kept across passes (not part of the render state).
+    scratch: PhotonScratch,
 }
 
 /// Memory per hitpoint slot of the photon mappers: the hitpoint record (`photon::HitPoints`
 /// with the frequency state) plus the renderer's per-slot validity flag, photon-bounce budget
-/// and direct-emission sum. The hash grid comes on top (about 80 bytes per hitpoint at the default cell size).
+/// and direct-emission sum. The hash grid comes on top (about 39 bytes per hitpoint at the
+/// default cell size, `photon::GridStats::bytes`).
 #[must_use]
 pub fn bytes_per_hitpoint() -> usize {
     HitPoints::<SlotFrequency>::bytes_per_hitpoint()
@@ -187,6 +193,7 @@ impl<'s> PhotonMapper<'s> {
             camera_passes: 0,
             grid: None,
             grid_slots: Vec::new(),
+            scratch: PhotonScratch::default(),
         })
     }
 
@@ -223,11 +230,15 @@ impl<'s> PhotonMapper<'s> {
         let mut stats = self.update_hitpoints(&deposits);
         stats.camera_paths = camera_paths;
         stats.photons_stored = deposits.photons_stored;
+        let trace_seconds = deposits.trace_seconds;
+        // Hand the per-slot buffers back for the next pass.
+        self.scratch.count = deposits.count;
+        self.scratch.flux = deposits.flux;
         stats.timings = PassTimings {
             camera,
             index,
-            trace: deposits.trace_seconds,
-            gather: photons_done - camera - index - deposits.trace_seconds,
+            trace: trace_seconds,
+            gather: photons_done - camera - index - trace_seconds,
             update: clock.elapsed().as_secs_f64() - photons_done,
         };
         self.pass += 1;
@@ -280,6 +291,23 @@ impl<'s> PhotonMapper<'s> {
         let initial_radius = self.kernel_scale;
         let first = self.slots.is_empty();
         let pass = self.pass;
+        if !update_hitpoints && !first {
+            // Only the directly seen emission changes: accumulate it in place, in parallel.
+            let mut direct = std::mem::take(&mut self.direct);
+            direct
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(SLOT_CHUNK)
+                .for_each(|(slot, sum)| {
+                    let sample = self.trace_camera_path(slot as u32, pass);
+                    for (c, sum) in sum.iter_mut().enumerate() {
+                        *sum += f64::from(sample.direct[c]);
+                    }
+                });
+            self.direct = direct;
+            self.camera_passes += 1;
+            return;
+        }
         let traced: Vec<CameraSample> = (0..n_slots)
             .into_par_iter()
             .with_min_len(SLOT_CHUNK)
@@ -454,8 +482,16 @@ impl<'s> PhotonMapper<'s> {
         if keep {
             return;
         }
-        self.grid_slots = (0..self.slots.len() as u32)
+        let valid: Vec<u32> = (0..self.slots.len() as u32)
             .filter(|&s| self.valid[s as usize])
+            .collect();
+        let positions: Vec<Vec3> = valid
+            .iter()
+            .map(|&s| self.slots.position()[s as usize])
+            .collect();
+        self.grid_slots = photon::morton_order(&positions)
+            .into_iter()
+            .map(|i| valid[i as usize])
             .collect();
         let positions: Vec<Vec3> = self
             .grid_slots
@@ -484,43 +520,69 @@ impl<'s> PhotonMapper<'s> {
         let n = u64::from(self.params.photons_per_pass);
         let first_index = self.n_emitted;
         let clock = Instant::now();
-        let chunks: Vec<TracedPhotons> = (0..n.div_ceil(PHOTON_CHUNK))
-            .into_par_iter()
-            .map(|chunk| {
-                let start = chunk * PHOTON_CHUNK;
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let n_chunks = usize::try_from(n.div_ceil(PHOTON_CHUNK)).unwrap_or(usize::MAX);
+        scratch.traced.resize_with(n_chunks, TracedPhotons::default);
+        scratch
+            .traced
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(chunk, out)| {
+                out.clear();
+                let start = chunk as u64 * PHOTON_CHUNK;
                 let end = (start + PHOTON_CHUNK).min(n);
-                let mut out = TracedPhotons::default();
                 for idx in start..end {
-                    self.trace_photon(first_index + idx, &mut out);
+                    self.trace_photon(first_index + idx, out);
                 }
-                out
-            })
-            .collect();
+            });
         self.n_emitted += n;
 
-        let mut photons = Vec::new();
-        let mut frequency = Vec::new();
+        // The frequency photons, concatenated in trace order.
+        scratch.frequency.clear();
         let mut frequency_photons = 0;
-        for chunk in chunks {
-            photons.extend(chunk.photons);
-            frequency.extend(chunk.frequency);
+        for chunk in &scratch.traced {
+            scratch.frequency.extend(chunk.frequency.iter().map(
+                |&(photon, curvature, spectrum)| FrequencyPhoton {
+                    photon,
+                    curvature,
+                    spectrum,
+                },
+            ));
             frequency_photons += chunk.frequency_photons;
         }
         let trace_seconds = clock.elapsed().as_secs_f64();
-        let Some(grid) = &self.grid else {
-            return PassDeposits::empty(self.slots.len(), frequency_photons);
+        let n_slots = self.slots.len();
+        let mut deposits = PassDeposits {
+            count: std::mem::take(&mut scratch.count),
+            flux: std::mem::take(&mut scratch.flux),
+            photons_deposited: 0,
+            frequency_photons,
+            photons_stored: 0,
+            trace_seconds,
         };
-        let positions: Vec<Vec3> = photons.iter().map(|p| p.position).collect();
-        let sorted: Vec<Photon> = photon::morton_order(&positions)
-            .into_iter()
-            .map(|i| photons[i as usize])
-            .collect();
+        deposits.count.clear();
+        deposits.count.resize(n_slots, 0);
+        deposits.flux.clear();
+        deposits.flux.resize(n_slots, [0.0; 3]);
+        let Some(grid) = &self.grid else {
+            self.scratch = scratch;
+            return deposits;
+        };
+        // Morton order (of the photons' positions, ties in trace order).
+        photon::morton_sort(
+            &scratch.traced,
+            |p: &Photon| p.position,
+            &mut scratch.keys,
+            &mut scratch.sorted,
+        );
 
         let slots = &self.slots;
         let grid_slots = &self.grid_slots;
-        let per_entry: Vec<(u32, [f64; 3])> = photon::gather(
+        photon::gather_with::<Photon, _, _>(
+            &mut scratch.gather,
             grid,
-            &sorted,
+            &scratch.sorted,
+            &mut scratch.per_entry,
             grid_slots.len(),
             |photon, entry| {
                 let slot = grid_slots[entry as usize] as usize;
@@ -538,69 +600,73 @@ impl<'s> PhotonMapper<'s> {
                 acc.1[2] += f64::from(flux.z);
             },
         );
-        let mut deposits = PassDeposits::empty(self.slots.len(), frequency_photons);
-        deposits.trace_seconds = trace_seconds;
-        deposits.photons_stored = sorted.len() as u64;
-        for (entry, (m, phi)) in per_entry.into_iter().enumerate() {
+        deposits.photons_stored = scratch.sorted.len() as u64;
+        for (entry, &(m, phi)) in scratch.per_entry.iter().enumerate() {
             let slot = grid_slots[entry] as usize;
             deposits.count[slot] = m;
             deposits.flux[slot] = phi;
             deposits.photons_deposited += u64::from(m);
         }
 
-        // Frequency deposits: the queries run in parallel over fixed chunks; the merges (min or
-        // max per coefficient) do not depend on the order, and run serially.
+        // Frequency deposits, gathered like the flux: each grid entry merges the field of its
+        // frequency photons in photon order (the merges, a min or max per coefficient, do not
+        // depend on the order anyway), then that pass estimate is merged into the slot's. The
+        // photons are Morton-sorted like the flux photons: grid queries in random order are
+        // several times slower.
         let policy = self.params.freq_merge;
-        let estimates: Vec<Vec<(usize, Spectrum)>> = frequency
-            .par_chunks(FREQUENCY_CHUNK)
-            .map(|chunk| {
-                let mut out = Vec::new();
-                for (photon, curvature, spectrum) in chunk {
-                    grid.for_each_containing(photon.position, |entry| {
-                        let slot = grid_slots[entry as usize] as usize;
-                        if !self.accepts(photon, slot) {
-                            return;
-                        }
-                        let Some(material) = self.scene.material(slots.material_idx()[slot]) else {
-                            return;
-                        };
-                        // The field the hitpoint's radius reads (design §8.1): the photon's
-                        // spectrum reflected by the hitpoint's lobe, with μo = 1 so that a stays
-                        // in surface units (b does not depend on μo) and μi = 1 for the
-                        // conservative 3D collapse (§8.5: the out-of-plane axis keeps its width).
-                        let lobe = spectrum_lobe(material.kind.lobe());
-                        out.push((
-                            slot,
-                            spectrum.reflect_isotropic(
-                                1.0,
-                                f64::from(*curvature),
-                                lobe,
-                                &self.caps,
-                            ),
-                        ));
-                    });
+        photon::morton_sort(
+            &[&scratch.frequency[..]],
+            |p: &FrequencyPhoton| p.photon.position,
+            &mut scratch.keys,
+            &mut scratch.frequency_sorted,
+        );
+        photon::gather_with(
+            &mut scratch.frequency_gather,
+            grid,
+            &scratch.frequency_sorted,
+            &mut scratch.frequency_per_entry,
+            grid_slots.len(),
+            |photon: &FrequencyPhoton, entry| {
+                let slot = grid_slots[entry as usize] as usize;
+                if !self.accepts(&photon.photon, slot) {
+                    return None;
                 }
-                out
-            })
-            .collect();
+                let material = self.scene.material(slots.material_idx()[slot])?;
+                // The field the hitpoint's radius reads (design §8.1): the photon's spectrum
+                // reflected by the hitpoint's lobe, with μo = 1 so that a stays in surface units
+                // (b does not depend on μo) and μi = 1 for the conservative 3D collapse (§8.5:
+                // the out-of-plane axis keeps its width).
+                let lobe = spectrum_lobe(material.kind.lobe());
+                Some(photon.spectrum.reflect_isotropic(
+                    1.0,
+                    f64::from(photon.curvature),
+                    lobe,
+                    &self.caps,
+                ))
+            },
+            |acc: &mut FrequencyEstimate, spectrum| acc.deposit(spectrum, policy),
+        );
         let columns = self.slots.columns_mut();
-        for (slot, spectrum) in estimates.into_iter().flatten() {
-            columns.freq[slot].estimate.deposit(spectrum, policy);
-            columns.has_freq[slot] = true;
+        for (entry, estimate) in scratch.frequency_per_entry.iter().enumerate() {
+            if let Some(spectrum) = estimate.spectrum() {
+                let slot = grid_slots[entry] as usize;
+                columns.freq[slot].estimate.deposit(spectrum, policy);
+                columns.has_freq[slot] = true;
+            }
         }
+        self.scratch = scratch;
         deposits
     }
 
-    /// Whether `photon` counts for `slot`: the light path they make has at most `max_depth`
-    /// bounces, and the photon is inside the radius, on the hitpoint's side, with agreeing
-    /// normals (see `photon::accepts`).
+    /// Whether `photon`, which the grid reported for `slot` (so it lies within the slot's
+    /// radius: the grid's test is exactly that of `photon::accepts`), counts for it: the light
+    /// path they make has at most `max_depth` bounces, and the photon is on the hitpoint's
+    /// side, with agreeing normals (see `photon::faces`).
     fn accepts(&self, photon: &Photon, slot: usize) -> bool {
         photon.bounces <= u32::from(self.photon_bounces[slot])
-            && photon::accepts(
+            && photon::faces(
                 photon,
-                self.slots.position()[slot],
                 self.slots.geometric_normal()[slot],
-                self.slots.radius()[slot],
                 AcceptParams::COS_60,
             )
     }
@@ -879,6 +945,62 @@ struct TracedPhotons {
     frequency_photons: u64,
 }
 
+impl TracedPhotons {
+    /// Empties the chunk for the next pass, keeping the allocations.
+    fn clear(&mut self) {
+        self.photons.clear();
+        self.frequency.clear();
+        self.frequency_photons = 0;
+    }
+}
+
+impl AsRef<[Photon]> for TracedPhotons {
+    fn as_ref(&self) -> &[Photon] {
+        &self.photons
+    }
+}
+
+/// A frequency photon as the gather reads it: the stored photon, the curvature at its hit and
+/// its spectrum on arrival.
+#[derive(Clone, Copy)]
+struct FrequencyPhoton {
+    photon: Photon,
+    curvature: f32,
+    spectrum: Spectrum,
+}
+
+impl AsRef<Photon> for FrequencyPhoton {
+    fn as_ref(&self) -> &Photon {
+        &self.photon
+    }
+}
+
+/// The photon pass's buffers, kept from one pass to the next: a pass of a million photons
+/// fills about a hundred megabytes of them, which freshly allocated would cost page faults
+/// (10 % of a pass in the profile) and serial copies. None of it carries state between passes.
+#[derive(Default)]
+struct PhotonScratch {
+    /// Per chunk of [`PHOTON_CHUNK`] photon paths, what they stored.
+    traced: Vec<TracedPhotons>,
+    /// The frequency photons of all chunks, concatenated.
+    frequency: Vec<FrequencyPhoton>,
+    /// The same in Morton order.
+    frequency_sorted: Vec<FrequencyPhoton>,
+    /// Morton keys of the stored photons.
+    keys: MortonScratch,
+    /// The stored photons in Morton order.
+    sorted: Vec<Photon>,
+    gather: GatherScratch<Rgb>,
+    /// Per grid entry: M and Φ of the pass.
+    per_entry: Vec<(u32, [f64; 3])>,
+    frequency_gather: GatherScratch<Spectrum>,
+    /// Per grid entry: the merged frequency deposits of the pass.
+    frequency_per_entry: Vec<FrequencyEstimate>,
+    /// Per slot M and Φ, lent to [`PassDeposits`] during a pass.
+    count: Vec<u32>,
+    flux: Vec<[f64; 3]>,
+}
+
 /// What one photon pass brings to each hitpoint slot: M and Φ.
 struct PassDeposits {
     count: Vec<u32>,
@@ -887,19 +1009,6 @@ struct PassDeposits {
     frequency_photons: u64,
     photons_stored: u64,
     trace_seconds: f64,
-}
-
-impl PassDeposits {
-    fn empty(n_slots: usize, frequency_photons: u64) -> Self {
-        Self {
-            count: vec![0; n_slots],
-            flux: vec![[0.0; 3]; n_slots],
-            photons_deposited: 0,
-            frequency_photons,
-            photons_stored: 0,
-            trace_seconds: 0.0,
-        }
-    }
 }
 
 /// Veach's correction for shading normals on light paths (thesis §5.3; pbrt's
