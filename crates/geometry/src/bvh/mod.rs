@@ -32,7 +32,7 @@ use obvhs::{BvhBuildParams, aabb::Aabb as BvhAabb, bvh2::builder::build_bvh2};
 
 use crate::{Cylinder, Ray, Sphere, Triangle};
 use prim::{CylGeom, PrimRay, Ray4, SphereGeom, TriGeom, TriPack};
-use wide::{BoxRay, Leaf, Wide};
+use wide::{BoxRay, Leaf, Leaves, Wide};
 
 /// The power of two that brings the largest coordinate magnitude of the scene to [2⁹, 2¹⁰).
 ///
@@ -114,6 +114,27 @@ pub(crate) struct Accel {
     scale: f32,
     /// Number of primitives in the BVH.
     len: usize,
+}
+
+/// One ray's query of the leaves: the ray in the forms the primitive tests take, and the slot of
+/// the closest hit so far.
+struct Query<'a> {
+    accel: &'a Accel,
+    rays: (PrimRay, Ray4),
+    closest: Option<usize>,
+}
+
+impl Leaves for Query<'_> {
+    #[inline(always)]
+    fn closest(&mut self, leaf: Leaf, tmax: &mut f32) {
+        self.accel
+            .leaf_closest(&self.rays, leaf, tmax, &mut self.closest);
+    }
+
+    #[inline(always)]
+    fn any(&self, leaf: Leaf, tmax: f32) -> bool {
+        self.accel.leaf_any(&self.rays, leaf, tmax)
+    }
 }
 
 /// obvhs build settings: `fast_build` (PLOC with a short search, 2 % reinsertion) with leaves of
@@ -295,11 +316,13 @@ impl Accel {
     pub(crate) fn intersect(&self, ray: &Ray) -> Option<RawHit> {
         let bvh = self.bvh.as_ref()?;
         let (rays, box_ray, mut tmax) = self.internal_ray(ray)?;
-        let mut closest = None;
-        bvh.closest(&box_ray, &mut tmax, |leaf, tmax| {
-            self.leaf_closest(&rays, leaf, tmax, &mut closest);
-        });
-        let slot = closest?;
+        let mut query = Query {
+            accel: self,
+            rays,
+            closest: None,
+        };
+        bvh.closest(&box_ray, &mut tmax, &mut query);
+        let slot = query.closest?;
         let t = tmax / self.scale;
         let id = self.ids[slot];
         Some(if id & SPHERE_BIT != 0 {
@@ -333,7 +356,12 @@ impl Accel {
         let Some((rays, box_ray, tmax)) = self.internal_ray(ray) else {
             return false;
         };
-        bvh.any(&box_ray, tmax, |leaf| self.leaf_any(&rays, leaf, tmax))
+        let query = Query {
+            accel: self,
+            rays,
+            closest: None,
+        };
+        bvh.any(&box_ray, tmax, &query)
     }
 
     /// Number of primitives in the BVH.

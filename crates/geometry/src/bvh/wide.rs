@@ -40,6 +40,15 @@ const STACK_SMALL: usize = 64;
 /// Capacity of the on-stack traversal stack of deep trees; deeper ones use a heap stack.
 const STACK_LARGE: usize = 256;
 
+/// The primitive tests of the leaves, as the traversals call them. A trait rather than closures so
+/// that the calls are inlined into the traversal loop (a closure was not, measurably).
+pub(super) trait Leaves {
+    /// Lowers `tmax` to the closest hit in `leaf` below it, if any.
+    fn closest(&mut self, leaf: Leaf, tmax: &mut f32);
+    /// Whether anything in `leaf` is hit below `tmax`.
+    fn any(&self, leaf: Leaf, tmax: f32) -> bool;
+}
+
 /// A leaf as the traversal hands it over: its number (in [`Wide::leaves`]) and whether it holds
 /// anything but triangles.
 #[derive(Clone, Copy, Debug)]
@@ -90,7 +99,8 @@ impl Node {
         self.children[slot] = child;
     }
 
-    /// The mask of the child boxes the ray enters within [tmin, tmax], and their entry distances.
+    /// The mask of the child boxes the ray enters within [tmin, tmax], and their entry distances
+    /// (∞ for the others).
     ///
     /// Slab distances are (bound − origin) · (1 / direction). A zero direction component gives an
     /// infinite inverse, and NaN where the origin lies exactly on a bound; NaN then either culls
@@ -112,17 +122,12 @@ impl Node {
             let tz1 = (b(4 + ((sz ^ 1) & 1)) - ray.origin[2]) * ray.inv_dir[2];
             let tnear = tx0.max(ty0).max(tz0).max(ray.tmin);
             let tfar = (tx1.min(ty1).min(tz1) * ROBUST_EXIT).min(tmax);
-            mask |= tnear.cmple(tfar).bitmask() << (4 * g);
-            *entry = tnear;
+            let hit = tnear.cmple(tfar);
+            mask |= hit.bitmask() << (4 * g);
+            *entry = Vec4::select(hit, tnear, Vec4::INFINITY);
         }
         (mask, entry)
     }
-}
-
-/// Lane `i` of the entry distances of [`Node::intersect`].
-#[inline(always)]
-fn lane(entry: &[Vec4; HALVES], i: usize) -> f32 {
-    entry[i / 4][i % 4]
 }
 
 /// A ray prepared for the box tests: origin and inverse direction splatted over the lanes, and
@@ -165,8 +170,6 @@ type Entry = (u32, f32);
 trait Stack {
     fn push(&mut self, e: Entry);
     fn pop(&mut self) -> Option<Entry>;
-    /// The top `n` entries, to be sorted in place.
-    fn top_mut(&mut self, n: usize) -> &mut [Entry];
 }
 
 /// A fixed-capacity stack; [`Wide::stack_need`] guarantees it cannot overflow.
@@ -197,11 +200,6 @@ impl<const N: usize> Stack for ArrayStack<N> {
         self.len = self.len.checked_sub(1)?;
         Some(self.items[self.len])
     }
-
-    #[inline(always)]
-    fn top_mut(&mut self, n: usize) -> &mut [Entry] {
-        &mut self.items[self.len - n..self.len]
-    }
 }
 
 impl Stack for Vec<Entry> {
@@ -211,11 +209,6 @@ impl Stack for Vec<Entry> {
 
     fn pop(&mut self) -> Option<Entry> {
         Vec::pop(self)
-    }
-
-    fn top_mut(&mut self, n: usize) -> &mut [Entry] {
-        let len = self.len();
-        &mut self[len - n..]
     }
 }
 
@@ -374,7 +367,7 @@ impl Wide {
     /// upper bound and lowers it on a hit; nodes are visited nearest first, and those
     /// entered beyond the bound are skipped.
     #[inline(always)]
-    pub(super) fn closest(&self, ray: &BoxRay, tmax: &mut f32, leaf: impl FnMut(Leaf, &mut f32)) {
+    pub(super) fn closest(&self, ray: &BoxRay, tmax: &mut f32, leaf: &mut impl Leaves) {
         if self.stack_need <= STACK_SMALL {
             self.closest_with(&mut ArrayStack::<STACK_SMALL>::new(), ray, tmax, leaf);
         } else if self.stack_need <= STACK_LARGE {
@@ -390,51 +383,32 @@ impl Wide {
         stack: &mut impl Stack,
         ray: &BoxRay,
         tmax: &mut f32,
-        mut leaf: impl FnMut(Leaf, &mut f32),
+        leaves: &mut impl Leaves,
     ) {
         let mut current = self.root;
         loop {
             if current & LEAF_BIT != 0 {
-                leaf(leaf_of(current), tmax);
+                leaves.closest(leaf_of(current), tmax);
             } else {
                 let node = &self.nodes[current as usize];
                 let (mut mask, tnear) = node.intersect(ray, *tmax);
                 if mask != 0 {
                     let first = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    if mask == 0 {
+                    if mask & (mask - 1) == 0 {
                         current = node.children[first];
                         continue;
                     }
-                    let second = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    let (t0, t1) = (lane(&tnear, first), lane(&tnear, second));
-                    if mask == 0 {
-                        // Two (the common case): continue with the nearer, push the farther.
-                        let (near, far, t_far) = if t0 <= t1 {
-                            (first, second, t1)
-                        } else {
-                            (second, first, t0)
-                        };
-                        stack.push((node.children[far], t_far));
-                        current = node.children[near];
-                        continue;
-                    }
-                    // More: push them all, nearest on top, and continue with the nearest.
-                    stack.push((node.children[first], t0));
-                    stack.push((node.children[second], t1));
-                    let mut pushed = 2;
+                    // Two or more: continue with the nearest, push the others (in lane order:
+                    // sorting them cost more than it saved, measured).
+                    let (nearest, entry) = nearest_lane(&tnear);
+                    mask &= !(1 << nearest);
                     while mask != 0 {
                         let i = mask.trailing_zeros() as usize;
                         mask &= mask - 1;
-                        stack.push((node.children[i], lane(&tnear, i)));
-                        pushed += 1;
+                        stack.push((node.children[i], entry[i]));
                     }
-                    sort_descending(stack.top_mut(pushed));
-                    if let Some((c, _)) = stack.pop() {
-                        current = c;
-                        continue;
-                    }
+                    current = node.children[nearest];
+                    continue;
                 }
             }
             // Next subtree that the ray still enters before the closest hit so far.
@@ -452,7 +426,7 @@ impl Wide {
 
     /// Any-hit traversal: stops as soon as `leaf` reports a hit within [tmin, tmax].
     #[inline(always)]
-    pub(super) fn any(&self, ray: &BoxRay, tmax: f32, leaf: impl FnMut(Leaf) -> bool) -> bool {
+    pub(super) fn any(&self, ray: &BoxRay, tmax: f32, leaf: &impl Leaves) -> bool {
         if self.stack_need <= STACK_SMALL {
             self.any_with(&mut ArrayStack::<STACK_SMALL>::new(), ray, tmax, leaf)
         } else if self.stack_need <= STACK_LARGE {
@@ -468,12 +442,12 @@ impl Wide {
         stack: &mut impl Stack,
         ray: &BoxRay,
         tmax: f32,
-        mut leaf: impl FnMut(Leaf) -> bool,
+        leaves: &impl Leaves,
     ) -> bool {
         let mut current = self.root;
         loop {
             if current & LEAF_BIT != 0 {
-                if leaf(leaf_of(current)) {
+                if leaves.any(leaf_of(current), tmax) {
                     return true;
                 }
             } else {
@@ -498,14 +472,22 @@ impl Wide {
     }
 }
 
-/// Insertion sort of three to [`WIDTH`] entries by decreasing entry distance.
+/// The lane of smallest entry distance (the first such lane on ties) in the output of
+/// [`Node::intersect`], and the entry distances as an array.
 #[inline(always)]
-fn sort_descending(entries: &mut [Entry]) {
-    for i in 1..entries.len() {
-        let mut j = i;
-        while j > 0 && entries[j - 1].1 < entries[j].1 {
-            entries.swap(j - 1, j);
-            j -= 1;
+fn nearest_lane(entries: &[Vec4; HALVES]) -> (usize, [f32; WIDTH]) {
+    let min = entries
+        .iter()
+        .fold(Vec4::INFINITY, |a, &b| a.min(b))
+        .min_element();
+    let mut at = 0;
+    let mut array = [0.0; WIDTH];
+    for (g, t) in entries.iter().enumerate().rev() {
+        let eq = t.cmpeq(Vec4::splat(min)).bitmask();
+        if eq != 0 {
+            at = 4 * g + eq.trailing_zeros() as usize;
         }
+        array[4 * g..4 * g + 4].copy_from_slice(&t.to_array());
     }
+    (at, array)
 }
