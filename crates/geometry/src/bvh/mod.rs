@@ -7,10 +7,11 @@
 //! spheres and cylinders one by one. obvhs types never leave this module.
 //!
 //! This replaced traversal of obvhs' `CwBvh`, whose compressed 8-wide nodes (a GPU layout) are
-//! decoded per node on the CPU. Measured in `benches/bvh.rs` (CPU time of one thread, old and new
-//! side by side): on the bunny, diffuse-bounce closest hits ~1.45× and any hits ~1.9× faster,
-//! primary rays ~1.3×; the 1M-triangle build (with the collapse and the layout) takes ~0.7 s
-//! instead of ~1.3 s.
+//! decoded per node on the CPU. Measured with `benches/bvh.rs`, old and new binaries alternating,
+//! best of 3 runs, rays per CPU-second of one thread (a shared 2-core machine): bunny
+//! diffuse-bounce closest hits 3.7 M/s (×1.7), occluded 4.5 M/s (×1.9), primary 8.0 M/s (×1.5);
+//! MetalRoughSpheres (1M triangles) bounce closest hits 1.6 M/s (×1.5) and `Scene::new` 0.63 s
+//! instead of 1.06 s (×1.7), the collapse and the leaf layout included.
 //!
 //! Exactness: the box test is conservative (exit distances are widened by 1 + 2γ₃, and every
 //! primitive's box is padded by a few ulps so that no primitive touches a box face), so the BVH
@@ -143,8 +144,9 @@ impl Leaves for Query<'_> {
 /// Measured with `benches/bvh.rs` (1 thread, CPU time): on the 1M-triangle MetalRoughSpheres,
 /// `fast` builds in about 0.7 s with 1.4 M diffuse-bounce rays/s; `very_fast_build` saves
 /// ~0.1 s but traces 10 % slower, `fastest_build` (no reinsertion) saved nothing overall and
-/// traces 20–30 % slower, and `medium_build` costs ~0.1 s more for no measurable speed-up. On the bunny, the traversal
-/// cost parameter of the leaf collapse (3 to 20) made no difference; leaves of at most 2 or 1
+/// traces 20–30 % slower, and `medium_build` costs ~0.1 s more for no measurable speed-up. On
+/// the bunny, neither the traversal cost parameter of the leaf collapse (3 to 20) nor leaves of
+/// up to 8 primitives (two packs) made a measurable difference; leaves of at most 2 or 1
 /// primitives were 10 % and 45 % slower.
 fn build_params() -> BvhBuildParams {
     BvhBuildParams {
