@@ -259,3 +259,47 @@ fn large_scene() {
         .count();
     assert!(sphere_hits > 0 && accel.ids.iter().any(|id| id & SPHERE_BIT != 0));
 }
+
+/// A leaf larger than a pack (obvhs makes none with our settings) becomes a node of small leaves
+/// under the same box, all of which a ray through the box reaches.
+#[test]
+fn oversized_leaves_are_split() {
+    use super::wide::{BoxRay, Leaves, MAX_LEAF_PRIMS, Wide};
+    use glam::Vec3A;
+    use obvhs::{aabb::Aabb, bvh2::Bvh2, bvh2::node::Bvh2Node};
+
+    struct Visited(Vec<usize>);
+    impl Leaves for Visited {
+        fn closest(&mut self, leaf: Leaf, _: &mut f32) {
+            self.0.push(leaf.index);
+        }
+        fn any(&self, _: Leaf, _: f32) -> bool {
+            false
+        }
+    }
+
+    let aabb = Aabb::new(Vec3A::ZERO, Vec3A::ONE);
+    for count in [5, 20, 70] {
+        let bvh2 = Bvh2 {
+            nodes: vec![Bvh2Node::new(aabb, count, 0)],
+            primitive_indices: (0..count).collect(),
+            ..Default::default()
+        };
+        let wide = Wide::from_bvh2(&bvh2, &|_, _| false);
+        let mut covered = vec![false; count as usize];
+        for &(first, n) in &wide.leaves {
+            assert!((1..=MAX_LEAF_PRIMS).contains(&n));
+            for i in first..first + n {
+                assert!(!std::mem::replace(&mut covered[i as usize], true));
+            }
+        }
+        assert!(covered.iter().all(|&c| c), "{count}");
+        let ray = BoxRay::new(Vec3A::new(0.5, 0.5, -1.0), Vec3A::Z, 0.0);
+        let mut visited = Visited(Vec::new());
+        let mut tmax = f32::INFINITY;
+        wide.closest(&ray, &mut tmax, &mut visited);
+        visited.0.sort_unstable();
+        assert_eq!(visited.0, (0..wide.leaves.len()).collect::<Vec<_>>());
+        assert!(!wide.any(&ray, f32::INFINITY, &visited));
+    }
+}
