@@ -1,5 +1,9 @@
 //! BVH build time and closest-hit throughput (rays/s) on 1 and 2 threads.
 //!
+//! Throughput is given per second of wall time and per CPU-second (the CPU time of the pool's
+//! threads, from `/proc`): on a shared machine the latter stays close to the idle per-core rate when the
+//! former does not. On an idle machine the two agree for one thread.
+//!
 //! `cargo bench -p geometry` (scenes from `../shared/scenes` beside the checkout, or the paths given as arguments).
 #![allow(clippy::unwrap_used, clippy::print_stdout, missing_docs)]
 
@@ -10,14 +14,29 @@ use std::{path::PathBuf, time::Instant};
 use geometry::{Ray, Scene};
 use rayon::prelude::*;
 
-fn throughput(scene: &Scene, rays: &[Ray], threads: usize, shadow: bool) -> (f64, usize) {
+/// CPU time consumed so far by the calling thread, in seconds (Linux: the first field of
+/// `/proc/thread-self/schedstat`, in nanoseconds); `None` elsewhere.
+fn thread_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    Some(stat.split_whitespace().next()?.parse::<f64>().ok()? * 1e-9)
+}
+
+/// CPU time consumed so far by the threads of `pool`, in seconds.
+fn pool_cpu_seconds(pool: &rayon::ThreadPool) -> Option<f64> {
+    pool.broadcast(|_| thread_cpu_seconds()).into_iter().sum()
+}
+
+/// Best-of-3 throughput in Mrays/s of wall time and in Mrays per CPU-second (the per-core rate,
+/// which other work on a shared machine disturbs far less), and the number of hits.
+fn throughput(scene: &Scene, rays: &[Ray], threads: usize, shadow: bool) -> (f64, f64, usize) {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .unwrap();
-    let mut best = f64::INFINITY;
+    let (mut best, mut best_cpu) = (f64::INFINITY, f64::INFINITY);
     let mut hits = 0;
     for _ in 0..3 {
+        let cpu = pool_cpu_seconds(&pool);
         let start = Instant::now();
         hits = pool.install(|| {
             rays.par_chunks(4096)
@@ -34,8 +53,12 @@ fn throughput(scene: &Scene, rays: &[Ray], threads: usize, shadow: bool) -> (f64
                 .sum()
         });
         best = best.min(start.elapsed().as_secs_f64());
+        if let (Some(before), Some(after)) = (cpu, pool_cpu_seconds(&pool)) {
+            best_cpu = best_cpu.min(after - before);
+        }
     }
-    (rays.len() as f64 / best / 1e6, hits)
+    let n = rays.len() as f64 / 1e6;
+    (n / best, n / best_cpu, hits)
 }
 
 fn main() {
@@ -81,9 +104,9 @@ fn main() {
             ("diffuse-bounce occluded", &bounce, true),
         ] {
             for threads in [1, 2] {
-                let (mrays, hits) = throughput(&scene, rays, threads, shadow);
+                let (mrays, per_cpu, hits) = throughput(&scene, rays, threads, shadow);
                 println!(
-                    "  {name:28} {threads} thread(s): {mrays:6.2} Mrays/s ({} rays, {:.1} % hit)",
+                    "  {name:28} {threads} thread(s): {mrays:6.2} Mrays/s, {per_cpu:6.2} Mrays/CPU-s ({} rays, {:.1} % hit)",
                     rays.len(),
                     100.0 * hits as f64 / rays.len() as f64
                 );

@@ -1,5 +1,7 @@
-//! Compares obvhs layouts and build presets on the same ray sets (triangles only, RtTriangle):
-//! the measurements behind the choice made in `src/bvh.rs`. `cargo bench -p geometry --bench bvh_variants`.
+//! Compares obvhs' own layouts and build presets (triangles only, RtTriangle) with ours
+//! (`Scene::intersect` / `Scene::occluded`, i.e. `src/bvh/`) on the same ray sets, single-threaded:
+//! the measurements behind the choice made in `src/bvh/mod.rs`.
+//! `cargo bench -p geometry --bench bvh_variants`.
 #![allow(clippy::unwrap_used, clippy::print_stdout, missing_docs)]
 
 mod common;
@@ -54,6 +56,27 @@ fn main() {
             .map(|r| BRay::new_inf(r.origin.into(), Vec3A::from(r.direction) + Vec3A::ZERO))
             .collect()
     };
+    let ours = |rays: &[Ray], shadow: bool| {
+        let mut best = f64::INFINITY;
+        for _ in 0..3 {
+            let start = Instant::now();
+            let n = if shadow {
+                rays.iter().filter(|r| scene.occluded(r)).count()
+            } else {
+                rays.iter().filter(|r| scene.intersect(r).is_some()).count()
+            };
+            std::hint::black_box(n);
+            best = best.min(start.elapsed().as_secs_f64());
+        }
+        rays.len() as f64 / best / 1e6
+    };
+    for (set, rays) in [("primary", &primary), ("bounce", &bounce)] {
+        println!(
+            "bunny ours (Scene): {set:7} closest {:5.2} Mrays/s; occluded {:5.2}",
+            ours(rays, false),
+            ours(rays, true)
+        );
+    }
     let (primary, bounce) = (conv(&primary), conv(&bounce));
     for (name, params) in [
         ("fast", BvhBuildParams::fast_build()),

@@ -2,7 +2,7 @@
 //!
 //! The principal type is [`Scene`], built from a plain [`SceneDescription`] by [`Scene::new`].
 //! It answers closest-hit ([`Scene::intersect`]) and shadow ([`Scene::occluded`], [`Scene::visible`])
-//! queries through one obvhs CwBvh over triangles, analytic spheres and analytic open cylinders
+//! queries through one BVH over triangles, analytic spheres and analytic open cylinders
 //! (a scene-format extension, `docs/scene-format-extensions.md`), and owns the
 //! [`CameraModel`] and the [`LightSampler`]. Materials become [`Bsdf`]s at a [`Hit`].
 //!
@@ -20,8 +20,8 @@
 //!   floating-point error bound, so they neither re-hit their surface nor slip through corners.
 //! - Refraction scales radiance by 1/η′² on camera paths only ([`TransportMode`]).
 //!
-//! The BVH works around two obvhs 0.4 limitations: `-0.0` direction components (crates.md G1) and
-//! the CwBvh's culling of boxes a ray leaves within t < 10⁻⁴ (see `bvh.rs`).
+//! obvhs builds the BVH; the crate collapses it into its own 8-wide SIMD layout for traversal
+//! (see `bvh/mod.rs`), which is exact: it never culls a primitive the ray meets.
 //!
 //! The loaders turn a scene file into a plain [`SceneDescription`]:
 //! [`load`] picks the loader by extension (`.toml` scene files of format version 1, lone

@@ -296,8 +296,8 @@ impl Scene {
         let position_error = gamma(7.0) * ((b0 * p0).abs() + (b1 * p1).abs() + (b2 * p2).abs());
         // Nudge the point toward the centroid by the size of its error bound, so that a hit on an edge
         // does not sit on the plane of an adjacent wall, from where a spawned ray could slip through the
-        // corner (obvhs skips nodes closer than t ≈ 1.2e-7). Then clamp it to the triangle's bounding
-        // box, so that points on axis-aligned walls stay exactly on them.
+        // corner. Then clamp it to the triangle's bounding box, so that points on axis-aligned walls
+        // stay exactly on them.
         let mut position = b0 * p0 + b1 * p1 + b2 * p2;
         let to_centroid = (p0 + p1 + p2) / 3.0 - position;
         let len = to_centroid.length();

@@ -1,0 +1,270 @@
+//! Primitive data in BVH order and the ray–primitive tests (in internal, scaled coordinates).
+
+use glam::{Vec3, Vec3A, Vec4};
+
+use crate::{Cylinder, Sphere};
+
+/// A ray as the primitive tests see it; the upper end of the interval is passed separately, since
+/// it shrinks during a closest-hit traversal.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PrimRay {
+    pub(super) origin: Vec3A,
+    /// Unit direction.
+    pub(super) direction: Vec3A,
+    /// Lower end of the ray interval (0: hits at the origin count for triangles).
+    pub(super) tmin: f32,
+}
+
+/// A triangle as obvhs' `RtTriangle` stores it: v0, e1 = v0 − v1, e2 = v2 − v0 (the normal
+/// ng = e1 × e2 is computed where needed).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct TriGeom {
+    pub(super) v0: Vec3A,
+    pub(super) e1: Vec3A,
+    pub(super) e2: Vec3A,
+}
+
+impl TriGeom {
+    pub(super) fn new(p: [Vec3; 3]) -> Self {
+        let v0 = Vec3A::from(p[0]);
+        Self {
+            v0,
+            e1: v0 - Vec3A::from(p[1]),
+            e2: Vec3A::from(p[2]) - v0,
+        }
+    }
+
+    /// Whether the triangle has a finite, non-zero normal (others never enter the BVH).
+    pub(super) fn is_proper(&self) -> bool {
+        let ng = self.e1.cross(self.e2);
+        ng.is_finite() && ng != Vec3A::ZERO
+    }
+
+    /// Barycentrics (weight of v1, weight of v2) of the ray's hit with the triangle's plane.
+    pub(super) fn barycentrics(&self, origin: Vec3A, direction: Vec3A) -> (f32, f32) {
+        let c = self.v0 - origin;
+        let r = direction.cross(c);
+        let inv_det = 1.0 / self.e1.cross(self.e2).dot(direction);
+        (r.dot(self.e2) * inv_det, r.dot(self.e1) * inv_det)
+    }
+}
+
+/// A sphere in internal (scaled) coordinates.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SphereGeom {
+    center: Vec3A,
+    radius2: f32,
+}
+
+impl SphereGeom {
+    pub(super) fn new(s: &Sphere, scale: f32) -> Self {
+        let radius = s.radius * scale;
+        Self {
+            center: Vec3A::from(s.center * scale),
+            radius2: radius * radius,
+        }
+    }
+
+    /// Closest root in (tmin, tmax) of |o + t·d − c|² = r² for a unit `d` (the Ray Tracing Gems
+    /// ch. 7 form), or ∞.
+    #[inline(always)]
+    pub(super) fn intersect(&self, ray: &PrimRay, tmax: f32) -> f32 {
+        let f = ray.origin - self.center;
+        let b = -f.dot(ray.direction);
+        let l = f + b * ray.direction;
+        let disc = self.radius2 - l.length_squared();
+        if disc < 0.0 {
+            return f32::INFINITY;
+        }
+        let c = f.length_squared() - self.radius2;
+        let q = b + disc.sqrt().copysign(b);
+        if q == 0.0 {
+            return f32::INFINITY;
+        }
+        let (t0, t1) = {
+            let a = c / q;
+            if a < q { (a, q) } else { (q, a) }
+        };
+        if t0 > ray.tmin && t0 < tmax {
+            t0
+        } else if t1 > ray.tmin && t1 < tmax {
+            t1
+        } else {
+            f32::INFINITY
+        }
+    }
+}
+
+/// The ray splatted over four lanes, for [`TriPack::intersect`].
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Ray4 {
+    origin: [Vec4; 3],
+    direction: [Vec4; 3],
+    tmin: Vec4,
+}
+
+impl Ray4 {
+    pub(super) fn new(ray: &PrimRay) -> Self {
+        let (o, d) = (ray.origin, ray.direction);
+        Self {
+            origin: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
+            direction: [Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z)],
+            tmin: Vec4::splat(ray.tmin),
+        }
+    }
+}
+
+/// The triangles of one leaf in SoA form (144 bytes), tested together: lane i holds v0, e1 and e2
+/// of a [`TriGeom`] by axis. Lanes without a triangle have a NaN `v0`, which fails every
+/// comparison of the test.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct TriPack {
+    v0: [Vec4; 3],
+    e1: [Vec4; 3],
+    e2: [Vec4; 3],
+}
+
+impl TriPack {
+    /// A pack with no triangle.
+    pub(super) const EMPTY: Self = Self {
+        v0: [Vec4::NAN; 3],
+        e1: [Vec4::ZERO; 3],
+        e2: [Vec4::ZERO; 3],
+    };
+
+    /// Puts the triangle `g` into `lane`.
+    pub(super) fn set(&mut self, lane: usize, g: &TriGeom) {
+        for axis in 0..3 {
+            self.v0[axis][lane] = g.v0[axis];
+            self.e1[axis][lane] = g.e1[axis];
+            self.e2[axis][lane] = g.e2[axis];
+        }
+    }
+
+    /// The triangle in `lane`.
+    pub(super) fn get(&self, lane: usize) -> TriGeom {
+        let v = |rows: &[Vec4; 3]| Vec3A::new(rows[0][lane], rows[1][lane], rows[2][lane]);
+        TriGeom {
+            v0: v(&self.v0),
+            e1: v(&self.e1),
+            e2: v(&self.e2),
+        }
+    }
+
+    /// Möller–Trumbore in the form of obvhs' `RtTriangle::intersect` (ng = e1 × e2, computed here
+    /// rather than stored, which saves a cache line per leaf), with inclusive edges, on four
+    /// triangles at once: per lane t in [tmin, tmax), ∞ elsewhere.
+    #[inline(always)]
+    pub(super) fn intersect(&self, ray: &Ray4, tmax: f32) -> Vec4 {
+        let [ox, oy, oz] = ray.origin;
+        let [dx, dy, dz] = ray.direction;
+        let [ax, ay, az] = self.e1;
+        let [bx, by, bz] = self.e2;
+        let (cx, cy, cz) = (self.v0[0] - ox, self.v0[1] - oy, self.v0[2] - oz);
+        // r = d × c and ng = e1 × e2.
+        let (rx, ry, rz) = (dy * cz - dz * cy, dz * cx - dx * cz, dx * cy - dy * cx);
+        let (nx, ny, nz) = (ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx);
+        let inv_det = Vec4::ONE / (nx * dx + ny * dy + nz * dz);
+        let u = (rx * bx + ry * by + rz * bz) * inv_det;
+        let v = (rx * ax + ry * ay + rz * az) * inv_det;
+        let w = Vec4::ONE - u - v;
+        let t = (nx * cx + ny * cy + nz * cz) * inv_det;
+        // t = tmin counts: spawned origins sit strictly off their own surface, but may lie
+        // exactly on an adjacent wall at a corner, and must not slip through it.
+        let hit = u.cmpge(Vec4::ZERO)
+            & v.cmpge(Vec4::ZERO)
+            & w.cmpge(Vec4::ZERO)
+            & inv_det.is_finite_mask()
+            & t.cmpge(ray.tmin)
+            & t.cmplt(Vec4::splat(tmax));
+        Vec4::select(hit, t, Vec4::INFINITY)
+    }
+}
+
+/// A cylinder in internal (scaled) coordinates.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct CylGeom {
+    /// Centre of the bottom circle.
+    center: Vec3A,
+    /// Unit axis.
+    axis: Vec3A,
+    /// Unit vector perpendicular to the axis on which the kept arc is centred.
+    facing: Vec3A,
+    radius: f32,
+    height: f32,
+    /// cos(arc / 2); below −1 for a whole circle.
+    cos_half_arc: f32,
+}
+
+impl CylGeom {
+    pub(super) fn new(c: &Cylinder, scale: f32) -> Self {
+        Self {
+            center: Vec3A::from(c.center * scale),
+            axis: Vec3A::from(c.axis),
+            facing: Vec3A::from(c.facing),
+            radius: c.radius * scale,
+            height: c.height * scale,
+            cos_half_arc: if c.arc >= std::f32::consts::TAU {
+                -2.0
+            } else {
+                (0.5 * c.arc).cos()
+            },
+        }
+    }
+
+    /// Closest root in (tmin, tmax) of the open cylinder that lies within its height and arc, or ∞.
+    ///
+    /// With f = o − c split into f⊥ + fₐ·a (and likewise d), the roots of |f⊥ + t·d⊥|² = r² are
+    /// t = (b ± √disc)/A with A = |d⊥|², b = −f⊥·d⊥ and disc = A·(r² − |l|²), l = f⊥ + (b/A)·d⊥
+    /// the point of closest approach to the axis (the stable form of the sphere's test); both roots
+    /// are tried, nearer first, against the height and arc ranges.
+    #[inline(always)]
+    pub(super) fn intersect(&self, ray: &PrimRay, tmax: f32) -> f32 {
+        let a = self.axis;
+        let f = ray.origin - self.center;
+        let d = ray.direction;
+        let fa = f.dot(a);
+        let da = d.dot(a);
+        let fp = f - fa * a;
+        let dp = d - da * a;
+        let aa = dp.length_squared();
+        if aa.is_nan() || aa <= 0.0 {
+            // Parallel to the axis: an open cylinder is never crossed.
+            return f32::INFINITY;
+        }
+        let r2 = self.radius * self.radius;
+        let b = -fp.dot(dp);
+        let l = fp + (b / aa) * dp;
+        let disc = aa * (r2 - l.length_squared());
+        if disc.is_nan() || disc < 0.0 {
+            return f32::INFINITY;
+        }
+        let c = fp.length_squared() - r2;
+        let q = b + disc.sqrt().copysign(b);
+        if q == 0.0 {
+            return f32::INFINITY;
+        }
+        let (t0, t1) = {
+            let x = c / q;
+            let y = q / aa;
+            if x < y { (x, y) } else { (y, x) }
+        };
+        for t in [t0, t1] {
+            if !(t > ray.tmin && t < tmax) {
+                continue;
+            }
+            let s = fa + t * da;
+            if !(s >= 0.0 && s <= self.height) {
+                continue;
+            }
+            if self.cos_half_arc >= -1.0 {
+                let radial = fp + t * dp;
+                if radial.dot(self.facing) < self.cos_half_arc * radial.length() {
+                    continue;
+                }
+            }
+            return t;
+        }
+        f32::INFINITY
+    }
+}
