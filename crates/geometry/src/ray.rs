@@ -18,7 +18,8 @@ pub struct Ray {
 
 impl Ray {
     /// A ray with a normalised `direction` whose `-0.0` components are turned into `+0.0`
-    /// (obvhs' CwBvh traversal misses hits for `-0.0` components, gotcha G1 in crates.md).
+    /// (kept from when obvhs' CwBvh traversal, which misses hits for `-0.0` components, gotcha
+    /// G1 in crates.md, ran the queries; our own traversal in `bvh/wide.rs` handles both).
     ///
     /// A zero or non-finite `direction` yields a non-finite direction, and queries then report no hit.
     #[inline]

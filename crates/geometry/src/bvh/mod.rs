@@ -162,6 +162,9 @@ fn padded(lo: Vec3A, hi: Vec3A) -> BvhAabb {
     BvhAabb::new(lo - pad(lo), hi + pad(hi))
 }
 
+/// Primitives per scene must stay below this (ids keep two tag bits); `Scene::new` checks it.
+pub(crate) const MAX_PRIMITIVES: usize = CYLINDER_BIT as usize;
+
 impl Accel {
     /// Builds the BVH over every non-degenerate triangle, every sphere and every cylinder.
     pub(crate) fn build(
@@ -171,10 +174,7 @@ impl Accel {
     ) -> Self {
         let scale = internal_scale(triangles, spheres, cylinders);
         let n = triangles.len() + spheres.len() + cylinders.len();
-        assert!(
-            n < CYLINDER_BIT as usize,
-            "at most 2^30 primitives per scene"
-        );
+        assert!(n < MAX_PRIMITIVES, "Scene::new checks the primitive count");
         let internal = |tri: &Triangle| tri.positions.map(|v| v * scale);
         let mut ids = Vec::with_capacity(n);
         let mut aabbs = Vec::with_capacity(n);

@@ -189,6 +189,14 @@ impl Scene {
             None => SceneError::NoLight { path: source() },
             Some(what) => invalid(what),
         })?;
+        let primitives =
+            description.triangles.len() + description.spheres.len() + description.cylinders.len();
+        if primitives >= crate::bvh::MAX_PRIMITIVES {
+            return Err(invalid(format!(
+                "{primitives} primitives (at most {} per scene)",
+                crate::bvh::MAX_PRIMITIVES - 1
+            )));
+        }
         let accel = Accel::build(
             &description.triangles,
             &description.spheres,
