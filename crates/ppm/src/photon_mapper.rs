@@ -284,7 +284,8 @@ impl<'s> PhotonMapper<'s> {
     /// Traces one camera path per slot with this pass's jitter. The emission they see
     /// directly (and the direct lighting, if enabled) is always accumulated, so that emitters
     /// seen through a pixel are antialiased progressively even by PPM; the visible points
-    /// replace the slots' only when `update_hitpoints` (the first pass, and every SPPM pass).
+    /// replace the slots' only when `update_hitpoints` (the first pass, and every SPPM pass):
+    /// otherwise only the emission sums are updated, in place.
     fn camera_pass(&mut self, update_hitpoints: bool) {
         let spp = self.params.samples_per_pixel;
         let n_slots = self.width as usize * self.height as usize * spp as usize;
@@ -322,9 +323,6 @@ impl<'s> PhotonMapper<'s> {
         for (slot, sample) in traced.into_iter().enumerate() {
             for c in 0..3 {
                 self.direct[slot][c] += f64::from(sample.direct[c]);
-            }
-            if !update_hitpoints {
-                continue;
             }
             let point = sample.visible.unwrap_or(VisiblePoint {
                 position: Vec3::ZERO,
@@ -541,13 +539,7 @@ impl<'s> PhotonMapper<'s> {
         scratch.frequency.clear();
         let mut frequency_photons = 0;
         for chunk in &scratch.traced {
-            scratch.frequency.extend(chunk.frequency.iter().map(
-                |&(photon, curvature, spectrum)| FrequencyPhoton {
-                    photon,
-                    curvature,
-                    spectrum,
-                },
-            ));
+            scratch.frequency.extend_from_slice(&chunk.frequency);
             frequency_photons += chunk.frequency_photons;
         }
         let trace_seconds = clock.elapsed().as_secs_f64();
@@ -724,7 +716,11 @@ impl<'s> PhotonMapper<'s> {
                 };
                 out.photons.push(photon);
                 if let Some(s) = spectrum {
-                    out.frequency.push((photon, hit.curvature, s));
+                    out.frequency.push(FrequencyPhoton {
+                        photon,
+                        curvature: hit.curvature,
+                        spectrum: s,
+                    });
                 }
             }
             // Scatter.
@@ -941,7 +937,7 @@ struct VisiblePoint {
 struct TracedPhotons {
     photons: Vec<Photon>,
     /// Frequency photons again, with the curvature at their hit and their spectrum.
-    frequency: Vec<(Photon, f32, Spectrum)>,
+    frequency: Vec<FrequencyPhoton>,
     frequency_photons: u64,
 }
 

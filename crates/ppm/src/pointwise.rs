@@ -60,13 +60,15 @@ pub fn pointwise_reference(
             sum[2] += f64::from(l.z) * scale;
         };
         let passes = emission_passes.max(1);
-        for pass in 0..passes {
+        let first = mapper.camera_chain(slot, 0);
+        add(first.direct, 1.0 / f64::from(passes));
+        for pass in 1..passes {
             add(
                 mapper.camera_chain(slot, pass).direct,
                 1.0 / f64::from(passes),
             );
         }
-        if let Some(end) = mapper.camera_chain(slot, 0).end {
+        if let Some(end) = first.end {
             let scale = 1.0 / f64::from(paths_per_point.max(1));
             for path in 0..paths_per_point {
                 let mut sampler =
