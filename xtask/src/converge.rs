@@ -17,6 +17,7 @@ pub(crate) const HELP: &str = "\
 cargo xtask converge --scene NAME [--budgets 2,4,8,16,32] [--methods ppm,sppm,freq,freq-sppm,path]
                      [--photons N] [--seed S] [--out DIR] [--quick]
                      [--pointwise PATHS] [--replot] [--alpha A] [--freq-fraction F] [--kernel-k poster|strict|K] [--freq-merge min|poster-max]
+                     [--freq-geometry on|off] [--clock wall|cpu]
 cargo xtask converge --scene NAME --sweep [--budget SECONDS] [--methods freq]
 
 Runs each method alone (one after another) on the suite scene NAME at its suite film size and
@@ -34,9 +35,14 @@ path-traced radiance at each hitpoint of their first camera pass (PATHS paths pe
 ppm::pointwise_reference), so that their rate of convergence can be read. Write it to its
 own --out DIR.
 --replot redraws the SVGs from DIR/NAME.csv.
+--clock cpu measures budgets in process CPU seconds divided by the thread count instead of
+wall-clock seconds: the same on an idle machine, and what each method would have taken alone
+when other jobs share the machine.
+--freq-geometry off lets frequency methods hold radii over edges and corners (no clear-disc
+probes).
 --sweep renders the methods (default freq and ppm) at one budget (default 8 s) with one
-parameter varied at a time around the defaults (alpha, freq-fraction, kernel-k, freq-merge)
-and writes DIR/NAME-sweep.csv.";
+parameter varied at a time around the defaults (alpha, freq-fraction, kernel-k, freq-merge,
+freq-geometry) and writes DIR/NAME-sweep.csv.";
 
 /// Camera passes averaged for the directly seen emission of the pointwise reference.
 const POINTWISE_EMISSION_PASSES: u32 = 256;
@@ -62,7 +68,72 @@ struct Flags {
     replot: bool,
     budget: f64,
     pointwise: Option<u32>,
+    clock: Clock,
     overrides: Overrides,
+}
+
+/// What a budget's seconds measure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Clock {
+    /// Wall-clock seconds (the default).
+    Wall,
+    /// Process CPU seconds (user + system, from `/proc/self/stat`) divided by the number of
+    /// rayon threads: on an idle machine the same as wall-clock, on a shared one what the
+    /// method would have taken alone. For comparisons while other jobs run.
+    Cpu,
+}
+
+impl Clock {
+    fn now(self) -> (Instant, f64) {
+        (
+            Instant::now(),
+            if self == Clock::Cpu {
+                process_cpu_seconds()
+            } else {
+                0.0
+            },
+        )
+    }
+
+    fn since(self, (wall, cpu): (Instant, f64)) -> Duration {
+        match self {
+            Clock::Wall => wall.elapsed(),
+            Clock::Cpu => {
+                Duration::from_secs_f64(((process_cpu_seconds() - cpu) / threads()).max(0.0))
+            }
+        }
+    }
+}
+
+/// The threads the renderer uses: rayon's default pool size.
+fn threads() -> f64 {
+    std::env::var("RAYON_NUM_THREADS")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+        .filter(|&n| n > 0)
+        .or_else(|| std::thread::available_parallelism().ok().map(usize::from))
+        .unwrap_or(1) as f64
+}
+
+/// CPU seconds (user + system) used by this process so far, from `/proc/self/stat`
+/// (fields 14 and 15, in clock ticks of 10 ms); 0 where it cannot be read.
+fn process_cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    // The command name (field 2) may contain spaces: count fields after its closing ')'.
+    let Some(rest) = stat.rsplit_once(')').map(|(_, r)| r) else {
+        return 0.0;
+    };
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| {
+        fields
+            .get(i)
+            .and_then(|f| f.parse::<f64>().ok())
+            .unwrap_or(0.0)
+    };
+    // After ')': field 3 is index 0, so utime (14) is index 11 and stime (15) index 12.
+    (ticks(11) + ticks(12)) / 100.0
 }
 
 /// Parameter values given on the command line.
@@ -72,6 +143,7 @@ struct Overrides {
     freq_fraction: Option<f64>,
     kernel_k: Option<f64>,
     freq_merge: Option<ppm::MergePolicy>,
+    freq_geometry: Option<bool>,
 }
 
 impl Overrides {
@@ -88,17 +160,21 @@ impl Overrides {
         if let Some(m) = self.freq_merge {
             params.freq_merge = m;
         }
+        if let Some(g) = self.freq_geometry {
+            params.freq_geometry = g;
+        }
     }
 
     fn label(&self, defaults: &ppm::RenderParams) -> String {
         let mut p = *defaults;
         self.apply(&mut p);
         format!(
-            "alpha={:.3} ff={} k={} merge={}",
+            "alpha={:.3} ff={} k={} merge={} geometry={}",
             p.alpha,
             p.freq_fraction,
             k_name(p.kernel_k),
-            merge_name(p.freq_merge)
+            merge_name(p.freq_merge),
+            if p.freq_geometry { "on" } else { "off" }
         )
     }
 }
@@ -144,6 +220,7 @@ impl Flags {
             sweep: false,
             replot: false,
             budget: 8.0,
+            clock: Clock::Wall,
             pointwise: None,
             overrides: Overrides::default(),
         };
@@ -168,6 +245,13 @@ impl Flags {
                 "--sweep" => flags.sweep = true,
                 "--replot" => flags.replot = true,
                 "--pointwise" => flags.pointwise = Some(value()?.parse()?),
+                "--clock" => {
+                    flags.clock = match value()?.as_str() {
+                        "wall" => Clock::Wall,
+                        "cpu" => Clock::Cpu,
+                        other => bail!("--clock takes wall or cpu, not `{other}`"),
+                    };
+                }
                 "--alpha" => flags.overrides.alpha = Some(value()?.parse()?),
                 "--freq-fraction" => flags.overrides.freq_fraction = Some(value()?.parse()?),
                 "--kernel-k" => {
@@ -183,6 +267,13 @@ impl Flags {
                         "min" => ppm::MergePolicy::MinRadius,
                         "poster-max" => ppm::MergePolicy::PosterMax,
                         other => bail!("unknown merge policy `{other}` (min, poster-max)"),
+                    });
+                }
+                "--freq-geometry" => {
+                    flags.overrides.freq_geometry = Some(match value()?.as_str() {
+                        "on" => true,
+                        "off" => false,
+                        other => bail!("--freq-geometry takes on or off, not `{other}`"),
                     });
                 }
                 other => bail!("converge: unknown flag `{other}`"),
@@ -265,9 +356,6 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         return Ok(true);
     }
     let scene = suite::load_scene(root, entry)?;
-    if flags.sweep {
-        return sweep(&scene, entry, &reference, &flags, &out);
-    }
     let masks = build_masks(&scene, &reference);
     let reference = match flags.pointwise {
         None => reference,
@@ -284,6 +372,9 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
             Image::new(reference.width, reference.height, pixels)
         }
     };
+    if flags.sweep {
+        return sweep(&scene, entry, &reference, &masks, &flags, &out);
+    }
     let transport = suite::transport_mask(&scene);
     write_masks(
         &out.join(format!("{}-masks.png", entry.name)),
@@ -305,9 +396,9 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         let mut elapsed = Duration::ZERO;
         for &budget in &flags.budgets {
             while elapsed.as_secs_f64() < budget {
-                let start = Instant::now();
+                let start = flags.clock.now();
                 renderer.iterate();
-                elapsed += start.elapsed();
+                elapsed += flags.clock.since(start);
             }
             let image = Image::new(reference.width, reference.height, renderer.image());
             let all = image_io::errors(&image, &reference, Some(&transport))?;
@@ -733,10 +824,10 @@ fn sweep(
     scene: &geometry::Scene,
     entry: &SuiteScene,
     reference: &Image,
+    masks: &Masks,
     flags: &Flags,
     out: &Path,
 ) -> Result<bool> {
-    let masks = build_masks(scene, reference);
     let transport = suite::transport_mask(scene);
     let mut variants: Vec<Overrides> = vec![Overrides::default()];
     for alpha in [0.5, 2.0 / 3.0, 0.8] {
@@ -751,8 +842,19 @@ fn sweep(
             ..Overrides::default()
         });
     }
+    for k in [
+        spectrum::K_POSTER,
+        4.0 * spectrum_k_strict(),
+        2.0 * spectrum_k_strict(),
+        0.5 * spectrum_k_strict(),
+    ] {
+        variants.push(Overrides {
+            kernel_k: Some(k),
+            ..Overrides::default()
+        });
+    }
     variants.push(Overrides {
-        kernel_k: Some(spectrum_k_strict()),
+        freq_geometry: Some(false),
         ..Overrides::default()
     });
     variants.push(Overrides {
@@ -760,12 +862,14 @@ fn sweep(
         ..Overrides::default()
     });
     let mut csv = String::from(
-        "scene,method,budget_s,alpha,freq_fraction,kernel_k,freq_merge,seconds,passes,rel_mse,rmse,mean_ratio,rel_mse_low,rel_mse_caustic,rel_mse_glossy\n",
+        "scene,method,budget_s,alpha,freq_fraction,kernel_k,freq_merge,freq_geometry,seconds,passes,rel_mse,rmse,mean_ratio,rel_mse_low,rel_mse_caustic,rel_mse_glossy\n",
     );
     for &method in &flags.methods {
         for v in &variants {
-            let only_alpha =
-                v.freq_fraction.is_none() && v.kernel_k.is_none() && v.freq_merge.is_none();
+            let only_alpha = v.freq_fraction.is_none()
+                && v.kernel_k.is_none()
+                && v.freq_merge.is_none()
+                && v.freq_geometry.is_none();
             if !method.uses_frequency() && !only_alpha {
                 continue;
             }
@@ -775,9 +879,9 @@ fn sweep(
             let mut renderer = ppm::Renderer::new(scene, params).context("render parameters")?;
             let mut elapsed = Duration::ZERO;
             while elapsed.as_secs_f64() < flags.budget {
-                let start = Instant::now();
+                let start = flags.clock.now();
                 renderer.iterate();
-                elapsed += start.elapsed();
+                elapsed += flags.clock.since(start);
             }
             let image = Image::new(reference.width, reference.height, renderer.image());
             let e = image_io::errors(&image, reference, Some(&transport))?;
@@ -798,7 +902,7 @@ fn sweep(
             );
             let _ = writeln!(
                 csv,
-                "{},{},{},{:.4},{},{},{},{:.3},{},{:.6e},{:.6e},{:.5},{:.6e},{:.6e},{:.6e}",
+                "{},{},{},{:.4},{},{},{},{},{:.3},{},{:.6e},{:.6e},{:.5},{:.6e},{:.6e},{:.6e}",
                 entry.name,
                 method.name(),
                 flags.budget,
@@ -806,6 +910,7 @@ fn sweep(
                 params.freq_fraction,
                 k_name(params.kernel_k),
                 merge_name(params.freq_merge),
+                if params.freq_geometry { "on" } else { "off" },
                 elapsed.as_secs_f64(),
                 renderer.passes(),
                 e.rel_mse,

@@ -334,6 +334,9 @@ fn apply_flags(base: RenderParams, flags: &ParamArgs) -> anyhow::Result<RenderPa
     if let Some(seed) = flags.seed {
         p.seed = seed;
     }
+    if flags.no_freq_geometry {
+        p.freq_geometry = false;
+    }
     if flags.direct_lighting {
         p.direct_lighting = true;
     }

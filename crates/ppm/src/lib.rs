@@ -37,6 +37,7 @@
 //! # }
 //! ```
 
+mod disc;
 mod params;
 mod path;
 mod photon_mapper;

@@ -112,6 +112,10 @@ pub struct RenderParams {
     /// shadow ray per segment of a frequency photon), so that shadow edges raise the spatial
     /// frequency and keep hitpoints there shrinking.
     pub freq_occlusion: bool,
+    /// Whether a hitpoint may hold its radius only where its gather disc lies on its own
+    /// surface (probe rays when it first becomes a candidate, `crate::disc`), so that held
+    /// kernels do not hang over edges and corners where no photon is accepted.
+    pub freq_geometry: bool,
     /// Add direct lighting by light sampling at hitpoints instead of gathering photons that
     /// arrive straight from an emitter.
     pub direct_lighting: bool,
@@ -171,6 +175,7 @@ impl RenderParams {
             kernel_k: K_STRICT,
             freq_floor: FrequencyFloor::Keep,
             freq_occlusion: true,
+            freq_geometry: true,
             direct_lighting: false,
         }
     }

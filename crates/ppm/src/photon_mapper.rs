@@ -96,6 +96,36 @@ pub(crate) struct SlotFrequency {
     pub(crate) estimate: FrequencyEstimate,
     /// Distance to the camera (or last specular vertex) projected on the normal, z of §8.2.
     pub(crate) normal_distance: f32,
+    /// The largest radius at which the gather disc lies on the hitpoint's surface
+    /// ([`crate::disc::clear_radius`]), or [`GEOMETRY_UNKNOWN`] until it is probed: when the
+    /// slot first becomes a candidate for holding, again after every new visible point.
+    pub(crate) clear_radius: f32,
+}
+
+/// [`SlotFrequency::clear_radius`] before the probes ran.
+pub(crate) const GEOMETRY_UNKNOWN: f32 = -1.0;
+
+impl SlotFrequency {
+    /// A slot's frequency state for a new visible point: no deposit, geometry not probed.
+    pub(crate) fn new(normal_distance: f32) -> Self {
+        Self {
+            estimate: FrequencyEstimate::EMPTY,
+            normal_distance,
+            clear_radius: GEOMETRY_UNKNOWN,
+        }
+    }
+
+    /// The radius below which the slot holds its kernel: the frequency radius r_freq of its
+    /// merged deposits (`None` before the first), bounded by the clear radius of its disc once
+    /// probed.
+    pub(crate) fn hold_radius(&self, k: f64) -> Option<f64> {
+        let r_freq = self.estimate.radius(f64::from(self.normal_distance), k)?;
+        Some(if self.clear_radius >= 0.0 {
+            r_freq.min(f64::from(self.clear_radius))
+        } else {
+            r_freq
+        })
+    }
 }
 
 /// The photon mappers' state: hitpoint slots with their statistics, the grid, the direct
@@ -338,10 +368,7 @@ impl<'s> PhotonMapper<'s> {
             // Visible points have bounces < max_depth ≤ 1024 (`trace_camera_path`).
             let budget = (self.params.max_depth - 1).saturating_sub(point.bounces);
             self.photon_bounces[slot] = u16::try_from(budget).unwrap_or(u16::MAX);
-            let freq = SlotFrequency {
-                estimate: FrequencyEstimate::EMPTY,
-                normal_distance: point.normal_distance,
-            };
+            let freq = SlotFrequency::new(point.normal_distance);
             let new = NewHitPoint {
                 position: point.position,
                 shading_normal: point.shading_normal,
@@ -357,7 +384,10 @@ impl<'s> PhotonMapper<'s> {
                 self.slots.push(new);
             } else {
                 self.slots.replace_visible_point(slot, &new);
-                self.slots.columns_mut().freq[slot].normal_distance = point.normal_distance;
+                self.slots.columns_mut().freq[slot] = SlotFrequency {
+                    estimate: self.slots.freq()[slot].estimate,
+                    ..freq
+                };
             }
         }
         self.camera_passes += 1;
@@ -818,11 +848,50 @@ impl<'s> PhotonMapper<'s> {
     // ------------------------------------------------------------------------------------
     // Phase 4: hitpoint update.
 
+    /// Probes the clear radius ([`crate::disc::clear_radius`]) of every valid slot that has
+    /// become a candidate for holding (R ≤ r_freq) and has not been probed at its visible
+    /// point, in parallel. Deterministic: the probes use no random numbers.
+    fn probe_clear_radii(&mut self) {
+        let k = self.params.kernel_k;
+        let r0 = self.kernel_scale as f32;
+        let slots = &self.slots;
+        let valid = &self.valid;
+        let scene = self.scene;
+        let probed: Vec<(usize, f32)> = (0..slots.len())
+            .into_par_iter()
+            .with_min_len(SLOT_CHUNK)
+            .filter_map(|slot| {
+                let freq = slots.freq()[slot];
+                if !valid[slot] || freq.clear_radius != GEOMETRY_UNKNOWN {
+                    return None;
+                }
+                let r_freq = freq.estimate.radius(f64::from(freq.normal_distance), k)?;
+                if slots.radius()[slot] > r_freq {
+                    return None;
+                }
+                let clear = crate::disc::clear_radius(
+                    scene,
+                    slots.position()[slot],
+                    slots.geometric_normal()[slot],
+                    r0,
+                );
+                Some((slot, clear))
+            })
+            .collect();
+        let columns = self.slots.columns_mut();
+        for (slot, clear) in probed {
+            columns.freq[slot].clear_radius = clear;
+        }
+    }
+
     fn update_hitpoints(&mut self, deposits: &PassDeposits) -> PassStats {
         let alpha = self.params.alpha;
         let k = self.params.kernel_k;
         let floor = self.params.freq_floor;
         let uses_frequency = self.params.method.uses_frequency();
+        if uses_frequency && self.params.freq_geometry {
+            self.probe_clear_radii();
+        }
         let columns = self.slots.columns_mut();
         let held: Vec<bool> = columns
             .radius
@@ -833,8 +902,7 @@ impl<'s> PhotonMapper<'s> {
             .zip(deposits.count.par_iter().zip(deposits.flux.par_iter()))
             .map(|((((radius, photon_count), tau), freq), (&m, &phi))| {
                 let r_freq = if uses_frequency {
-                    freq.estimate
-                        .radius(f64::from(freq.normal_distance), k)
+                    freq.hold_radius(k)
                         .map_or(FrequencyRadius::None, FrequencyRadius::Predicted)
                 } else {
                     FrequencyRadius::None

@@ -248,14 +248,14 @@ fn slot_aov(mapper: &PhotonMapper<'_>, aov: Aov) -> Vec<f32> {
                     continue;
                 }
                 let freq = slots.freq()[slot];
-                let r_freq = freq.estimate.radius(f64::from(freq.normal_distance), k);
                 let value = match aov {
                     Aov::Radius => Some(slots.radius()[slot]),
                     Aov::PhotonCount => Some(slots.photon_count()[slot]),
-                    Aov::FreqRadius => r_freq,
-                    _ => {
-                        Some(r_freq.map_or(0.0, |r| f64::from(u8::from(slots.radius()[slot] <= r))))
-                    }
+                    Aov::FreqRadius => freq.estimate.radius(f64::from(freq.normal_distance), k),
+                    _ => Some(
+                        freq.hold_radius(k)
+                            .map_or(0.0, |r| f64::from(u8::from(slots.radius()[slot] <= r))),
+                    ),
                 };
                 if let Some(v) = value {
                     sum += v.min(f64::from(f32::MAX));

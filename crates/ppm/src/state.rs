@@ -20,7 +20,7 @@ use crate::update::FrequencyFloor;
 const MAGIC: &[u8; 8] = b"FPPMSTAT";
 /// Version of the checkpoint layout; bump it whenever the layout or the meaning of a field
 /// changes, so that old checkpoints are refused rather than misread.
-pub const STATE_VERSION: u32 = 2;
+pub const STATE_VERSION: u32 = 3;
 
 /// Why a checkpoint could not be restored.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -174,6 +174,7 @@ fn write_params(w: &mut Writer, p: &RenderParams) {
     });
     w.u32(u32::from(p.direct_lighting));
     w.u32(u32::from(p.freq_occlusion));
+    w.u32(u32::from(p.freq_geometry));
 }
 
 fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
@@ -198,6 +199,7 @@ fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
     };
     let direct_lighting = r.bool()?;
     let freq_occlusion = r.bool()?;
+    let freq_geometry = r.bool()?;
     Ok(RenderParams {
         method,
         photons_per_pass,
@@ -211,6 +213,7 @@ fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
         kernel_k,
         freq_floor,
         freq_occlusion,
+        freq_geometry,
         direct_lighting,
     })
 }
@@ -238,6 +241,7 @@ fn write_photon_mapper(w: &mut Writer, p: &PhotonMapper<'_>) {
         w.u32(u32::from(s.has_freq()[i]));
         let freq = s.freq()[i];
         w.f32(freq.normal_distance);
+        w.f32(freq.clear_radius);
         match freq.estimate.spectrum() {
             None => w.u32(0),
             Some(spectrum) => {
@@ -281,6 +285,7 @@ fn read_photon_mapper(
         let flux = [r.f64()?, r.f64()?, r.f64()?];
         let has_freq = r.bool()?;
         let normal_distance = r.f32()?;
+        let clear_radius = r.f32()?;
         let spectrum = match r.u32()? {
             0 => None,
             1 => Some(
@@ -305,6 +310,7 @@ fn read_photon_mapper(
             freq: SlotFrequency {
                 estimate: FrequencyEstimate::from_spectrum(spectrum),
                 normal_distance,
+                clear_radius,
             },
         });
         stats.push((photon_count, flux, has_freq));
