@@ -22,6 +22,7 @@
 //! internally by a power of two (see [`internal_scale`]), now only for the range of the arithmetic.
 
 mod prim;
+mod simd;
 #[cfg(test)]
 mod tests;
 mod wide;
