@@ -7,9 +7,10 @@
 #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
 mod imp {
     use std::arch::x86_64::{
-        __m256, _CMP_EQ_OQ, _CMP_LE_OQ, _mm256_blendv_ps, _mm256_cmp_ps, _mm256_loadu_ps,
-        _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_permute2f128_ps,
-        _mm256_set1_ps, _mm256_shuffle_ps, _mm256_storeu_ps, _mm256_sub_ps,
+        __m256, _CMP_EQ_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _mm256_add_ps, _mm256_and_ps, _mm256_blendv_ps,
+        _mm256_cmp_ps, _mm256_div_ps, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_ps,
+        _mm256_movemask_ps, _mm256_mul_ps, _mm256_permute2f128_ps, _mm256_set1_ps,
+        _mm256_shuffle_ps, _mm256_storeu_ps, _mm256_sub_ps,
     };
 
     // SAFETY (every `unsafe` block of this module): the intrinsics need AVX (and AVX2), which the
@@ -45,8 +46,18 @@ mod imp {
         }
 
         #[inline(always)]
+        pub(in crate::bvh) fn add(self, o: Self) -> Self {
+            Self(unsafe { _mm256_add_ps(self.0, o.0) })
+        }
+
+        #[inline(always)]
         pub(in crate::bvh) fn mul(self, o: Self) -> Self {
             Self(unsafe { _mm256_mul_ps(self.0, o.0) })
+        }
+
+        #[inline(always)]
+        pub(in crate::bvh) fn div(self, o: Self) -> Self {
+            Self(unsafe { _mm256_div_ps(self.0, o.0) })
         }
 
         #[inline(always)]
@@ -65,10 +76,22 @@ mod imp {
             Self(unsafe { _mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0) })
         }
 
+        /// All-ones lanes where `self < o` (false for NaN), zero elsewhere.
+        #[inline(always)]
+        pub(in crate::bvh) fn lt(self, o: Self) -> Self {
+            Self(unsafe { _mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0) })
+        }
+
         /// All-ones lanes where `self == o` (false for NaN), zero elsewhere.
         #[inline(always)]
         pub(in crate::bvh) fn eq(self, o: Self) -> Self {
             Self(unsafe { _mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, o.0) })
+        }
+
+        /// Bitwise and (of comparison results).
+        #[inline(always)]
+        pub(in crate::bvh) fn and(self, o: Self) -> Self {
+            Self(unsafe { _mm256_and_ps(self.0, o.0) })
         }
 
         /// `self` where `mask` (a comparison result) is set, `o` elsewhere.
@@ -136,8 +159,18 @@ mod imp {
         }
 
         #[inline(always)]
+        pub(in crate::bvh) fn add(self, o: Self) -> Self {
+            self.zip(o, |a, b| a + b)
+        }
+
+        #[inline(always)]
         pub(in crate::bvh) fn mul(self, o: Self) -> Self {
             self.zip(o, |a, b| a * b)
+        }
+
+        #[inline(always)]
+        pub(in crate::bvh) fn div(self, o: Self) -> Self {
+            self.zip(o, |a, b| a / b)
         }
 
         /// As `minps`: the second operand unless the first is smaller.
@@ -158,8 +191,18 @@ mod imp {
         }
 
         #[inline(always)]
+        pub(in crate::bvh) fn lt(self, o: Self) -> Self {
+            self.zip(o, |a, b| Self::flag(a < b))
+        }
+
+        #[inline(always)]
         pub(in crate::bvh) fn eq(self, o: Self) -> Self {
             self.zip(o, |a, b| Self::flag(a == b))
+        }
+
+        #[inline(always)]
+        pub(in crate::bvh) fn and(self, o: Self) -> Self {
+            self.zip(o, |a, b| f32::from_bits(a.to_bits() & b.to_bits()))
         }
 
         #[inline(always)]

@@ -1,15 +1,17 @@
 //! An 8-wide BVH for single-ray traversal on the CPU, collapsed from an obvhs `Bvh2`.
 //!
-//! Each node holds the boxes of its (up to) eight children in SoA form, as two groups of four
-//! lanes per bound (`Vec4`s of lower and upper bounds per axis), so one ray is tested against all
-//! eight boxes with a few dozen SSE instructions and no decoding. Children are visited nearest
-//! first (closest hit) or in any order (any hit). Leaves are not nodes: a child reference
-//! encodes the leaf's number directly, and the leaf's triangles sit in one SIMD pack
-//! (`prim::TriPack`) of the same number.
+//! Each node holds the boxes of its (up to) eight children in SoA form, one row of eight lanes per
+//! bound (lower and upper bounds per axis, `simd::F8`), so one ray is tested against all eight
+//! boxes with about twenty AVX instructions and no decoding. Children are visited nearest first
+//! (closest hit) or in any order (any hit). Leaves are not nodes: a child reference encodes the
+//! leaf's number directly, and the leaf's triangles sit in one SIMD pack (`prim::TriPack`) of the
+//! same number.
 //!
 //! Measured against a 4-wide layout of the same kind (bunny, diffuse-bounce rays, CPU time):
-//! 8-wide was ~12 % faster for closest hits and ~20 % for any hit. One 8-lane AVX test per node
-//! (written lane by lane, which the compiler vectorised) was not faster than two 4-lane ones.
+//! 8-wide was ~12 % faster for closest hits and ~20 % for any hit. One 8-lane test per node
+//! written lane by lane (which the compiler vectorised) was not faster than two 4-lane ones; with
+//! AVX intrinsics (`simd.rs`) it is: 20 % fewer instructions per incoherent ray. Sorting the
+//! pushed children, branchless pushes and prefetching gained nothing (earlier measurements).
 
 use std::mem::MaybeUninit;
 
@@ -26,7 +28,7 @@ const LEAF_BIT: u32 = 1 << 31;
 /// Set in a leaf reference whose primitives are not all triangles.
 const MIXED_BIT: u32 = 1 << 30;
 /// Most primitives in one leaf: one SIMD lane each.
-pub(super) const MAX_LEAF_PRIMS: u32 = 4;
+pub(super) const MAX_LEAF_PRIMS: u32 = 8;
 /// Leaves are numbered below this bound in a leaf reference.
 const MAX_LEAVES: u32 = 1 << 30;
 /// The reference in an unused child slot; its box is empty, so it is never followed.
@@ -118,7 +120,7 @@ impl NodeBuilder {
 }
 
 impl Node {
-    /// The mask of the child boxes the ray enters within [tmin, tmax], and their entry distances
+    /// The mask of the child boxes the ray enters within [0, tmax], and their entry distances
     /// (∞ for the others).
     ///
     /// Slab distances are (bound − origin) · (1 / direction). A zero direction component gives an
@@ -135,7 +137,7 @@ impl Node {
         let ty1 = b(2 + ((sy ^ 1) & 1)).sub(ray.origin[1]).mul(ray.inv_dir[1]);
         let tz0 = b(4 + (sz & 1)).sub(ray.origin[2]).mul(ray.inv_dir[2]);
         let tz1 = b(4 + ((sz ^ 1) & 1)).sub(ray.origin[2]).mul(ray.inv_dir[2]);
-        let tnear = tx0.max(ty0).max(tz0).max(ray.tmin);
+        let tnear = tx0.max(ty0).max(tz0).max(F8::splat(0.0));
         let tfar = tx1
             .min(ty1)
             .min(tz1)
@@ -155,7 +157,6 @@ impl Node {
 pub(super) struct BoxRay {
     origin: [F8; 3],
     inv_dir: [F8; 3],
-    tmin: F8,
     near: [usize; 3],
 }
 
@@ -163,7 +164,7 @@ impl BoxRay {
     /// Any finite `direction` will do: a ±0.0 component has an inverse of ±∞, which
     /// [`Node::intersect`] handles.
     #[inline(always)]
-    pub(super) fn new(origin: Vec3A, direction: Vec3A, tmin: f32) -> Self {
+    pub(super) fn new(origin: Vec3A, direction: Vec3A) -> Self {
         let inv = Vec3A::ONE / direction;
         Self {
             origin: [
@@ -172,7 +173,6 @@ impl BoxRay {
                 F8::splat(origin.z),
             ],
             inv_dir: [F8::splat(inv.x), F8::splat(inv.y), F8::splat(inv.z)],
-            tmin: F8::splat(tmin),
             near: [
                 usize::from(inv.x < 0.0),
                 usize::from(inv.y < 0.0),
@@ -447,7 +447,7 @@ impl Wide {
         }
     }
 
-    /// Any-hit traversal: stops as soon as `leaf` reports a hit within [tmin, tmax].
+    /// Any-hit traversal: stops as soon as `leaf` reports a hit within [0, tmax].
     #[inline(always)]
     pub(super) fn any(&self, ray: &BoxRay, tmax: f32, leaf: &impl Leaves) -> bool {
         if self.stack_need <= STACK_SMALL {
