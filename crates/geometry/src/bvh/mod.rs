@@ -1,17 +1,34 @@
 //! The scene's BVH over triangles, analytic spheres and analytic cylinders.
 //!
 //! obvhs builds a binary BVH (`Bvh2`: PLOC, a little reinsertion, SAH leaf collapse to at most
-//! four primitives), which is collapsed into our own CPU layout (`wide.rs`): 8-wide nodes whose
-//! child boxes are stored as SoA `Vec4`s and tested together, nearest child first; each leaf's
-//! triangles are tested together too, as one SoA pack of four lanes (`prim::TriPack`), and its
-//! spheres and cylinders one by one. obvhs types never leave this module.
+//! eight primitives), which is collapsed into our own CPU layout (`wide.rs`): 8-wide nodes whose
+//! child boxes are stored in SoA rows of eight lanes and tested together with one AVX operation
+//! per step (`simd.rs`), nearest child first; each leaf's triangles are tested together too, as
+//! one SoA pack of eight lanes (`prim::TriPack`), and its spheres and cylinders one by one.
+//! obvhs types never leave this module.
 //!
 //! This replaced traversal of obvhs' `CwBvh`, whose compressed 8-wide nodes (a GPU layout) are
-//! decoded per node on the CPU. Measured with `benches/bvh.rs`, old and new binaries alternating,
-//! best of 3 runs, rays per CPU-second of one thread (a shared 2-core machine): bunny
-//! diffuse-bounce closest hits 3.7 M/s (×1.7), occluded 4.5 M/s (×1.9), primary 8.0 M/s (×1.5);
-//! MetalRoughSpheres (1M triangles) bounce closest hits 1.6 M/s (×1.5) and `Scene::new` 0.63 s
-//! instead of 1.06 s (×1.7), the collapse and the leaf layout included.
+//! decoded per node on the CPU (bunny diffuse-bounce closest hits ×1.7, occluded ×1.9, primary
+//! ×1.5; `Scene::new` of the 1M-triangle MetalRoughSpheres ×1.7 faster).
+//!
+//! Where the time of an incoherent ray goes (callgrind, bunny diffuse-bounce closest hits, which
+//! mostly leave the surface and miss: 7.8 node visits and 4 leaf tests per ray): building the
+//! `Hit` afterwards costs about 1 % of the instructions, ray setup about 5 %, the node tests and
+//! the stack about two thirds and the leaf tests a quarter. Replaying each ray four times (hot
+//! caches, trained branches) was only ~15 % faster, and shuffling the rays ~30 % slower, so the
+//! pixel-ordered benchmark is mostly bound by instructions and branches, not by memory. A
+//! stronger obvhs build does not help much: even `reinsertion_batch_ratio` 1 (a build ~20× as
+//! slow) cut the instructions by only 5 %. What did help: one AVX test of the eight child boxes
+//! instead of two SSE tests of four (and no zeroing of the traversal stack per ray), 957 instead
+//! of 1200 instructions per ray; then leaves of up to eight triangles in one 8-lane pack, with
+//! the collapse cost raised from 3 to 6 so that obvhs fills them, 943 instructions per ray
+//! (occluded 1037 → 763, primary closest hits 829 → 655). Measured with `benches/bvh.rs`, old
+//! and new binaries alternating, rays per CPU-second of one thread on a shared, loaded 2-core
+//! machine (±15 % run to run): bunny diffuse-bounce closest hits ×1.1–1.3 (3.0–3.3 → 3.3–4.2
+//! M/s), occluded ×1.15 (3.9 → 4.5 M/s), primary ×1.2 (6.0 → 7.2 M/s); MetalRoughSpheres
+//! diffuse-bounce closest hits ×1.3 (1.17 → 1.5 M/s), `Scene::new` unchanged (0.93–0.98 s);
+//! with `examples/prof.rs`, which runs one query kind alone, bunny diffuse-bounce closest hits
+//! ×1.25 and occluded ×1.4.
 //!
 //! Exactness: the box test is conservative (exit distances are widened by 1 + 2γ₃, and every
 //! primitive's box is padded by a few ulps so that no primitive touches a box face), so the BVH
@@ -22,17 +39,19 @@
 //! internally by a power of two (see [`internal_scale`]), now only for the range of the arithmetic.
 
 mod prim;
+mod simd;
 #[cfg(test)]
 mod tests;
 mod wide;
 
 use std::time::Duration;
 
-use glam::{Vec3A, Vec4};
+use glam::Vec3A;
 use obvhs::{BvhBuildParams, aabb::Aabb as BvhAabb, bvh2::builder::build_bvh2};
 
 use crate::{Cylinder, Ray, Sphere, Triangle};
-use prim::{CylGeom, PrimRay, Ray4, SphereGeom, TriGeom, TriPack};
+use prim::{CylGeom, PrimRay, Ray8, SphereGeom, TriGeom, TriPack, TriPackBuilder};
+use simd::F8;
 use wide::{BoxRay, Leaf, Leaves, Wide};
 
 /// The power of two that brings the largest coordinate magnitude of the scene to [2⁹, 2¹⁰).
@@ -121,7 +140,7 @@ pub(crate) struct Accel {
 /// the closest hit so far.
 struct Query<'a> {
     accel: &'a Accel,
-    rays: (PrimRay, Ray4),
+    rays: (PrimRay, Ray8),
     closest: Option<usize>,
 }
 
@@ -139,18 +158,23 @@ impl Leaves for Query<'_> {
 }
 
 /// obvhs build settings: `fast_build` (PLOC with a short search, 2 % reinsertion) with leaves of
-/// up to [`LANES`] primitives, one [`TriPack`] each.
+/// up to [`LANES`] primitives, one [`TriPack`] each, and a leaf-collapse traversal cost of 6
+/// instead of 3.
 ///
-/// Measured with `benches/bvh.rs` (1 thread, CPU time): on the 1M-triangle MetalRoughSpheres,
-/// `fast` builds in about 0.7 s with 1.4 M diffuse-bounce rays/s; `very_fast_build` saves
-/// ~0.1 s but traces 10 % slower, `fastest_build` (no reinsertion) saved nothing overall and
-/// traces 20–30 % slower, and `medium_build` costs ~0.1 s more for no measurable speed-up. On
-/// the bunny, neither the traversal cost parameter of the leaf collapse (3 to 20) nor leaves of
-/// up to 8 primitives (two packs) made a measurable difference; leaves of at most 2 or 1
-/// primitives were 10 % and 45 % slower.
+/// Measured with `benches/bvh.rs` (1 thread, CPU time), with the 4-lane leaves of before: on
+/// the 1M-triangle MetalRoughSpheres, `fast` builds in about 0.7 s with 1.4 M diffuse-bounce
+/// rays/s; `very_fast_build` saves ~0.1 s but traces 10 % slower, `fastest_build` (no
+/// reinsertion) saved nothing overall and traces 20–30 % slower, and `medium_build` costs ~0.1 s
+/// more for no measurable speed-up; leaves of at most 2 or 1 primitives were 10 % and 45 %
+/// slower on the bunny. With 8-lane packs (callgrind, bunny diffuse-bounce closest hits): a
+/// collapse cost of 6 gives 1.4 % fewer instructions than 3 (any value from 6 to 30 gives the same
+/// tree), 1 gives 8 % more; PLOC search distance, search depth and reinsertion ratio as in
+/// `medium_build` save 0 %, as in `slow_build` (without pre-splitting) 1 %, `very_slow_build`'s
+/// reinsertion 5 % at ~20× the build time.
 fn build_params() -> BvhBuildParams {
     BvhBuildParams {
         max_prims_per_leaf: LANES as u32,
+        collapse_traversal_cost: 6.0,
         ..BvhBuildParams::fast_build()
     }
 }
@@ -222,17 +246,19 @@ impl Accel {
             order[range].iter().any(|&i| !is_triangle(ids[i as usize]))
         });
         // Lay the primitives out leaf by leaf, in the order the leaves were made (depth first).
-        accel.packs = vec![TriPack::EMPTY; bvh.leaves.len()];
+        accel.packs = Vec::with_capacity(bvh.leaves.len());
         accel.ids = vec![NO_PRIMITIVE; bvh.leaves.len() * LANES];
         for (leaf, &(first, count)) in bvh.leaves.iter().enumerate() {
+            let mut pack = TriPackBuilder::EMPTY;
             for lane in 0..count as usize {
                 let id = ids[order[first as usize + lane] as usize];
                 accel.ids[leaf * LANES + lane] = id;
                 if is_triangle(id) {
                     let geom = TriGeom::new(internal(&triangles[id as usize]));
-                    accel.packs[leaf].set(lane, &geom);
+                    pack.set(lane, &geom);
                 }
             }
+            accel.packs.push(pack.build());
         }
         accel.bvh = Some(bvh);
         accel
@@ -257,16 +283,17 @@ impl Accel {
     #[inline(always)]
     fn leaf_closest(
         &self,
-        rays: &(PrimRay, Ray4),
+        rays: &(PrimRay, Ray8),
         leaf: Leaf,
         tmax: &mut f32,
         closest: &mut Option<usize>,
     ) {
         let t = self.packs[leaf.index].intersect(&rays.1, *tmax);
-        let best = t.min_element();
-        if best < *tmax {
-            let lane = t.cmpeq(Vec4::splat(best)).bitmask().trailing_zeros() as usize;
-            *tmax = best;
+        let best = t.min_all();
+        let lanes = t.eq(best).and(best.lt(F8::splat(*tmax))).bitmask();
+        if lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            *tmax = best.to_array()[0];
             *closest = Some(leaf.index * LANES + lane);
         }
         if leaf.mixed {
@@ -282,9 +309,9 @@ impl Accel {
 
     /// Whether anything in `leaf` is hit below `tmax`.
     #[inline(always)]
-    fn leaf_any(&self, rays: &(PrimRay, Ray4), leaf: Leaf, tmax: f32) -> bool {
+    fn leaf_any(&self, rays: &(PrimRay, Ray8), leaf: Leaf, tmax: f32) -> bool {
         let t = self.packs[leaf.index].intersect(&rays.1, tmax);
-        if t.cmplt(Vec4::splat(tmax)).any() {
+        if t.lt(F8::splat(tmax)).bitmask() != 0 {
             return true;
         }
         leaf.mixed
@@ -296,7 +323,7 @@ impl Accel {
     /// `None` for a non-finite ray. Unlike obvhs' CwBvh (crates.md G1), the traversal needs no
     /// sanitising of `-0.0` direction components.
     #[inline(always)]
-    fn internal_ray(&self, ray: &Ray) -> Option<((PrimRay, Ray4), BoxRay, f32)> {
+    fn internal_ray(&self, ray: &Ray) -> Option<((PrimRay, Ray8), BoxRay, f32)> {
         if !(ray.direction.is_finite() && ray.origin.is_finite()) {
             return None;
         }
@@ -305,16 +332,21 @@ impl Accel {
             direction: Vec3A::from(ray.direction),
             tmin: 0.0,
         };
-        let box_ray = BoxRay::new(prim_ray.origin, prim_ray.direction, prim_ray.tmin);
+        let box_ray = BoxRay::new(prim_ray.origin, prim_ray.direction);
         Some((
-            (prim_ray, Ray4::new(&prim_ray)),
+            (prim_ray, Ray8::new(&prim_ray)),
             box_ray,
             ray.t_max * self.scale,
         ))
     }
 
     /// The closest hit with 0 ≤ t < `ray.t_max` (t > 0 for spheres).
-    #[inline]
+    ///
+    /// Never inlined, so that the traversal is compiled once, alone, and its speed does not depend
+    /// on the caller: inlined into the benchmark's rayon closure (beside `occluded`), it seemed
+    /// slower than through a call from `examples/prof.rs` (within the noise of the shared
+    /// machine); a call costs a few instructions of the ~900 of an incoherent ray.
+    #[inline(never)]
     pub(crate) fn intersect(&self, ray: &Ray) -> Option<RawHit> {
         let bvh = self.bvh.as_ref()?;
         let (rays, box_ray, mut tmax) = self.internal_ray(ray)?;
@@ -349,8 +381,9 @@ impl Accel {
         })
     }
 
-    /// Whether anything is hit with 0 ≤ t < `ray.t_max` (t > 0 for spheres).
-    #[inline]
+    /// Whether anything is hit with 0 ≤ t < `ray.t_max` (t > 0 for spheres). Never inlined, as
+    /// [`Accel::intersect`].
+    #[inline(never)]
     pub(crate) fn occluded(&self, ray: &Ray) -> bool {
         let Some(bvh) = self.bvh.as_ref() else {
             return false;

@@ -294,7 +294,7 @@ fn oversized_leaves_are_split() {
             }
         }
         assert!(covered.iter().all(|&c| c), "{count}");
-        let ray = BoxRay::new(Vec3A::new(0.5, 0.5, -1.0), Vec3A::Z, 0.0);
+        let ray = BoxRay::new(Vec3A::new(0.5, 0.5, -1.0), Vec3A::Z);
         let mut visited = Visited(Vec::new());
         let mut tmax = f32::INFINITY;
         wide.closest(&ray, &mut tmax, &mut visited);

@@ -1,30 +1,34 @@
 //! An 8-wide BVH for single-ray traversal on the CPU, collapsed from an obvhs `Bvh2`.
 //!
-//! Each node holds the boxes of its (up to) eight children in SoA form, as two groups of four
-//! lanes per bound (`Vec4`s of lower and upper bounds per axis), so one ray is tested against all
-//! eight boxes with a few dozen SSE instructions and no decoding. Children are visited nearest
-//! first (closest hit) or in any order (any hit). Leaves are not nodes: a child reference
-//! encodes the leaf's number directly, and the leaf's triangles sit in one SIMD pack
-//! (`prim::TriPack`) of the same number.
+//! Each node holds the boxes of its (up to) eight children in SoA form, one row of eight lanes per
+//! bound (lower and upper bounds per axis, `simd::F8`), so one ray is tested against all eight
+//! boxes with about twenty AVX instructions and no decoding. Children are visited nearest first
+//! (closest hit) or in any order (any hit). Leaves are not nodes: a child reference encodes the
+//! leaf's number directly, and the leaf's triangles sit in one SIMD pack (`prim::TriPack`) of the
+//! same number.
 //!
 //! Measured against a 4-wide layout of the same kind (bunny, diffuse-bounce rays, CPU time):
-//! 8-wide was ~12 % faster for closest hits and ~20 % for any hit. One 8-lane AVX test per node
-//! (written lane by lane, which the compiler vectorised) was not faster than two 4-lane ones.
+//! 8-wide was ~12 % faster for closest hits and ~20 % for any hit. One 8-lane test per node
+//! written lane by lane (which the compiler vectorised) was not faster than two 4-lane ones; with
+//! AVX intrinsics (`simd.rs`) it is: 20 % fewer instructions per incoherent ray. Sorting the
+//! pushed children, branchless pushes and prefetching gained nothing (earlier measurements).
 
-use glam::{Vec3A, Vec4};
+use std::mem::MaybeUninit;
+
+use glam::Vec3A;
 use obvhs::{aabb::Aabb as BvhAabb, bvh2::Bvh2};
 
-/// Groups of four SIMD lanes per node.
-const HALVES: usize = 2;
+use super::simd::F8;
+
 /// Number of children per node.
-const WIDTH: usize = 4 * HALVES;
+const WIDTH: usize = 8;
 
 /// Set in a child reference that is a leaf (else the reference is a node index).
 const LEAF_BIT: u32 = 1 << 31;
 /// Set in a leaf reference whose primitives are not all triangles.
 const MIXED_BIT: u32 = 1 << 30;
 /// Most primitives in one leaf: one SIMD lane each.
-pub(super) const MAX_LEAF_PRIMS: u32 = 4;
+pub(super) const MAX_LEAF_PRIMS: u32 = 8;
 /// Leaves are numbered below this bound in a leaf reference.
 const MAX_LEAVES: u32 = 1 << 30;
 /// The reference in an unused child slot; its box is empty, so it is never followed.
@@ -34,8 +38,8 @@ const EMPTY: u32 = u32::MAX;
 /// test never culls a box the exact ray enters (pbrt-v4, "Robust ray–bounds intersection").
 const ROBUST_EXIT: f32 = 1.0 + 4.0 * f32::EPSILON;
 
-/// Capacity of the on-stack traversal stack of ordinary trees (it is zeroed for every ray, so it
-/// should not be larger than needed: the bunny needs 50 entries, a 1M-triangle scene 64).
+/// Capacity of the on-stack traversal stack of ordinary trees (the bunny needs 50 entries, a
+/// 1M-triangle scene 64).
 const STACK_SMALL: usize = 64;
 /// Capacity of the on-stack traversal stack of deep trees; deeper ones use a heap stack.
 const STACK_LARGE: usize = 256;
@@ -65,41 +69,58 @@ fn leaf_of(r: u32) -> Leaf {
     }
 }
 
-/// A node: the child boxes in SoA form, in groups of four lanes, and the child references.
+/// A node: the child boxes in SoA form, one row of eight lanes per bound, and the child
+/// references (256 bytes, four cache lines).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct Node {
-    /// `bounds[2 * axis][g]`: the lower bounds along `axis` of children 4g .. 4g + 4;
-    /// `bounds[2 * axis + 1][g]`: their upper bounds.
-    bounds: [[Vec4; HALVES]; 6],
+    /// `bounds[2 * axis]`: the lower bounds of the children along `axis`;
+    /// `bounds[2 * axis + 1]`: their upper bounds.
+    bounds: [F8; 6],
     /// Node index, leaf reference or [`EMPTY`], per child.
     children: [u32; WIDTH],
 }
 
-impl Node {
+/// A [`Node`] under construction.
+#[derive(Clone, Copy, Debug)]
+struct NodeBuilder {
+    bounds: [[f32; WIDTH]; 6],
+    children: [u32; WIDTH],
+}
+
+impl NodeBuilder {
     /// A node whose slots all hold [`EMPTY`] with an empty box (lower bound +∞, upper −∞, which
     /// no slab test with a finite origin enters, whatever the direction: no NaN can arise).
     const EMPTY: Self = Self {
         bounds: [
-            [Vec4::INFINITY; HALVES],
-            [Vec4::NEG_INFINITY; HALVES],
-            [Vec4::INFINITY; HALVES],
-            [Vec4::NEG_INFINITY; HALVES],
-            [Vec4::INFINITY; HALVES],
-            [Vec4::NEG_INFINITY; HALVES],
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
         ],
         children: [EMPTY; WIDTH],
     };
 
     fn set_child(&mut self, slot: usize, aabb: &BvhAabb, child: u32) {
         for axis in 0..3 {
-            self.bounds[2 * axis][slot / 4][slot % 4] = aabb.min[axis];
-            self.bounds[2 * axis + 1][slot / 4][slot % 4] = aabb.max[axis];
+            self.bounds[2 * axis][slot] = aabb.min[axis];
+            self.bounds[2 * axis + 1][slot] = aabb.max[axis];
         }
         self.children[slot] = child;
     }
 
-    /// The mask of the child boxes the ray enters within [tmin, tmax], and their entry distances
+    fn build(&self) -> Node {
+        Node {
+            bounds: self.bounds.map(F8::from_array),
+            children: self.children,
+        }
+    }
+}
+
+impl Node {
+    /// The mask of the child boxes the ray enters within [0, tmax], and their entry distances
     /// (∞ for the others).
     ///
     /// Slab distances are (bound − origin) · (1 / direction). A zero direction component gives an
@@ -107,26 +128,26 @@ impl Node {
     /// the box or is ignored, and both are right because every box is padded beyond its
     /// primitives (`Accel::build`): a ray that stays in the plane of a box face meets none of them.
     #[inline(always)]
-    fn intersect(&self, ray: &BoxRay, tmax: f32) -> (u32, [Vec4; HALVES]) {
+    fn intersect(&self, ray: &BoxRay, tmax: f32) -> (u32, F8) {
         let [sx, sy, sz] = ray.near;
-        let tmax = Vec4::splat(tmax);
-        let mut mask = 0;
-        let mut entry = [Vec4::ZERO; HALVES];
-        for (g, entry) in entry.iter_mut().enumerate() {
-            let b = |row: usize| self.bounds[row][g];
-            let tx0 = (b(sx & 1) - ray.origin[0]) * ray.inv_dir[0];
-            let tx1 = (b((sx ^ 1) & 1) - ray.origin[0]) * ray.inv_dir[0];
-            let ty0 = (b(2 + (sy & 1)) - ray.origin[1]) * ray.inv_dir[1];
-            let ty1 = (b(2 + ((sy ^ 1) & 1)) - ray.origin[1]) * ray.inv_dir[1];
-            let tz0 = (b(4 + (sz & 1)) - ray.origin[2]) * ray.inv_dir[2];
-            let tz1 = (b(4 + ((sz ^ 1) & 1)) - ray.origin[2]) * ray.inv_dir[2];
-            let tnear = tx0.max(ty0).max(tz0).max(ray.tmin);
-            let tfar = (tx1.min(ty1).min(tz1) * ROBUST_EXIT).min(tmax);
-            let hit = tnear.cmple(tfar);
-            mask |= hit.bitmask() << (4 * g);
-            *entry = Vec4::select(hit, tnear, Vec4::INFINITY);
-        }
-        (mask, entry)
+        let b = |row: usize| self.bounds[row];
+        let tx0 = b(sx & 1).sub(ray.origin[0]).mul(ray.inv_dir[0]);
+        let tx1 = b((sx ^ 1) & 1).sub(ray.origin[0]).mul(ray.inv_dir[0]);
+        let ty0 = b(2 + (sy & 1)).sub(ray.origin[1]).mul(ray.inv_dir[1]);
+        let ty1 = b(2 + ((sy ^ 1) & 1)).sub(ray.origin[1]).mul(ray.inv_dir[1]);
+        let tz0 = b(4 + (sz & 1)).sub(ray.origin[2]).mul(ray.inv_dir[2]);
+        let tz1 = b(4 + ((sz ^ 1) & 1)).sub(ray.origin[2]).mul(ray.inv_dir[2]);
+        let tnear = tx0.max(ty0).max(tz0).max(F8::splat(0.0));
+        let tfar = tx1
+            .min(ty1)
+            .min(tz1)
+            .mul(F8::splat(ROBUST_EXIT))
+            .min(F8::splat(tmax));
+        let hit = tnear.le(tfar);
+        (
+            hit.bitmask(),
+            F8::select(hit, tnear, F8::splat(f32::INFINITY)),
+        )
     }
 }
 
@@ -134,9 +155,8 @@ impl Node {
 /// per axis which side of a box the ray enters (0: lower bound, 1: upper).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct BoxRay {
-    origin: [Vec4; 3],
-    inv_dir: [Vec4; 3],
-    tmin: Vec4,
+    origin: [F8; 3],
+    inv_dir: [F8; 3],
     near: [usize; 3],
 }
 
@@ -144,16 +164,15 @@ impl BoxRay {
     /// Any finite `direction` will do: a ±0.0 component has an inverse of ±∞, which
     /// [`Node::intersect`] handles.
     #[inline(always)]
-    pub(super) fn new(origin: Vec3A, direction: Vec3A, tmin: f32) -> Self {
+    pub(super) fn new(origin: Vec3A, direction: Vec3A) -> Self {
         let inv = Vec3A::ONE / direction;
         Self {
             origin: [
-                Vec4::splat(origin.x),
-                Vec4::splat(origin.y),
-                Vec4::splat(origin.z),
+                F8::splat(origin.x),
+                F8::splat(origin.y),
+                F8::splat(origin.z),
             ],
-            inv_dir: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
-            tmin: Vec4::splat(tmin),
+            inv_dir: [F8::splat(inv.x), F8::splat(inv.y), F8::splat(inv.z)],
             near: [
                 usize::from(inv.x < 0.0),
                 usize::from(inv.y < 0.0),
@@ -172,9 +191,11 @@ trait Stack {
     fn pop(&mut self) -> Option<Entry>;
 }
 
-/// A fixed-capacity stack; [`Wide::stack_need`] guarantees it cannot overflow.
+/// A fixed-capacity stack; [`Wide::stack_need`] guarantees it cannot overflow. Its storage is
+/// left uninitialised: zeroing it cost about 5 % of the instructions of an incoherent ray.
 struct ArrayStack<const N: usize> {
-    items: [Entry; N],
+    /// `items[..len]` are initialised.
+    items: [MaybeUninit<Entry>; N],
     len: usize,
 }
 
@@ -182,7 +203,7 @@ impl<const N: usize> ArrayStack<N> {
     #[inline(always)]
     fn new() -> Self {
         Self {
-            items: [(0, 0.0); N],
+            items: [const { MaybeUninit::uninit() }; N],
             len: 0,
         }
     }
@@ -191,14 +212,15 @@ impl<const N: usize> ArrayStack<N> {
 impl<const N: usize> Stack for ArrayStack<N> {
     #[inline(always)]
     fn push(&mut self, e: Entry) {
-        self.items[self.len] = e;
+        self.items[self.len] = MaybeUninit::new(e);
         self.len += 1;
     }
 
     #[inline(always)]
     fn pop(&mut self) -> Option<Entry> {
         self.len = self.len.checked_sub(1)?;
-        Some(self.items[self.len])
+        // SAFETY: `push` initialised every item below the old length.
+        Some(unsafe { self.items[self.len].assume_init() })
     }
 }
 
@@ -258,8 +280,8 @@ impl<F: Fn(u32, u32) -> bool> Collapse<'_, F> {
         }
         let per_child = count.div_ceil(WIDTH as u32);
         let at = self.nodes.len();
-        self.nodes.push(Node::EMPTY);
-        let mut node = Node::EMPTY;
+        self.nodes.push(NodeBuilder::EMPTY.build());
+        let mut node = NodeBuilder::EMPTY;
         let mut depth = 0;
         for slot in 0..WIDTH as u32 {
             let start = slot * per_child;
@@ -270,7 +292,7 @@ impl<F: Fn(u32, u32) -> bool> Collapse<'_, F> {
                 depth = depth.max(d);
             }
         }
-        self.nodes[at] = node;
+        self.nodes[at] = node.build();
         (at as u32, depth + 1)
     }
 }
@@ -296,7 +318,7 @@ impl Wide {
                 leaves: c.leaves,
             };
         }
-        c.nodes.push(Node::EMPTY);
+        c.nodes.push(NodeBuilder::EMPTY.build());
         let mut work = vec![Pending {
             bvh2_node: 0,
             index: 0,
@@ -305,7 +327,7 @@ impl Wide {
         let mut max_depth = 1;
         while let Some(p) = work.pop() {
             max_depth = max_depth.max(p.depth);
-            let mut node = Node::EMPTY;
+            let mut node = NodeBuilder::EMPTY;
             let open = Self::open(bvh2, p.bvh2_node);
             for (slot, &child) in open.iter().enumerate().filter(|&(_, &n)| n != usize::MAX) {
                 let child_node = &bvh2.nodes[child];
@@ -319,7 +341,7 @@ impl Wide {
                     reference
                 } else {
                     let index = c.nodes.len();
-                    c.nodes.push(Node::EMPTY);
+                    c.nodes.push(NodeBuilder::EMPTY.build());
                     work.push(Pending {
                         bvh2_node: child,
                         index,
@@ -329,7 +351,7 @@ impl Wide {
                 };
                 node.set_child(slot, &child_node.aabb, reference);
             }
-            c.nodes[p.index] = node;
+            c.nodes[p.index] = node.build();
         }
         Self {
             nodes: c.nodes,
@@ -400,7 +422,8 @@ impl Wide {
                     }
                     // Two or more: continue with the nearest, push the others (in lane order:
                     // sorting them cost more than it saved, measured).
-                    let (nearest, entry) = nearest_lane(&tnear);
+                    let nearest = nearest_lane(tnear, mask);
+                    let entry = tnear.to_array();
                     mask &= !(1 << nearest);
                     while mask != 0 {
                         let i = mask.trailing_zeros() as usize;
@@ -424,7 +447,7 @@ impl Wide {
         }
     }
 
-    /// Any-hit traversal: stops as soon as `leaf` reports a hit within [tmin, tmax].
+    /// Any-hit traversal: stops as soon as `leaf` reports a hit within [0, tmax].
     #[inline(always)]
     pub(super) fn any(&self, ray: &BoxRay, tmax: f32, leaf: &impl Leaves) -> bool {
         if self.stack_need <= STACK_SMALL {
@@ -472,22 +495,9 @@ impl Wide {
     }
 }
 
-/// The lane of smallest entry distance (the first such lane on ties) in the output of
-/// [`Node::intersect`], and the entry distances as an array.
+/// The lane of smallest entry distance among the children in `mask` (the first such lane on
+/// ties) in the output of [`Node::intersect`].
 #[inline(always)]
-fn nearest_lane(entries: &[Vec4; HALVES]) -> (usize, [f32; WIDTH]) {
-    let min = entries
-        .iter()
-        .fold(Vec4::INFINITY, |a, &b| a.min(b))
-        .min_element();
-    let mut at = 0;
-    let mut array = [0.0; WIDTH];
-    for (g, t) in entries.iter().enumerate().rev() {
-        let eq = t.cmpeq(Vec4::splat(min)).bitmask();
-        if eq != 0 {
-            at = 4 * g + eq.trailing_zeros() as usize;
-        }
-        array[4 * g..4 * g + 4].copy_from_slice(&t.to_array());
-    }
-    (at, array)
+fn nearest_lane(entries: F8, mask: u32) -> usize {
+    (entries.eq(entries.min_all()).bitmask() & mask).trailing_zeros() as usize
 }
