@@ -17,7 +17,7 @@ pub(crate) const HELP: &str = "\
 cargo xtask converge --scene NAME [--budgets 2,4,8,16,32] [--methods ppm,sppm,freq,freq-sppm,path]
                      [--photons N] [--seed S] [--out DIR] [--quick]
                      [--pointwise PATHS] [--replot] [--alpha A] [--freq-fraction F] [--kernel-k poster|strict|K] [--freq-merge min|poster-max]
-                     [--freq-geometry on|off] [--clock wall|cpu]
+                     [--freq-geometry on|off] [--clock wall|cpu] [--film WxH]
 cargo xtask converge --scene NAME --sweep [--budget SECONDS] [--methods freq]
 
 Runs each method alone (one after another) on the suite scene NAME at its suite film size and
@@ -38,6 +38,8 @@ own --out DIR.
 --clock cpu measures budgets in process CPU seconds divided by the thread count instead of
 wall-clock seconds: the same on an idle machine, and what each method would have taken alone
 when other jobs share the machine.
+--film WxH renders at another film size (with --pointwise only; masks then come from the
+pointwise reference).
 --freq-geometry off lets frequency methods hold radii over edges and corners (no clear-disc
 probes).
 --sweep renders the methods (default freq and ppm) at one budget (default 8 s) with one
@@ -68,6 +70,7 @@ struct Flags {
     replot: bool,
     budget: f64,
     pointwise: Option<u32>,
+    film: Option<(u32, u32)>,
     clock: Clock,
     overrides: Overrides,
 }
@@ -221,6 +224,7 @@ impl Flags {
             replot: false,
             budget: 8.0,
             clock: Clock::Wall,
+            film: None,
             pointwise: None,
             overrides: Overrides::default(),
         };
@@ -245,6 +249,17 @@ impl Flags {
                 "--sweep" => flags.sweep = true,
                 "--replot" => flags.replot = true,
                 "--pointwise" => flags.pointwise = Some(value()?.parse()?),
+                "--film" => {
+                    let v = value()?;
+                    let (w, h) = v
+                        .split_once('x')
+                        .with_context(|| format!("--film takes WIDTHxHEIGHT, not `{v}`"))?;
+                    let (w, h): (u32, u32) = (w.parse()?, h.parse()?);
+                    if w == 0 || h == 0 || w > 4096 || h > 4096 {
+                        bail!("--film {v}: each side must be in [1, 4096]");
+                    }
+                    flags.film = Some((w, h));
+                }
                 "--clock" => {
                     flags.clock = match value()?.as_str() {
                         "wall" => Clock::Wall,
@@ -297,6 +312,11 @@ impl Flags {
             bail!("converge: budgets must be positive seconds");
         }
         flags.budgets.sort_by(f64::total_cmp);
+        if flags.film.is_some() && flags.pointwise.is_none() {
+            bail!(
+                "converge: --film needs --pointwise (the golden references have the suite's film size)"
+            );
+        }
         if flags.pointwise.is_some()
             && flags
                 .methods
@@ -355,8 +375,18 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         plot_error_curves(&out, &entry.name, &rows)?;
         return Ok(true);
     }
-    let scene = suite::load_scene(root, entry)?;
-    let masks = build_masks(&scene, &reference);
+    let (scene, reference) = match flags.film {
+        None => (suite::load_scene(root, entry)?, reference),
+        Some((width, height)) => {
+            // Masks below come from the reference; the pointwise reference replaces this
+            // placeholder before anything is measured (`--film` requires `--pointwise`).
+            let scene = suite::load_scene_sized(root, &entry.path, width, height)?;
+            let (w, h) = (width as usize, height as usize);
+            let blank = Image::new(w, h, vec![[0.0; 3]; w * h]);
+            (scene, blank)
+        }
+    };
+    let golden_masks = build_masks(&scene, &reference);
     let reference = match flags.pointwise {
         None => reference,
         Some(paths) => {
@@ -371,6 +401,11 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
             );
             Image::new(reference.width, reference.height, pixels)
         }
+    };
+    let masks = if flags.film.is_some() {
+        build_masks(&scene, &reference)
+    } else {
+        golden_masks
     };
     if flags.sweep {
         return sweep(&scene, entry, &reference, &masks, &flags, &out);
