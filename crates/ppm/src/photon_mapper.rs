@@ -5,7 +5,9 @@
 //! hitpoint spheres), `photon_pass` (trace photons in fixed chunks, collect deposits) and
 //! `update_hitpoints` (fold the deposits into R, N, τ with the keep-or-shrink rule).
 
-use geometry::{Bsdf, EmitterShape, Hit, Lobe as MaterialLobe, Ray, Rgb, Scene, TransportMode};
+use geometry::{
+    Bsdf, EmitterShape, Hit, Lobe as MaterialLobe, MaterialKind, Ray, Rgb, Scene, TransportMode,
+};
 use glam::{Vec2, Vec3};
 use photon::{
     AcceptParams, GatherScratch, GridParams, HitPointGrid, HitPoints, MortonScratch, NewHitPoint,
@@ -703,8 +705,22 @@ impl<'s> PhotonMapper<'s> {
                 let slot = grid_slots[entry as usize] as usize;
                 self.accepts(photon, slot).then(|| {
                     let material = self.scene.material(slots.material_idx()[slot])?;
-                    let bsdf = Bsdf::from_normal(material.kind, slots.shading_normal()[slot], true);
-                    let f = bsdf.eval(slots.outgoing()[slot], photon.incoming);
+                    let (normal, outgoing) = (slots.shading_normal()[slot], slots.outgoing()[slot]);
+                    let f = match material.kind {
+                        // `Bsdf::eval` of a Lambertian without building the shading frame: the
+                        // same hemisphere test on the same dot products (the frame's z is the
+                        // normal), the same value.
+                        MaterialKind::Diffuse { albedo } => {
+                            if outgoing.dot(normal) * photon.incoming.dot(normal) <= 0.0 {
+                                Rgb::ZERO
+                            } else {
+                                albedo * std::f32::consts::FRAC_1_PI
+                            }
+                        }
+                        kind => {
+                            Bsdf::from_normal(kind, normal, true).eval(outgoing, photon.incoming)
+                        }
+                    };
                     Some(f * photon.power * slots.weight()[slot])
                 })?
             },
