@@ -72,6 +72,25 @@ pub struct GatherScratch<T> {
     bins: Vec<Vec<Vec<(u32, T)>>>,
 }
 
+impl<T> GatherScratch<T> {
+    /// Heap bytes of the bins (allocated capacities).
+    #[must_use]
+    pub fn heap_bytes(&self) -> usize {
+        use std::mem::size_of;
+        self.bins
+            .iter()
+            .map(|ranges| {
+                ranges.capacity() * size_of::<Vec<(u32, T)>>()
+                    + ranges
+                        .iter()
+                        .map(|bin| bin.capacity() * size_of::<(u32, T)>())
+                        .sum::<usize>()
+            })
+            .sum::<usize>()
+            + self.bins.capacity() * size_of::<Vec<Vec<(u32, T)>>>()
+    }
+}
+
 impl<T> Default for GatherScratch<T> {
     fn default() -> Self {
         Self { bins: Vec::new() }
@@ -121,6 +140,8 @@ pub fn gather_with<P, T, A>(
             }
         });
     accumulators.clear();
+    // Exactly: the default growth would double the capacity when the count grows a little.
+    accumulators.reserve_exact(n_hitpoints);
     accumulators.resize(n_hitpoints, A::default());
     let bins = &*bins;
     accumulators

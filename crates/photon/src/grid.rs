@@ -44,8 +44,10 @@ impl GridParams {
 /// the query point. Level L has cell edge e·2^L and holds the hitpoints with
 /// e·2^(L−2) < R ≤ e·2^(L−1) (level 0: all R ≤ e/2), so a hitpoint spans at most 2–3 cells per
 /// axis; e comes from [`CellSize`]. Cells of all levels are hashed into one power-of-two table
-/// of about 2 × the number of hitpoints; `cell_start[b]..cell_start[b + 1]` indexes bucket b's
-/// entries. Only infinite radii (or R > e·2^47) go to an overflow list scanned by every query.
+/// of about 2 × the number of occupied cells (at most 2 × the number of hitpoints);
+/// `cell_start[b]..cell_start[b + 1]` indexes bucket b's entries. Sized by the hitpoints, the
+/// table was mostly empty while radii are large (tens of hitpoints per cell): 8 bytes per
+/// hitpoint, a fifth of the grid, for buckets nobody looks up. Only infinite radii (or R > e·2^47) go to an overflow list scanned by every query.
 /// An entry is a hitpoint index (4 bytes); the hitpoint's position and R² are stored once per
 /// hitpoint (16 bytes, one quarter of a cache line) and read through the index. Hitpoints given
 /// in a spatially coherent order (the Morton order of `morton_order`) keep those reads local:
@@ -58,9 +60,11 @@ impl GridParams {
 /// The stored R² is the largest `f32` not above the exact `f64` R², which makes the `f32` test
 /// `|p − x|² ≤ R²_f32` equivalent to [`crate::within_radius`]: the results are exact.
 ///
-/// Build: the (bucket, hitpoint) pairs are generated in parallel over fixed chunks of hitpoints,
-/// concatenated in chunk order and sorted by bucket with a stable LSD radix sort, so entries of
-/// a bucket are in increasing hitpoint index whatever the thread count. No per-cell allocation,
+/// Build: the (32-bit cell hash, hitpoint) pairs are generated in parallel over fixed chunks of
+/// hitpoints, concatenated in chunk order and sorted by hash with a stable LSD radix sort; the
+/// distinct hashes give the table size, a bucket being the top bits of the hash. Entries of a
+/// bucket are in increasing hitpoint index (buckets holding several cells are sorted and
+/// deduplicated) whatever the thread count. No per-cell allocation,
 /// no locks. Queries take `&self` and run in parallel freely.
 ///
 /// PPM radii shrink between passes: [`Self::refresh_radii`] copies the new radii into the
@@ -178,7 +182,8 @@ impl HitPointGrid {
         let min_edge = (extent * 2.0_f32.powi(-20)).max(f32::MIN_POSITIVE.sqrt());
         // Rounded up, so that the largest radius of `MaxRadius(2.0)` stays on level 0.
         let cell_edge = f32_at_least(reference_radius * factor).max(min_edge);
-        let n_buckets = (2 * n).max(2).next_power_of_two();
+        // The largest table: about 2 buckets per hitpoint (see the type's documentation).
+        let max_buckets = (2 * n).max(2).next_power_of_two().min(1 << 31);
         let mut grid = Self {
             origin: lo,
             cell_edge,
@@ -186,7 +191,7 @@ impl HitPointGrid {
                 .map(|level| 1.0 / cell_edge * 0.5_f32.powi(level as i32))
                 .collect(),
             occupied_levels: Vec::new(),
-            hash_shift: 32 - n_buckets.trailing_zeros(),
+            hash_shift: 32 - max_buckets.trailing_zeros(),
             cell_start: Vec::new(),
             points: Vec::new(),
             level: Vec::new(),
@@ -200,7 +205,7 @@ impl HitPointGrid {
         // rounding of `x ± r` and of `p − x` in the distance test. It stays below `min_edge`.
         let pad = extent * 2.0_f32.powi(-21);
 
-        // (bucket << 32 | hitpoint) keys in hitpoint order, and the overflow hitpoints.
+        // (cell hash << 32 | hitpoint) keys in hitpoint order, and the overflow hitpoints.
         let chunks: Vec<(Vec<u64>, Vec<u32>, u64)> = positions
             .par_chunks(BUILD_CHUNK)
             .zip(radii.par_chunks(BUILD_CHUNK))
@@ -217,7 +222,7 @@ impl HitPointGrid {
                     }
                     let cells = grid.level_of(r).and_then(|level| {
                         level_mask |= 1 << level;
-                        grid.buckets_of(x, r, level, pad, &mut buckets)
+                        grid.cell_hashes_of(x, r, level, pad, &mut buckets)
                     });
                     match cells {
                         Some(k) => keys.extend(
@@ -242,21 +247,52 @@ impl HitPointGrid {
             .filter(|l| level_mask >> l & 1 == 1)
             .collect();
         drop(chunks);
-        radix_sort_by_bucket(&mut keys, 32 - grid.hash_shift);
+        radix_sort_by_bucket(&mut keys, 32);
 
-        // Bucket starts from the sorted keys.
+        // Table size from the occupied cells (distinct hashes; cells whose hashes collide count
+        // once, which only makes the table smaller), then entries and bucket starts.
+        let n_cells = 1 + keys.windows(2).filter(|w| w[0] >> 32 != w[1] >> 32).count();
+        let n_buckets = (2 * n_cells).next_power_of_two().clamp(2, max_buckets);
+        grid.hash_shift = 32 - n_buckets.trailing_zeros();
+        assert!(
+            u32::try_from(keys.len()).is_ok(),
+            "fewer than 2³² grid entries"
+        );
         grid.cell_start = vec![0; n_buckets + 1];
-        let mut j = 0;
-        for (b, start) in grid.cell_start.iter_mut().enumerate() {
-            while j < keys.len() && (keys[j] >> 32) < b as u64 {
-                j += 1;
+        grid.entry_idx = Vec::with_capacity(keys.len());
+        let mut i = 0;
+        while i < keys.len() {
+            let bucket = (keys[i] >> 32) as u32 >> grid.hash_shift;
+            let (first_key, first_entry) = (i, grid.entry_idx.len());
+            let mut several_cells = false;
+            while i < keys.len() && (keys[i] >> 32) as u32 >> grid.hash_shift == bucket {
+                several_cells |= keys[i] >> 32 != keys[first_key] >> 32;
+                grid.entry_idx.push(keys[i] as u32);
+                i += 1;
             }
-            *start = u32::try_from(j).expect("fewer than 2³² grid entries");
+            if several_cells {
+                // Cells sharing the bucket: back to increasing hitpoint index, each once.
+                let entries = &mut grid.entry_idx[first_entry..];
+                entries.sort_unstable();
+                let mut kept = 0;
+                for j in 0..entries.len() {
+                    if j == 0 || entries[j] != entries[kept - 1] {
+                        entries[kept] = entries[j];
+                        kept += 1;
+                    }
+                }
+                grid.entry_idx.truncate(first_entry + kept);
+            }
+            grid.cell_start[bucket as usize + 1] = grid.entry_idx.len() as u32;
         }
-
-        // Entries and per-hitpoint records, in parallel (pure maps).
-        grid.entry_idx = keys.par_iter().map(|&k| k as u32).collect();
         drop(keys);
+        // Empty buckets start where the previous one ended.
+        for b in 1..grid.cell_start.len() {
+            grid.cell_start[b] = grid.cell_start[b].max(grid.cell_start[b - 1]);
+        }
+        grid.entry_idx.shrink_to_fit();
+
+        // Per-hitpoint records, in parallel (pure maps).
         grid.points = positions
             .par_iter()
             .zip(radii)
@@ -398,12 +434,7 @@ impl HitPointGrid {
 
     #[inline]
     fn bucket(&self, x: i32, y: i32, z: i32, level: u32) -> usize {
-        // Teschner et al. 2003 primes, then a Fibonacci multiply keeps the high bits.
-        let h = (x as u32).wrapping_mul(73_856_093)
-            ^ (y as u32).wrapping_mul(19_349_663)
-            ^ (z as u32).wrapping_mul(83_492_791)
-            ^ level.wrapping_mul(0x2545_F491);
-        (h.wrapping_mul(0x9E37_79B1) >> self.hash_shift) as usize
+        (cell_hash(x, y, z, level) >> self.hash_shift) as usize
     }
 
     /// The level of a hitpoint of radius `r`: the smallest L with 2r ≤ e·2^L; `None` (overflow
@@ -419,9 +450,9 @@ impl HitPointGrid {
         None
     }
 
-    /// The distinct buckets of the cells overlapped by the padded box of sphere (x, r) in
+    /// The distinct hashes of the cells overlapped by the padded box of sphere (x, r) in
     /// `out[..k]`; `None` if it spans more than `MAX_CELLS_PER_HITPOINT` cells.
-    fn buckets_of(
+    fn cell_hashes_of(
         &self,
         x: Vec3,
         r: f64,
@@ -444,7 +475,7 @@ impl HitPointGrid {
         for cz in lo[2]..=hi[2] {
             for cy in lo[1]..=hi[1] {
                 for cx in lo[0]..=hi[0] {
-                    let b = self.bucket(cx, cy, cz, level) as u32;
+                    let b = cell_hash(cx, cy, cz, level);
                     if !out[..k].contains(&b) {
                         out[k] = b;
                         k += 1;
@@ -456,7 +487,18 @@ impl HitPointGrid {
     }
 }
 
-/// Stable LSD radix sort of `keys` by their high `bucket_bits` bits (11 bits per pass).
+/// The 32-bit hash of a cell; a bucket is its top bits.
+#[inline]
+fn cell_hash(x: i32, y: i32, z: i32, level: u32) -> u32 {
+    // Teschner et al. 2003 primes, then a Fibonacci multiply keeps the high bits.
+    let h = (x as u32).wrapping_mul(73_856_093)
+        ^ (y as u32).wrapping_mul(19_349_663)
+        ^ (z as u32).wrapping_mul(83_492_791)
+        ^ level.wrapping_mul(0x2545_F491);
+    h.wrapping_mul(0x9E37_79B1)
+}
+
+/// Stable LSD radix sort of `keys` by the `bucket_bits` bits above bit 32 (11 bits per pass).
 fn radix_sort_by_bucket(keys: &mut Vec<u64>, bucket_bits: u32) {
     const DIGIT: u32 = 11;
     let mut scratch = vec![0_u64; keys.len()];

@@ -17,8 +17,6 @@ pub struct NewHitPoint<F> {
     pub outgoing: Vec3,
     /// Material index; the integrator re-creates the BSDF from it and the normals.
     pub material_idx: u32,
-    /// Pixel this hitpoint contributes to.
-    pub pixel_idx: u32,
     /// Throughput weight of the eye path up to this hitpoint (RGB).
     pub weight: Vec3,
     /// Initial gather radius.
@@ -34,11 +32,13 @@ pub struct NewHitPoint<F> {
 /// - the progressive statistics are `f64`: the radius R, the accumulated photon count N and the
 ///   flux τ. Over millions of passes R² shrinks geometrically (R² ∝ N^(α−1)) and N grows without
 ///   bound; `f32` would lose N increments once N > 2²⁴ · M and would make the τ·R′²/R²
-///   rescaling drift. The doubles cost 40 of the 141 bytes.
+///   rescaling drift. The doubles cost 40 of the 136 bytes.
 /// - the frequency state is a generic column `F` (the integrator plugs in the `spectrum`
-///   accumulator), plus a `has_freq` flag: `false` until a frequency photon was merged.
+///   accumulator, which itself knows whether a frequency photon was merged).
 ///
-/// Use [`Self::bytes_per_hitpoint`] for the memory cost; with a 32-byte `F` it is 141 bytes.
+/// Nothing derivable is stored: the pixel of a hitpoint is a function of its index (the
+/// integrator lays the slots out pixel by pixel), the "has a frequency photon" flag is part of
+/// `F`. Use [`Self::bytes_per_hitpoint`] for the memory cost; with a 32-byte `F` it is 136 bytes.
 #[derive(Clone, Debug, Default)]
 pub struct HitPoints<F> {
     position: Vec<Vec3>,
@@ -46,12 +46,10 @@ pub struct HitPoints<F> {
     geometric_normal: Vec<Vec3>,
     outgoing: Vec<Vec3>,
     material_idx: Vec<u32>,
-    pixel_idx: Vec<u32>,
     weight: Vec<Vec3>,
     radius: Vec<f64>,
     photon_count: Vec<f64>,
     flux: Vec<[f64; 3]>,
-    has_freq: Vec<bool>,
     freq: Vec<F>,
 }
 
@@ -66,8 +64,6 @@ pub struct HitPointColumnsMut<'a, F> {
     pub photon_count: &'a mut [f64],
     /// Accumulated flux τ (RGB).
     pub flux: &'a mut [[f64; 3]],
-    /// Whether a frequency photon has been merged.
-    pub has_freq: &'a mut [bool],
     /// Frequency state.
     pub freq: &'a mut [F],
     /// Throughput weight (SPPM rewrites it each pass).
@@ -84,17 +80,15 @@ impl<F: Copy + Default> HitPoints<F> {
             geometric_normal: Vec::with_capacity(n_hitpoints),
             outgoing: Vec::with_capacity(n_hitpoints),
             material_idx: Vec::with_capacity(n_hitpoints),
-            pixel_idx: Vec::with_capacity(n_hitpoints),
             weight: Vec::with_capacity(n_hitpoints),
             radius: Vec::with_capacity(n_hitpoints),
             photon_count: Vec::with_capacity(n_hitpoints),
             flux: Vec::with_capacity(n_hitpoints),
-            has_freq: Vec::with_capacity(n_hitpoints),
             freq: Vec::with_capacity(n_hitpoints),
         }
     }
 
-    /// Appends a hitpoint with count 0, zero flux and `has_freq = false`; returns its index.
+    /// Appends a hitpoint with count 0 and zero flux; returns its index.
     pub fn push(&mut self, hitpoint: NewHitPoint<F>) -> usize {
         debug_assert!(hitpoint.radius >= 0.0, "radius must be non-negative");
         let idx = self.position.len();
@@ -103,19 +97,16 @@ impl<F: Copy + Default> HitPoints<F> {
         self.geometric_normal.push(hitpoint.geometric_normal);
         self.outgoing.push(hitpoint.outgoing);
         self.material_idx.push(hitpoint.material_idx);
-        self.pixel_idx.push(hitpoint.pixel_idx);
         self.weight.push(hitpoint.weight);
         self.radius.push(hitpoint.radius);
         self.photon_count.push(0.0);
         self.flux.push([0.0; 3]);
-        self.has_freq.push(false);
         self.freq.push(hitpoint.freq);
         idx
     }
 
     /// Overwrites where hitpoint `idx` is (position, normals, outgoing direction, material,
-    /// pixel, weight) and keeps its progressive statistics (R, N, τ, `has_freq`, frequency
-    /// state): the SPPM camera pass, which re-traces the visible point of each slot every
+    /// weight) and keeps its progressive statistics (R, N, τ, frequency state): the SPPM camera pass, which re-traces the visible point of each slot every
     /// pass while the statistics carry over. `hitpoint.radius` and `hitpoint.freq` are ignored.
     ///
     /// # Panics
@@ -127,7 +118,6 @@ impl<F: Copy + Default> HitPoints<F> {
         self.geometric_normal[idx] = hitpoint.geometric_normal;
         self.outgoing[idx] = hitpoint.outgoing;
         self.material_idx[idx] = hitpoint.material_idx;
-        self.pixel_idx[idx] = hitpoint.pixel_idx;
         self.weight[idx] = hitpoint.weight;
     }
 
@@ -150,12 +140,10 @@ impl<F: Copy + Default> HitPoints<F> {
         self.geometric_normal.clear();
         self.outgoing.clear();
         self.material_idx.clear();
-        self.pixel_idx.clear();
         self.weight.clear();
         self.radius.clear();
         self.photon_count.clear();
         self.flux.clear();
-        self.has_freq.clear();
         self.freq.clear();
     }
 
@@ -164,11 +152,26 @@ impl<F: Copy + Default> HitPoints<F> {
     pub const fn bytes_per_hitpoint() -> usize {
         use std::mem::size_of;
         5 * size_of::<Vec3>()
-            + 2 * size_of::<u32>()
+            + size_of::<u32>()
             + 2 * size_of::<f64>()
             + size_of::<[f64; 3]>()
-            + size_of::<bool>()
             + size_of::<F>()
+    }
+
+    /// Heap bytes of all columns: their allocated capacities times the element sizes.
+    #[must_use]
+    pub fn heap_bytes(&self) -> usize {
+        use std::mem::size_of;
+        (self.position.capacity()
+            + self.shading_normal.capacity()
+            + self.geometric_normal.capacity()
+            + self.outgoing.capacity()
+            + self.weight.capacity())
+            * size_of::<Vec3>()
+            + self.material_idx.capacity() * size_of::<u32>()
+            + (self.radius.capacity() + self.photon_count.capacity()) * size_of::<f64>()
+            + self.flux.capacity() * size_of::<[f64; 3]>()
+            + self.freq.capacity() * size_of::<F>()
     }
 
     /// Positions.
@@ -201,12 +204,6 @@ impl<F: Copy + Default> HitPoints<F> {
         &self.material_idx
     }
 
-    /// Pixel indices.
-    #[must_use]
-    pub fn pixel_idx(&self) -> &[u32] {
-        &self.pixel_idx
-    }
-
     /// Throughput weights.
     #[must_use]
     pub fn weight(&self) -> &[Vec3] {
@@ -231,12 +228,6 @@ impl<F: Copy + Default> HitPoints<F> {
         &self.flux
     }
 
-    /// Whether a frequency photon has been merged.
-    #[must_use]
-    pub fn has_freq(&self) -> &[bool] {
-        &self.has_freq
-    }
-
     /// Frequency states.
     #[must_use]
     pub fn freq(&self) -> &[F] {
@@ -249,7 +240,6 @@ impl<F: Copy + Default> HitPoints<F> {
             radius: &mut self.radius,
             photon_count: &mut self.photon_count,
             flux: &mut self.flux,
-            has_freq: &mut self.has_freq,
             freq: &mut self.freq,
             weight: &mut self.weight,
         }
@@ -262,7 +252,7 @@ mod tests {
 
     #[test]
     fn bytes_per_hitpoint_with_32_byte_state() {
-        assert_eq!(HitPoints::<[f32; 8]>::bytes_per_hitpoint(), 141);
+        assert_eq!(HitPoints::<[f32; 8]>::bytes_per_hitpoint(), 136);
         assert!(HitPoints::<[f32; 8]>::bytes_per_hitpoint() < 200);
     }
 
@@ -276,21 +266,19 @@ mod tests {
             geometric_normal: Vec3::Z,
             outgoing: Vec3::Z,
             material_idx: 3,
-            pixel_idx: 7,
             weight: Vec3::ONE,
             radius: 0.5,
             freq: 9,
         });
         assert_eq!(idx, 0);
         assert_eq!(hits.len(), 1);
-        assert_eq!(hits.pixel_idx(), &[7]);
+        assert_eq!(hits.material_idx(), &[3]);
         assert_eq!(hits.photon_count(), &[0.0]);
         let cols = hits.columns_mut();
         cols.radius[0] = 0.25;
-        cols.has_freq[0] = true;
+        cols.freq[0] = 4;
         assert_eq!(hits.radius(), &[0.25]);
-        assert_eq!(hits.has_freq(), &[true]);
-        assert_eq!(hits.freq(), &[9]);
+        assert_eq!(hits.freq(), &[4]);
         hits.clear();
         assert!(hits.is_empty());
     }

@@ -57,6 +57,14 @@ pub struct MortonScratch {
     spare: Vec<(u64, u64)>,
 }
 
+impl MortonScratch {
+    /// Heap bytes of the key buffers (allocated capacities).
+    #[must_use]
+    pub fn heap_bytes(&self) -> usize {
+        (self.keys.capacity() + self.spare.capacity()) * std::mem::size_of::<(u64, u64)>()
+    }
+}
+
 /// `(Morton key, chunk << 32 | index in chunk)` of every item, sorted. The bounding box is a
 /// min/max reduction (exact in any order) and the pairs are distinct, so the parallel unstable
 /// sort has one result, which orders ties by position in the concatenation.

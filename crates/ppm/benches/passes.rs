@@ -2,14 +2,27 @@
 //! `cargo bench -p ppm --bench passes`.
 //!
 //! Prints, for 1 and 2 threads: photon paths per second (tracing only, and whole passes),
-//! gather queries per second, hitpoints per pixel, bytes per hitpoint, and the extra cost of
+//! gather queries per second, hitpoints per pixel, memory per hitpoint, and the extra cost of
 //! frequency photons at the default fraction. Times are wall-clock medians over a few passes,
 //! measured side by side in one run (absolute numbers on a shared machine are noisy).
 //!
+//! "trace paths/s" is the photon paths started in a pass (all of them, including those that
+//! end at the first hit) over the wall time of the tracing phase alone (`PassTimings::trace`:
+//! emission, intersections, BSDF sampling, roulette, storing photons, frequency bookkeeping);
+//! "pass paths/s" divides the same count by the whole pass (camera, index, trace, gather and
+//! update).
+//!
 //! `FPPM_BENCH_METHODS=ppm,freq` restricts the methods, `FPPM_BENCH_THREADS=1,2` the thread
-//! counts (the summary lines need both 1 and 2 threads of ppm and freq). A second table gives
-//! the median seconds of each phase of a pass. "pass CPU s" is the process CPU time of a pass
-//! (all threads): with 1 thread it is the work itself, whatever else runs on the machine.
+//! counts (the summary lines need both 1 and 2 threads of ppm and freq); `FPPM_BENCH_PHOTONS`
+//! and `FPPM_BENCH_PASSES` change the photons per pass and the timed passes (for profiling
+//! under callgrind). A second table gives the median seconds of each phase of a pass. "pass
+//! CPU s" is the process CPU time of a pass (all threads): with 1 thread it is the work
+//! itself, whatever else runs on the machine.
+//!
+//! Memory is `Renderer::memory` after the timed passes (allocated capacities), per hitpoint
+//! slot: the state kept from pass to pass (records, the renderer's slot columns, the grid and
+//! its slot map) and the per-pass buffers, sized by the hitpoints (M, Φ and frequency
+//! accumulators) or by the photons (traced and sorted photons, keys, gather bins).
 
 #![allow(clippy::print_stdout, clippy::unwrap_used, missing_docs)]
 
@@ -17,8 +30,12 @@ use std::path::Path;
 
 use ppm::{Method, PassStats, RenderParams, Renderer};
 
-const PHOTONS_PER_PASS: u32 = 1_000_000;
-const PASSES: usize = 5;
+fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -41,8 +58,14 @@ fn process_cpu_seconds() -> f64 {
         .unwrap_or(0.0)
 }
 
-/// Per-pass statistics and the process CPU seconds of each pass.
-fn run(scene: &geometry::Scene, method: Method, threads: usize) -> (Vec<PassStats>, Vec<f64>) {
+/// Per-pass statistics, the process CPU seconds of each pass and the memory at the end.
+fn run(
+    scene: &geometry::Scene,
+    method: Method,
+    threads: usize,
+    photons_per_pass: u32,
+    passes: usize,
+) -> (Vec<PassStats>, Vec<f64>, ppm::MemoryUse) {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -50,17 +73,18 @@ fn run(scene: &geometry::Scene, method: Method, threads: usize) -> (Vec<PassStat
     pool.install(|| {
         let mut params = RenderParams::preview();
         params.method = method;
-        params.photons_per_pass = PHOTONS_PER_PASS;
+        params.photons_per_pass = photons_per_pass;
         let mut renderer = Renderer::new(scene, params).unwrap();
         // The first pass traces the hitpoints and builds the grid: not part of the steady state.
         renderer.iterate();
-        (0..PASSES)
+        let (stats, cpu) = (0..passes)
             .map(|_| {
                 let cpu = process_cpu_seconds();
                 let stats = renderer.iterate();
                 (stats, process_cpu_seconds() - cpu)
             })
-            .unzip()
+            .unzip();
+        (stats, cpu, renderer.memory().unwrap())
     })
 }
 
@@ -73,8 +97,10 @@ fn main() {
         height: 512,
     };
     let scene = geometry::Scene::new(description).unwrap();
+    let photons_per_pass: u32 = env_or("FPPM_BENCH_PHOTONS", 1_000_000);
+    let passes: usize = env_or("FPPM_BENCH_PASSES", 5);
     println!(
-        "CornellBox-Sphere, 512x512, {PHOTONS_PER_PASS} photons per pass, median of {PASSES} passes"
+        "CornellBox-Sphere, 512x512, {photons_per_pass} photons per pass, median of {passes} passes"
     );
     println!(
         "{:<10} {:>7} {:>16} {:>16} {:>16} {:>12} {:>12}",
@@ -93,15 +119,19 @@ fn main() {
         });
     let mut pass_seconds = Vec::new();
     let mut phases = Vec::new();
+    let mut memory = Vec::new();
     for &method in &methods {
         for &threads in &thread_counts {
-            let (stats, cpu) = run(&scene, method, threads);
+            let (stats, cpu, mem) = run(&scene, method, threads, photons_per_pass, passes);
+            if !memory.iter().any(|&(m, _)| m == method) {
+                memory.push((method, mem));
+            }
             let cpu = median(cpu);
             let trace = median(stats.iter().map(|s| s.timings.trace).collect());
             let gather = median(stats.iter().map(|s| s.timings.gather).collect());
             let total = median(stats.iter().map(|s| s.timings.total()).collect());
-            let stored = stats.iter().map(|s| s.photons_stored).sum::<u64>() as f64 / PASSES as f64;
-            let photons = f64::from(PHOTONS_PER_PASS);
+            let stored = stats.iter().map(|s| s.photons_stored).sum::<u64>() as f64 / passes as f64;
+            let photons = f64::from(photons_per_pass);
             println!(
                 "{:<10} {:>7} {:>16.0} {:>16.0} {:>16.0} {:>12.3} {:>12.2}",
                 method.name(),
@@ -175,9 +205,27 @@ fn main() {
     }
     let n_slots = 512 * 512 * RenderParams::preview().samples_per_pixel as usize;
     println!(
-        "hitpoints per pixel: {} ({} slots); bytes per hitpoint: {} (+ grid)",
+        "hitpoints per pixel: {} ({} slots); fixed columns: {} bytes per hitpoint",
         RenderParams::preview().samples_per_pixel,
         n_slots,
         ppm::bytes_per_hitpoint()
     );
+    println!(
+        "{:<10} {:>8} {:>8} {:>8} {:>11} {:>11} {:>11} {:>10}   (bytes per hitpoint)",
+        "method", "records", "columns", "grid", "persistent", "pass/hitp.", "pass/phot.", "total"
+    );
+    for (method, mem) in &memory {
+        let per = |bytes: usize| bytes as f64 / mem.hitpoints.max(1) as f64;
+        println!(
+            "{:<10} {:>8.1} {:>8.1} {:>8.1} {:>11.1} {:>11.1} {:>11.1} {:>10.1}",
+            method.name(),
+            per(mem.records),
+            per(mem.slot_columns),
+            per(mem.grid),
+            per(mem.persistent()),
+            per(mem.pass_hitpoint_buffers),
+            per(mem.pass_photon_buffers),
+            per(mem.total())
+        );
+    }
 }

@@ -20,7 +20,7 @@
 //!   convex edge or a strongly curved surface).
 //!
 //! The clear radius is the largest r of R₀, R₀/2, …, R₀/2^(LEVELS−1) with r ≤ d and every
-//! drop probe at r landing; 0 if none is. The candidates are coarse on purpose: a factor of
+//! drop probe at r landing; 0 if none is. It is kept as the level (one byte per slot). The candidates are coarse on purpose: a factor of
 //! two in radius is a factor of four in the variance the hold saves, and the bias of the
 //! level just below an edge is that of the shrinking PPM radius anyway.
 
@@ -35,12 +35,14 @@ pub(crate) const LEVELS: u32 = 5;
 /// hitpoint's (`photon::AcceptParams`' default normal agreement, 60°).
 const NORMAL_COS: f32 = 0.5;
 
-/// The largest radius r ∈ {r0, r0/2, …} at which the gather disc of the hitpoint at
-/// `position` with unit geometric normal `normal` (facing the camera side) lies on a surface
-/// that accepts photons; 0 if even the smallest candidate does not.
-pub(crate) fn clear_radius(scene: &Scene, position: Vec3, normal: Vec3, r0: f32) -> f32 {
+/// The level i of the largest radius r0·2^−i (i < [`LEVELS`]) at which the gather disc of the
+/// hitpoint at `position` with unit geometric normal `normal` (facing the camera side) lies on
+/// a surface that accepts photons; [`LEVELS`] if even the smallest candidate does not. Levels
+/// fit a byte of the slot's state; [`level_radius`] turns one into a radius.
+pub(crate) fn clear_level(scene: &Scene, position: Vec3, normal: Vec3, r0: f32) -> u8 {
+    const NONE: u8 = LEVELS as u8;
     if !(r0 > 0.0 && r0.is_finite()) || !position.is_finite() || !normal.is_finite() {
-        return 0.0;
+        return NONE;
     }
     // Height of the wall probes: above the surface by more than the float error of a hit at
     // this magnitude, far below any radius.
@@ -57,18 +59,27 @@ pub(crate) fn clear_radius(scene: &Scene, position: Vec3, normal: Vec3, r0: f32)
             wall = wall.min(hit.t);
         }
     }
-    let mut r = r0;
-    for _ in 0..LEVELS {
+    for level in 0..NONE {
+        let r = r0 * 0.5f32.powi(i32::from(level));
         if r <= wall
             && directions
                 .iter()
                 .all(|&d| lands(scene, position, normal, d, r, lift))
         {
-            return r;
+            return level;
         }
-        r *= 0.5;
     }
-    0.0
+    NONE
+}
+
+/// The clear radius of `level` ([`clear_level`]) for the initial radius `r0`: r0·2^−level, or 0
+/// for [`LEVELS`] and above.
+pub(crate) fn level_radius(level: u8, r0: f64) -> f64 {
+    if u32::from(level) < LEVELS {
+        r0 * 0.5f64.powi(i32::from(level))
+    } else {
+        0.0
+    }
 }
 
 /// Whether the drop probe at tangent distance `r` along `d` meets the hitpoint's surface.
@@ -131,24 +142,28 @@ intensity = [1.0, 1.0, 1.0]
         Scene::new(description).expect("the test scene builds")
     }
 
+    fn clear_radius(scene: &Scene, position: Vec3, normal: Vec3, r0: f32) -> f64 {
+        level_radius(clear_level(scene, position, normal, r0), f64::from(r0))
+    }
+
     #[test]
     fn open_floor_is_clear_at_the_initial_radius() {
         let r = clear_radius(&scene(), Vec3::new(0.0, 0.0, 0.0), Vec3::Y, 0.4);
-        assert_eq!(r, 0.4);
+        assert_eq!(r, f64::from(0.4f32));
     }
 
     #[test]
     fn a_wall_within_the_disc_limits_it_below_its_distance() {
         // The wall is 0.08 away: 0.4, 0.2 and 0.1 overhang it, 0.05 does not.
         let r = clear_radius(&scene(), Vec3::new(0.42, 0.0, 0.0), Vec3::Y, 0.4);
-        assert_eq!(r, 0.05);
+        assert_eq!(r, f64::from(0.4f32) / 8.0);
     }
 
     #[test]
     fn a_convex_edge_within_the_disc_limits_it_below_its_distance() {
         // The platform ends 0.13 away: its drop probes at 0.4 and 0.2 find no surface.
         let r = clear_radius(&scene(), Vec3::new(-0.63, 0.3, 0.0), Vec3::Y, 0.4);
-        assert_eq!(r, 0.1);
+        assert_eq!(r, f64::from(0.4f32) / 4.0);
     }
 
     #[test]

@@ -48,7 +48,9 @@ mod state;
 mod update;
 
 pub use crate::params::{Method, ParamError, RenderParams};
-pub use crate::photon_mapper::{PassStats, PassTimings, auto_initial_radius, bytes_per_hitpoint};
+pub use crate::photon_mapper::{
+    MemoryUse, PassStats, PassTimings, auto_initial_radius, bytes_per_hitpoint,
+};
 pub use crate::pointwise::pointwise_reference;
 pub use crate::renderer::{Aov, Renderer};
 pub use crate::rng::Sampler;

@@ -5,7 +5,9 @@
 //! hitpoint spheres), `photon_pass` (trace photons in fixed chunks, collect deposits) and
 //! `update_hitpoints` (fold the deposits into R, N, τ with the keep-or-shrink rule).
 
-use geometry::{Bsdf, EmitterShape, Hit, Lobe as MaterialLobe, Ray, Rgb, Scene, TransportMode};
+use geometry::{
+    Bsdf, EmitterShape, Hit, Lobe as MaterialLobe, MaterialKind, Ray, Rgb, Scene, TransportMode,
+};
 use glam::{Vec2, Vec3};
 use photon::{
     AcceptParams, GatherScratch, GridParams, HitPointGrid, HitPoints, MortonScratch, NewHitPoint,
@@ -91,39 +93,80 @@ impl PassTimings {
 
 /// Frequency state of one hitpoint slot: the merged estimate plus what a deposit needs to
 /// turn a photon's spectrum into the field seen by the camera.
+///
+/// 32 bytes: the merged spectrum's (a, b, c) and its flags are packed beside the distance (a
+/// `FrequencyEstimate`, 32 bytes with its padding, next to an `f32` would take 40). The
+/// estimate is stored bit for bit ([`Spectrum::to_bits`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct SlotFrequency {
-    pub(crate) estimate: FrequencyEstimate,
+    /// Bits of a, b, c of the merged spectrum; zero while `merged` is [`Self::EMPTY`].
+    coefficients: [u64; 3],
     /// Distance to the camera (or last specular vertex) projected on the normal, z of §8.2.
     pub(crate) normal_distance: f32,
-    /// The largest radius at which the gather disc lies on the hitpoint's surface
-    /// ([`crate::disc::clear_radius`]), or [`GEOMETRY_UNKNOWN`] until it is probed: when the
-    /// slot first becomes a candidate for holding, again after every new visible point.
-    pub(crate) clear_radius: f32,
+    /// [`Self::EMPTY`] until a frequency photon was merged, then 1 + the Lambertian flag.
+    merged: u8,
+    /// The clear radius of the gather disc at this visible point as a level of
+    /// [`crate::disc::clear_level`] (the radius R₀·2^−level, none at `disc::LEVELS`), or
+    /// [`GEOMETRY_UNKNOWN`] until it is probed: when the slot first becomes a candidate for
+    /// holding, again after every new visible point.
+    pub(crate) clear_level: u8,
 }
 
-/// [`SlotFrequency::clear_radius`] before the probes ran.
-pub(crate) const GEOMETRY_UNKNOWN: f32 = -1.0;
+/// [`SlotFrequency::clear_level`] before the probes ran.
+pub(crate) const GEOMETRY_UNKNOWN: u8 = u8::MAX;
 
 impl SlotFrequency {
-    /// A slot's frequency state for a new visible point: no deposit, geometry not probed.
-    pub(crate) fn new(normal_distance: f32) -> Self {
-        Self {
-            estimate: FrequencyEstimate::EMPTY,
+    /// No frequency photon merged yet.
+    const EMPTY: u8 = 0;
+
+    /// The state holding `estimate` at `normal_distance`.
+    pub(crate) fn new(estimate: FrequencyEstimate, normal_distance: f32) -> Self {
+        let mut freq = Self {
+            coefficients: [0; 3],
             normal_distance,
-            clear_radius: GEOMETRY_UNKNOWN,
+            merged: Self::EMPTY,
+            clear_level: GEOMETRY_UNKNOWN,
+        };
+        freq.set_estimate(estimate);
+        freq
+    }
+
+    /// The merged estimate.
+    pub(crate) fn estimate(&self) -> FrequencyEstimate {
+        if self.merged == Self::EMPTY {
+            return FrequencyEstimate::EMPTY;
+        }
+        let [a, b, c] = self.coefficients;
+        let spectrum = Spectrum::from_bits([a, b, c, u64::from(self.merged - 1)])
+            .expect("the bits of a valid spectrum, stored by set_estimate");
+        FrequencyEstimate::from_spectrum(Some(spectrum))
+    }
+
+    /// Replaces the merged estimate.
+    pub(crate) fn set_estimate(&mut self, estimate: FrequencyEstimate) {
+        match estimate.spectrum() {
+            None => {
+                self.coefficients = [0; 3];
+                self.merged = Self::EMPTY;
+            }
+            Some(spectrum) => {
+                let [a, b, c, lambertian] = spectrum.to_bits();
+                self.coefficients = [a, b, c];
+                // `to_bits` encodes the flag as 0 or 1.
+                self.merged = 1 + u8::from(lambertian != 0);
+            }
         }
     }
 
     /// The radius below which the slot holds its kernel: the frequency radius r_freq of its
-    /// merged deposits (`None` before the first), bounded by the clear radius of its disc once
-    /// probed.
-    pub(crate) fn hold_radius(&self, k: f64) -> Option<f64> {
-        let r_freq = self.estimate.radius(f64::from(self.normal_distance), k)?;
-        Some(if self.clear_radius >= 0.0 {
-            r_freq.min(f64::from(self.clear_radius))
-        } else {
+    /// merged deposits (`None` before the first), bounded by the clear radius of its disc
+    /// (levels of `r0`, the initial radius) once probed.
+    pub(crate) fn hold_radius(&self, k: f64, r0: f64) -> Option<f64> {
+        let r_freq = self.estimate().radius(f64::from(self.normal_distance), k)?;
+        Some(if self.clear_level == GEOMETRY_UNKNOWN {
             r_freq
+        } else {
+            r_freq.min(crate::disc::level_radius(self.clear_level, r0))
         })
     }
 }
@@ -141,11 +184,10 @@ pub(crate) struct PhotonMapper<'s> {
     pub(crate) pass: u32,
     pub(crate) n_emitted: u64,
     pub(crate) slots: HitPoints<SlotFrequency>,
-    /// Whether a slot holds a visible point in the current pass.
-    pub(crate) valid: Vec<bool>,
     /// Per slot: the most bounces a photon may have made and still count there,
     /// `max_depth − 1 − (specular bounces of the camera path)`, so that no light path has more
-    /// than `max_depth` scattering events (the hitpoint's own scattering is the 1).
+    /// than `max_depth` scattering events (the hitpoint's own scattering is the 1); or
+    /// [`NO_VISIBLE_POINT`] if the slot holds no visible point in the current pass.
     pub(crate) photon_bounces: Vec<u16>,
     /// Per slot: sum of directly seen emission (and direct lighting) over camera passes.
     pub(crate) direct: Vec<[f64; 3]>,
@@ -159,16 +201,51 @@ pub(crate) struct PhotonMapper<'s> {
     scratch: PhotonScratch,
 }
 
-/// Memory per hitpoint slot of the photon mappers: the hitpoint record (`photon::HitPoints`
-/// with the frequency state) plus the renderer's per-slot validity flag, photon-bounce budget
-/// and direct-emission sum. The hash grid comes on top (about 39 bytes per hitpoint at the
-/// default cell size, `photon::GridStats::bytes`).
+/// `photon_bounces` of a slot without a visible point (budgets are below `max_depth` ≤ 1024).
+pub(crate) const NO_VISIBLE_POINT: u16 = u16::MAX;
+
+/// Memory per hitpoint slot of the photon mappers' fixed columns: the hitpoint record
+/// (`photon::HitPoints` with the frequency state) plus the renderer's per-slot photon-bounce
+/// budget (which also says whether the slot is valid) and direct-emission sum. The hash grid
+/// and its slot map come on top; [`crate::Renderer::memory`] measures everything.
 #[must_use]
 pub fn bytes_per_hitpoint() -> usize {
     HitPoints::<SlotFrequency>::bytes_per_hitpoint()
-        + std::mem::size_of::<bool>()
         + std::mem::size_of::<u16>()
         + std::mem::size_of::<[f64; 3]>()
+}
+
+/// Heap memory of a render, in bytes, by part ([`crate::Renderer::memory`]): allocated
+/// capacities, so what the process holds between passes, not a lower bound.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MemoryUse {
+    /// Hitpoint slots (the divisor of the per-hitpoint figures).
+    pub hitpoints: usize,
+    /// The hitpoint records: geometry, R, N, τ and the frequency state (`photon::HitPoints`).
+    pub records: usize,
+    /// The renderer's other per-slot columns: photon-bounce budget and direct-emission sum.
+    pub slot_columns: usize,
+    /// The hash grid (`photon::GridStats::bytes`) and the slot of each of its entries.
+    pub grid: usize,
+    /// Per-pass buffers sized by the hitpoints: the M, Φ and frequency accumulators of a pass.
+    pub pass_hitpoint_buffers: usize,
+    /// Per-pass buffers sized by the photons: traced photons, their Morton-sorted copies and
+    /// keys, the gather bins. They scale with the photons per pass, not with the hitpoints.
+    pub pass_photon_buffers: usize,
+}
+
+impl MemoryUse {
+    /// The state a render keeps per hitpoint from pass to pass: records, columns and grid.
+    #[must_use]
+    pub fn persistent(&self) -> usize {
+        self.records + self.slot_columns + self.grid
+    }
+
+    /// Everything.
+    #[must_use]
+    pub fn total(&self) -> usize {
+        self.persistent() + self.pass_hitpoint_buffers + self.pass_photon_buffers
+    }
 }
 
 /// The smallppm choice of initial radius: twice the mean extent of the scene's bounding box
@@ -217,7 +294,6 @@ impl<'s> PhotonMapper<'s> {
             pass: 0,
             n_emitted: 0,
             slots: HitPoints::with_capacity(0),
-            valid: Vec::new(),
             photon_bounces: Vec::new(),
             direct: Vec::new(),
             camera_passes: 0,
@@ -245,6 +321,46 @@ impl<'s> PhotonMapper<'s> {
         self.n_emitted
     }
 
+    /// Whether `slot` holds a visible point in the current pass.
+    #[must_use]
+    pub(crate) fn is_valid(&self, slot: usize) -> bool {
+        self.photon_bounces[slot] != NO_VISIBLE_POINT
+    }
+
+    /// Heap memory by part (capacities of the buffers).
+    #[must_use]
+    pub(crate) fn memory(&self) -> MemoryUse {
+        use std::mem::size_of;
+        let s = &self.scratch;
+        let traced: usize = s
+            .traced
+            .iter()
+            .map(|t| {
+                t.photons.capacity() * size_of::<Photon>()
+                    + t.frequency.capacity() * size_of::<FrequencyPhoton>()
+            })
+            .sum::<usize>()
+            + s.traced.capacity() * size_of::<TracedPhotons>();
+        MemoryUse {
+            hitpoints: self.slots.len(),
+            records: self.slots.heap_bytes(),
+            slot_columns: self.photon_bounces.capacity() * size_of::<u16>()
+                + self.direct.capacity() * size_of::<[f64; 3]>(),
+            grid: self.grid.as_ref().map_or(0, |g| g.stats().bytes)
+                + self.grid_slots.capacity() * size_of::<u32>(),
+            pass_hitpoint_buffers: s.per_entry.capacity() * size_of::<(u32, [f64; 3])>()
+                + s.frequency_per_entry.capacity() * size_of::<FrequencyEstimate>()
+                + s.slot_entry.capacity() * size_of::<u32>(),
+            pass_photon_buffers: traced
+                + (s.frequency.capacity() + s.frequency_sorted.capacity())
+                    * size_of::<FrequencyPhoton>()
+                + s.sorted.capacity() * size_of::<Photon>()
+                + s.keys.heap_bytes()
+                + s.gather.heap_bytes()
+                + s.frequency_gather.heap_bytes(),
+        }
+    }
+
     /// Runs one pass: camera pass (the first time, or every time for SPPM), hash grid,
     /// photon pass, hitpoint update.
     pub(crate) fn iterate(&mut self) -> PassStats {
@@ -261,9 +377,9 @@ impl<'s> PhotonMapper<'s> {
         stats.camera_paths = camera_paths;
         stats.photons_stored = deposits.photons_stored;
         let trace_seconds = deposits.trace_seconds;
-        // Hand the per-slot buffers back for the next pass.
-        self.scratch.count = deposits.count;
-        self.scratch.flux = deposits.flux;
+        // Hand the accumulators back for the next pass.
+        self.scratch.per_entry = deposits.per_entry;
+        self.scratch.slot_entry = deposits.slot_entry;
         stats.timings = PassTimings {
             camera,
             index,
@@ -347,8 +463,7 @@ impl<'s> PhotonMapper<'s> {
         if first {
             self.slots = HitPoints::with_capacity(n_slots);
             self.direct = vec![[0.0; 3]; n_slots];
-            self.valid = vec![false; n_slots];
-            self.photon_bounces = vec![0; n_slots];
+            self.photon_bounces = vec![NO_VISIBLE_POINT; n_slots];
         }
         for (slot, sample) in traced.into_iter().enumerate() {
             for c in 0..3 {
@@ -364,18 +479,19 @@ impl<'s> PhotonMapper<'s> {
                 normal_distance: 0.0,
                 bounces: 0,
             });
-            self.valid[slot] = sample.visible.is_some();
             // Visible points have bounces < max_depth ≤ 1024 (`trace_camera_path`).
             let budget = (self.params.max_depth - 1).saturating_sub(point.bounces);
-            self.photon_bounces[slot] = u16::try_from(budget).unwrap_or(u16::MAX);
-            let freq = SlotFrequency::new(point.normal_distance);
+            self.photon_bounces[slot] = match sample.visible {
+                Some(_) => u16::try_from(budget).unwrap_or(NO_VISIBLE_POINT - 1),
+                None => NO_VISIBLE_POINT,
+            };
+            let freq = SlotFrequency::new(FrequencyEstimate::EMPTY, point.normal_distance);
             let new = NewHitPoint {
                 position: point.position,
                 shading_normal: point.shading_normal,
                 geometric_normal: point.geometric_normal,
                 outgoing: point.outgoing,
                 material_idx: point.material,
-                pixel_idx: slot as u32 / spp,
                 weight: point.weight,
                 radius: initial_radius,
                 freq,
@@ -384,10 +500,9 @@ impl<'s> PhotonMapper<'s> {
                 self.slots.push(new);
             } else {
                 self.slots.replace_visible_point(slot, &new);
-                self.slots.columns_mut().freq[slot] = SlotFrequency {
-                    estimate: self.slots.freq()[slot].estimate,
-                    ..freq
-                };
+                let slot_freq = &mut self.slots.columns_mut().freq[slot];
+                slot_freq.normal_distance = point.normal_distance;
+                slot_freq.clear_level = GEOMETRY_UNKNOWN;
             }
         }
         self.camera_passes += 1;
@@ -511,7 +626,7 @@ impl<'s> PhotonMapper<'s> {
             return;
         }
         let valid: Vec<u32> = (0..self.slots.len() as u32)
-            .filter(|&s| self.valid[s as usize])
+            .filter(|&s| self.is_valid(s as usize))
             .collect();
         let positions: Vec<Vec3> = valid
             .iter()
@@ -575,17 +690,20 @@ impl<'s> PhotonMapper<'s> {
         let trace_seconds = clock.elapsed().as_secs_f64();
         let n_slots = self.slots.len();
         let mut deposits = PassDeposits {
-            count: std::mem::take(&mut scratch.count),
-            flux: std::mem::take(&mut scratch.flux),
+            per_entry: Vec::new(),
+            slot_entry: std::mem::take(&mut scratch.slot_entry),
             photons_deposited: 0,
+            hitpoints_hit: 0,
             frequency_photons,
             photons_stored: 0,
             trace_seconds,
         };
-        deposits.count.clear();
-        deposits.count.resize(n_slots, 0);
-        deposits.flux.clear();
-        deposits.flux.resize(n_slots, [0.0; 3]);
+        // Slot → grid entry (`NOT_IN_GRID` for slots the grid does not index).
+        deposits.slot_entry.clear();
+        deposits.slot_entry.resize(n_slots, NOT_IN_GRID);
+        for (entry, &slot) in self.grid_slots.iter().enumerate() {
+            deposits.slot_entry[slot as usize] = entry as u32;
+        }
         let Some(grid) = &self.grid else {
             self.scratch = scratch;
             return deposits;
@@ -610,8 +728,22 @@ impl<'s> PhotonMapper<'s> {
                 let slot = grid_slots[entry as usize] as usize;
                 self.accepts(photon, slot).then(|| {
                     let material = self.scene.material(slots.material_idx()[slot])?;
-                    let bsdf = Bsdf::from_normal(material.kind, slots.shading_normal()[slot], true);
-                    let f = bsdf.eval(slots.outgoing()[slot], photon.incoming);
+                    let (normal, outgoing) = (slots.shading_normal()[slot], slots.outgoing()[slot]);
+                    let f = match material.kind {
+                        // `Bsdf::eval` of a Lambertian without building the shading frame: the
+                        // same hemisphere test on the same dot products (the frame's z is the
+                        // normal), the same value.
+                        MaterialKind::Diffuse { albedo } => {
+                            if outgoing.dot(normal) * photon.incoming.dot(normal) <= 0.0 {
+                                Rgb::ZERO
+                            } else {
+                                albedo * std::f32::consts::FRAC_1_PI
+                            }
+                        }
+                        kind => {
+                            Bsdf::from_normal(kind, normal, true).eval(outgoing, photon.incoming)
+                        }
+                    };
                     Some(f * photon.power * slots.weight()[slot])
                 })?
             },
@@ -623,12 +755,11 @@ impl<'s> PhotonMapper<'s> {
             },
         );
         deposits.photons_stored = scratch.sorted.len() as u64;
-        for (entry, &(m, phi)) in scratch.per_entry.iter().enumerate() {
-            let slot = grid_slots[entry] as usize;
-            deposits.count[slot] = m;
-            deposits.flux[slot] = phi;
+        for &(m, _) in &scratch.per_entry {
             deposits.photons_deposited += u64::from(m);
+            deposits.hitpoints_hit += u64::from(m > 0);
         }
+        deposits.per_entry = std::mem::take(&mut scratch.per_entry);
 
         // Frequency deposits, gathered like the flux: each grid entry merges the field of its
         // frequency photons in photon order (the merges, a min or max per coefficient, do not
@@ -671,9 +802,10 @@ impl<'s> PhotonMapper<'s> {
         let columns = self.slots.columns_mut();
         for (entry, estimate) in scratch.frequency_per_entry.iter().enumerate() {
             if let Some(spectrum) = estimate.spectrum() {
-                let slot = grid_slots[entry] as usize;
-                columns.freq[slot].estimate.deposit(spectrum, policy);
-                columns.has_freq[slot] = true;
+                let freq = &mut columns.freq[grid_slots[entry] as usize];
+                let mut merged = freq.estimate();
+                merged.deposit(spectrum, policy);
+                freq.set_estimate(merged);
             }
         }
         self.scratch = scratch;
@@ -848,39 +980,38 @@ impl<'s> PhotonMapper<'s> {
     // ------------------------------------------------------------------------------------
     // Phase 4: hitpoint update.
 
-    /// Probes the clear radius ([`crate::disc::clear_radius`]) of every valid slot that has
+    /// Probes the clear radius ([`crate::disc::clear_level`]) of every valid slot that has
     /// become a candidate for holding (R ≤ r_freq) and has not been probed at its visible
     /// point, in parallel. Deterministic: the probes use no random numbers.
     fn probe_clear_radii(&mut self) {
         let k = self.params.kernel_k;
         let r0 = self.kernel_scale as f32;
         let slots = &self.slots;
-        let valid = &self.valid;
         let scene = self.scene;
-        let probed: Vec<(usize, f32)> = (0..slots.len())
+        let probed: Vec<(usize, u8)> = (0..slots.len())
             .into_par_iter()
             .with_min_len(SLOT_CHUNK)
             .filter_map(|slot| {
                 let freq = slots.freq()[slot];
-                if !valid[slot] || freq.clear_radius != GEOMETRY_UNKNOWN {
+                if !self.is_valid(slot) || freq.clear_level != GEOMETRY_UNKNOWN {
                     return None;
                 }
-                let r_freq = freq.estimate.radius(f64::from(freq.normal_distance), k)?;
+                let r_freq = freq.estimate().radius(f64::from(freq.normal_distance), k)?;
                 if slots.radius()[slot] > r_freq {
                     return None;
                 }
-                let clear = crate::disc::clear_radius(
+                let level = crate::disc::clear_level(
                     scene,
                     slots.position()[slot],
                     slots.geometric_normal()[slot],
                     r0,
                 );
-                Some((slot, clear))
+                Some((slot, level))
             })
             .collect();
         let columns = self.slots.columns_mut();
-        for (slot, clear) in probed {
-            columns.freq[slot].clear_radius = clear;
+        for (slot, level) in probed {
+            columns.freq[slot].clear_level = level;
         }
     }
 
@@ -892,6 +1023,7 @@ impl<'s> PhotonMapper<'s> {
         if uses_frequency && self.params.freq_geometry {
             self.probe_clear_radii();
         }
+        let r0 = self.kernel_scale;
         let columns = self.slots.columns_mut();
         let held: Vec<bool> = columns
             .radius
@@ -899,10 +1031,14 @@ impl<'s> PhotonMapper<'s> {
             .zip(columns.photon_count.par_iter_mut())
             .zip(columns.flux.par_iter_mut())
             .zip(columns.freq.par_iter())
-            .zip(deposits.count.par_iter().zip(deposits.flux.par_iter()))
-            .map(|((((radius, photon_count), tau), freq), (&m, &phi))| {
+            .zip(
+                (0..deposits.slot_entry.len())
+                    .into_par_iter()
+                    .map(|s| deposits.of(s)),
+            )
+            .map(|((((radius, photon_count), tau), freq), (m, phi))| {
                 let r_freq = if uses_frequency {
-                    freq.hold_radius(k)
+                    freq.hold_radius(k, r0)
                         .map_or(FrequencyRadius::None, FrequencyRadius::Predicted)
                 } else {
                     FrequencyRadius::None
@@ -927,7 +1063,7 @@ impl<'s> PhotonMapper<'s> {
             photons_traced: u64::from(self.params.photons_per_pass),
             frequency_photons: deposits.frequency_photons,
             photons_deposited: deposits.photons_deposited,
-            hitpoints_hit: deposits.count.iter().filter(|&&m| m > 0).count() as u64,
+            hitpoints_hit: deposits.hitpoints_hit,
             hitpoints_valid: 0,
             mean_radius: 0.0,
             min_radius: f64::INFINITY,
@@ -939,7 +1075,7 @@ impl<'s> PhotonMapper<'s> {
         let mut sum = 0.0;
         let mut n_held = 0u64;
         for (slot, &r) in self.slots.radius().iter().enumerate() {
-            if !self.valid[slot] {
+            if !self.is_valid(slot) {
                 continue;
             }
             stats.hitpoints_valid += 1;
@@ -1060,19 +1196,35 @@ struct PhotonScratch {
     frequency_gather: GatherScratch<Spectrum>,
     /// Per grid entry: the merged frequency deposits of the pass.
     frequency_per_entry: Vec<FrequencyEstimate>,
-    /// Per slot M and Φ, lent to [`PassDeposits`] during a pass.
-    count: Vec<u32>,
-    flux: Vec<[f64; 3]>,
+    /// Per slot, its grid entry; lent to [`PassDeposits`] during a pass.
+    slot_entry: Vec<u32>,
 }
 
-/// What one photon pass brings to each hitpoint slot: M and Φ.
+/// `PassDeposits::slot_entry` of a slot the grid does not index.
+const NOT_IN_GRID: u32 = u32::MAX;
+
+/// What one photon pass brings to each hitpoint slot: M and Φ, per grid entry (no per-slot
+/// copy: [`Self::of`] looks a slot's entry up).
 struct PassDeposits {
-    count: Vec<u32>,
-    flux: Vec<[f64; 3]>,
+    /// Per grid entry: M and Φ.
+    per_entry: Vec<(u32, [f64; 3])>,
+    /// Per slot: its grid entry, or [`NOT_IN_GRID`].
+    slot_entry: Vec<u32>,
     photons_deposited: u64,
+    hitpoints_hit: u64,
     frequency_photons: u64,
     photons_stored: u64,
     trace_seconds: f64,
+}
+
+impl PassDeposits {
+    /// M and Φ of `slot` in this pass.
+    fn of(&self, slot: usize) -> (u32, [f64; 3]) {
+        match self.slot_entry[slot] {
+            NOT_IN_GRID => (0, [0.0; 3]),
+            entry => self.per_entry[entry as usize],
+        }
+    }
 }
 
 /// Veach's correction for shading normals on light paths (thesis §5.3; pbrt's

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use crate::params::{Method, ParamError, RenderParams};
 use crate::path::PathTracer;
-use crate::photon_mapper::{PassStats, PassTimings, PhotonMapper};
+use crate::photon_mapper::{MemoryUse, PassStats, PassTimings, PhotonMapper};
 
 /// A progressive render in progress: create it, call [`Renderer::iterate`] as often as the
 /// budget allows, read [`Renderer::image`] (and [`Renderer::aov`]) at any time, and save or
@@ -166,6 +166,16 @@ impl<'s> Renderer<'s> {
         }
     }
 
+    /// Heap memory of the photon mappers' state and pass buffers, by part; `None` for the path
+    /// tracer (one `[f64; 3]` sum per pixel).
+    #[must_use]
+    pub fn memory(&self) -> Option<MemoryUse> {
+        match &self.engine {
+            Engine::Photons(p) => Some(p.memory()),
+            Engine::Path(_) => None,
+        }
+    }
+
     /// An auxiliary image, `width × height × channels` values (channels as in
     /// [`Aov::channel_names`]), or `None` if this integrator has no such quantity (e.g. a
     /// radius for the path tracer, a frequency radius for classical PPM).
@@ -244,16 +254,16 @@ fn slot_aov(mapper: &PhotonMapper<'_>, aov: Aov) -> Vec<f32> {
         .map(|pixel| {
             let (mut sum, mut n) = (0.0f64, 0u32);
             for slot in pixel * spp..(pixel + 1) * spp {
-                if !mapper.valid[slot] {
+                if !mapper.is_valid(slot) {
                     continue;
                 }
                 let freq = slots.freq()[slot];
                 let value = match aov {
                     Aov::Radius => Some(slots.radius()[slot]),
                     Aov::PhotonCount => Some(slots.photon_count()[slot]),
-                    Aov::FreqRadius => freq.estimate.radius(f64::from(freq.normal_distance), k),
+                    Aov::FreqRadius => freq.estimate().radius(f64::from(freq.normal_distance), k),
                     _ => Some(
-                        freq.hold_radius(k)
+                        freq.hold_radius(k, mapper.kernel_scale)
                             .map_or(0.0, |r| f64::from(u8::from(slots.radius()[slot] <= r))),
                     ),
                 };

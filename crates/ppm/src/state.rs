@@ -13,7 +13,7 @@ use spectrum::{FrequencyEstimate, MergePolicy, Spectrum};
 
 use crate::params::{Method, ParamError, RenderParams};
 use crate::path::PathTracer;
-use crate::photon_mapper::{PhotonMapper, SlotFrequency};
+use crate::photon_mapper::{NO_VISIBLE_POINT, PhotonMapper, SlotFrequency};
 use crate::renderer::{Engine, Renderer};
 use crate::update::FrequencyFloor;
 
@@ -222,6 +222,7 @@ fn write_photon_mapper(w: &mut Writer, p: &PhotonMapper<'_>) {
     w.u64(p.n_emitted);
     w.u32(p.camera_passes);
     let s = &p.slots;
+    let spp = p.params.samples_per_pixel as usize;
     w.u64(s.len() as u64);
     for i in 0..s.len() {
         for v in [
@@ -234,23 +235,33 @@ fn write_photon_mapper(w: &mut Writer, p: &PhotonMapper<'_>) {
             v.to_array().iter().for_each(|&c| w.f32(c));
         }
         w.u32(s.material_idx()[i]);
-        w.u32(s.pixel_idx()[i]);
+        // Layout of version 2, which stored the pixel, the `has_freq` flag and the validity
+        // flag: they are now derived (slot / spp, the estimate, the bounce budget).
+        w.u32((i / spp) as u32);
         w.f64(s.radius()[i]);
         w.f64(s.photon_count()[i]);
         s.flux()[i].iter().for_each(|&c| w.f64(c));
-        w.u32(u32::from(s.has_freq()[i]));
         let freq = s.freq()[i];
+        let estimate = freq.estimate();
+        w.u32(u32::from(estimate.has_freq()));
         w.f32(freq.normal_distance);
-        w.f32(freq.clear_radius);
-        match freq.estimate.spectrum() {
+        w.u32(u32::from(freq.clear_level));
+        match estimate.spectrum() {
             None => w.u32(0),
             Some(spectrum) => {
                 w.u32(1);
                 spectrum.to_bits().iter().for_each(|&b| w.u64(b));
             }
         }
-        w.u32(u32::from(p.valid[i]));
-        w.u32(u32::from(p.photon_bounces[i]));
+        // An invalid slot stored the budget of a camera path without bounces.
+        let valid = p.is_valid(i);
+        let budget = if valid {
+            u32::from(p.photon_bounces[i])
+        } else {
+            p.params.max_depth - 1
+        };
+        w.u32(u32::from(valid));
+        w.u32(budget);
         p.direct[i].iter().for_each(|&c| w.f64(c));
     }
 }
@@ -268,24 +279,26 @@ fn read_photon_mapper(
     if n != expected && n != 0 {
         return Err(StateError::Corrupt);
     }
+    let spp = p.params.samples_per_pixel as usize;
     let mut slots = HitPoints::with_capacity(n);
     let mut stats = Vec::with_capacity(n);
-    p.valid = Vec::with_capacity(n);
     p.photon_bounces = Vec::with_capacity(n);
     p.direct = Vec::with_capacity(n);
-    for _ in 0..n {
+    for i in 0..n {
         let mut v = [Vec3::ZERO; 5];
         for item in &mut v {
             *item = Vec3::new(r.f32()?, r.f32()?, r.f32()?);
         }
         let material_idx = r.u32()?;
-        let pixel_idx = r.u32()?;
+        if r.u32()? as usize != i / spp {
+            return Err(StateError::Corrupt);
+        }
         let radius = r.f64()?;
         let photon_count = r.f64()?;
         let flux = [r.f64()?, r.f64()?, r.f64()?];
         let has_freq = r.bool()?;
         let normal_distance = r.f32()?;
-        let clear_radius = r.f32()?;
+        let clear_level = u8::try_from(r.u32()?).map_err(|_| StateError::Corrupt)?;
         let spectrum = match r.u32()? {
             0 => None,
             1 => Some(
@@ -294,9 +307,16 @@ fn read_photon_mapper(
             ),
             _ => return Err(StateError::Corrupt),
         };
-        p.valid.push(r.bool()?);
-        let budget = u16::try_from(r.u32()?).map_err(|_| StateError::Corrupt)?;
-        p.photon_bounces.push(budget);
+        if has_freq != spectrum.is_some() {
+            return Err(StateError::Corrupt);
+        }
+        let valid = r.bool()?;
+        let budget = u16::try_from(r.u32()?)
+            .ok()
+            .filter(|&b| b != NO_VISIBLE_POINT)
+            .ok_or(StateError::Corrupt)?;
+        p.photon_bounces
+            .push(if valid { budget } else { NO_VISIBLE_POINT });
         p.direct.push([r.f64()?, r.f64()?, r.f64()?]);
         slots.push(NewHitPoint {
             position: v[0],
@@ -305,21 +325,20 @@ fn read_photon_mapper(
             outgoing: v[3],
             weight: v[4],
             material_idx,
-            pixel_idx,
             radius,
-            freq: SlotFrequency {
-                estimate: FrequencyEstimate::from_spectrum(spectrum),
-                normal_distance,
-                clear_radius,
+            freq: {
+                let mut freq =
+                    SlotFrequency::new(FrequencyEstimate::from_spectrum(spectrum), normal_distance);
+                freq.clear_level = clear_level;
+                freq
             },
         });
-        stats.push((photon_count, flux, has_freq));
+        stats.push((photon_count, flux));
     }
     let columns = slots.columns_mut();
-    for (i, (photon_count, flux, has_freq)) in stats.into_iter().enumerate() {
+    for (i, (photon_count, flux)) in stats.into_iter().enumerate() {
         columns.photon_count[i] = photon_count;
         columns.flux[i] = flux;
-        columns.has_freq[i] = has_freq;
     }
     p.slots = slots;
     Ok(())
