@@ -41,7 +41,7 @@ const NORMAL_COS: f32 = 0.5;
 /// fit a byte of the slot's state; [`level_radius`] turns one into a radius.
 pub(crate) fn clear_level(scene: &Scene, position: Vec3, normal: Vec3, r0: f32) -> u8 {
     const NONE: u8 = LEVELS as u8;
-    if !(r0 > 0.0 && r0.is_finite()) || !position.is_finite() || !normal.is_finite() {
+    if !(r0 > 0.0 && r0.is_finite() && position.is_finite() && normal.is_finite()) {
         return NONE;
     }
     // Height of the wall probes: above the surface by more than the float error of a hit at
