@@ -238,6 +238,10 @@ fn write_images(job: &Job, renderer: &Renderer<'_>, elapsed: Duration) -> anyhow
         frame
             .metadata
             .push(("kernel_k".into(), params.kernel_k.to_string()));
+        frame.metadata.push((
+            "freq_geometry".into(),
+            if params.freq_geometry { "on" } else { "off" }.into(),
+        ));
     }
     for aov_flag in &job.outputs.aovs {
         for &aov in aov_flag.aovs() {

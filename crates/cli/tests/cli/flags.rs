@@ -164,6 +164,15 @@ fn frequency_flags_take_effect() {
         assert!(b.channels.contains_key("freq.radius"), "{name}");
         assert!(b.rgb().iter().all(|v| v.is_finite()), "{name}");
     }
+    assert_eq!(a.metadata["fppm.freq_geometry"], "on");
+    render_cornell(
+        &dir,
+        &[&base[..], &["--no-freq-geometry", "-o", "nogeo.exr"]].concat(),
+    )
+    .ok();
+    let nogeo = read_exr(&dir.join("nogeo.exr"));
+    assert_eq!(nogeo.metadata["fppm.freq_geometry"], "off");
+    assert_ne!(nogeo.rgb(), a.rgb(), "--no-freq-geometry changed nothing");
     let k = read_exr(&dir.join("k.exr"));
     assert_eq!(k.metadata["fppm.kernel_k"], "0.05");
     let fraction = read_exr(&dir.join("fraction.exr"));
