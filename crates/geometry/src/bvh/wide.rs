@@ -477,7 +477,9 @@ impl Wide {
                 if current & LEAF_BIT != 0 {
                     leaves.closest(leaf_of(current), tmax);
                 } else {
-                    let node = &self.nodes[current as usize];
+                    // SAFETY: `from_bvh2` makes every child reference without `LEAF_BIT` (and a
+                    // root without it) the index of a node it pushed.
+                    let node = unsafe { self.nodes.get_unchecked(current as usize) };
                     let (mask, tnear) = node.intersect(ray, *tmax);
                     if mask != 0 {
                         if mask & (mask - 1) == 0 {
@@ -523,7 +525,9 @@ impl Wide {
                         return true;
                     }
                 } else {
-                    let node = &self.nodes[current as usize];
+                    // SAFETY: `from_bvh2` makes every child reference without `LEAF_BIT` (and a
+                    // root without it) the index of a node it pushed.
+                    let node = unsafe { self.nodes.get_unchecked(current as usize) };
                     let (mask, tnear) = node.intersect(ray, tmax);
                     if mask != 0 {
                         current = node.children[mask.trailing_zeros() as usize & (WIDTH - 1)];
