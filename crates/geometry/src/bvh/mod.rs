@@ -38,8 +38,8 @@
 //! register, 796 / 658 / –; the node test takes per-ray byte offsets of its entry and exit rows
 //! and subtracts the bounds from the origin (so the loads fold into the subtraction),
 //! 729 / 577 / 541; one SIMD finiteness test of the ray instead of six scalar ones and no
-//! bounds check of node indices, 680 / 540 / 504. Checksums of every answer
-//! (`examples/prof.rs`) are unchanged.
+//! bounds check of node indices, 680 / 540 / 504; the ray's octant from one SIMD comparison,
+//! 656 / 528 / 485. Checksums of every answer (`examples/prof.rs`) are unchanged.
 //!
 //! Exactness: the box test is conservative (exit distances are widened by 1 + 2γ₃, and every
 //! primitive's box is padded by a few ulps so that no primitive touches a box face), so the BVH

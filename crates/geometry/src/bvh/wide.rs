@@ -191,7 +191,9 @@ impl BoxRay {
         let inv = Vec3A::ONE / direction;
         let neg_inv = -inv;
         let row = size_of::<F8>();
-        let near = |axis: usize| (2 * axis + usize::from(inv[axis] < 0.0)) * row;
+        // Bit `axis`: whether the ray runs towards −axis (one comparison of all three).
+        let negative = inv.cmplt(Vec3A::ZERO).bitmask() as usize;
+        let near = |axis: usize| (2 * axis + (negative >> axis & 1)) * row;
         let far = |axis: usize| near(axis) ^ row;
         Self {
             origin: [
