@@ -115,14 +115,16 @@ impl Ray8 {
     }
 }
 
-/// The triangles of one leaf in SoA form (288 bytes), tested together: lane i holds v0, e1 and e2
-/// of a [`TriGeom`] by axis. Lanes without a triangle have a NaN `v0`, which fails every
-/// comparison of the test.
+/// The triangles of one leaf in SoA form (384 bytes), tested together: lane i holds v0, e1, e2
+/// and the normal ng = e1 × e2 of a [`TriGeom`] by axis (ng computed at build time exactly as the
+/// test computed it before, so the bits are the same). Lanes without a triangle have a NaN `v0`,
+/// which fails every comparison of the test.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct TriPack {
     v0: [F8; 3],
     e1: [F8; 3],
     e2: [F8; 3],
+    ng: [F8; 3],
 }
 
 /// A [`TriPack`] under construction: rows of lanes as arrays.
@@ -131,6 +133,7 @@ pub(super) struct TriPackBuilder {
     v0: [[f32; 8]; 3],
     e1: [[f32; 8]; 3],
     e2: [[f32; 8]; 3],
+    ng: [[f32; 8]; 3],
 }
 
 impl TriPackBuilder {
@@ -139,14 +142,24 @@ impl TriPackBuilder {
         v0: [[f32::NAN; 8]; 3],
         e1: [[0.0; 8]; 3],
         e2: [[0.0; 8]; 3],
+        ng: [[0.0; 8]; 3],
     };
 
     /// Puts the triangle `g` into `lane`.
     pub(super) fn set(&mut self, lane: usize, g: &TriGeom) {
-        for axis in 0..3 {
+        // The same products and differences, in the same order, as `TriPack::intersect` used to
+        // compute per ray (`ay·bz − az·by`, …): scalar IEEE arithmetic gives the lanes' bits.
+        let (a, b) = (g.e1, g.e2);
+        let ng = [
+            a.y * b.z - a.z * b.y,
+            a.z * b.x - a.x * b.z,
+            a.x * b.y - a.y * b.x,
+        ];
+        for (axis, n) in ng.into_iter().enumerate() {
             self.v0[axis][lane] = g.v0[axis];
             self.e1[axis][lane] = g.e1[axis];
             self.e2[axis][lane] = g.e2[axis];
+            self.ng[axis][lane] = n;
         }
     }
 
@@ -155,6 +168,7 @@ impl TriPackBuilder {
             v0: self.v0.map(F8::from_array),
             e1: self.e1.map(F8::from_array),
             e2: self.e2.map(F8::from_array),
+            ng: self.ng.map(F8::from_array),
         }
     }
 }
@@ -176,27 +190,23 @@ impl TriPack {
         }
     }
 
-    /// Möller–Trumbore in the form of obvhs' `RtTriangle::intersect` (ng = e1 × e2, computed here
-    /// rather than stored, which saves 96 bytes per leaf), with inclusive edges, on eight
-    /// triangles at once: per lane t in [0, tmax), ∞ elsewhere.
+    /// Möller–Trumbore in the form of obvhs' `RtTriangle::intersect` (with the stored
+    /// ng = e1 × e2), with inclusive edges, on eight triangles at once: the lanes hit with t in
+    /// [0, tmax) (a comparison result), and t per lane (meaningful only in those lanes).
     #[inline(always)]
-    pub(super) fn intersect(&self, ray: &Ray8, tmax: f32) -> F8 {
+    pub(super) fn intersect(&self, ray: &Ray8, tmax: f32) -> (F8, F8) {
         let [ox, oy, oz] = ray.origin;
         let [dx, dy, dz] = ray.direction;
         let [ax, ay, az] = self.e1;
         let [bx, by, bz] = self.e2;
+        let [nx, ny, nz] = self.ng;
         let (cx, cy, cz) = (self.v0[0].sub(ox), self.v0[1].sub(oy), self.v0[2].sub(oz));
-        // r = d × c and ng = e1 × e2.
+        // r = d × c.
         let cross = |a1: F8, b1: F8, a2: F8, b2: F8| a1.mul(b1).sub(a2.mul(b2));
         let (rx, ry, rz) = (
             cross(dy, cz, dz, cy),
             cross(dz, cx, dx, cz),
             cross(dx, cy, dy, cx),
-        );
-        let (nx, ny, nz) = (
-            cross(ay, bz, az, by),
-            cross(az, bx, ax, bz),
-            cross(ax, by, ay, bx),
         );
         let dot = |x: F8, y: F8, z: F8, a: F8, b: F8, c: F8| x.mul(a).add(y.mul(b)).add(z.mul(c));
         let one = F8::splat(1.0);
@@ -207,16 +217,16 @@ impl TriPack {
         let w = one.sub(u).sub(v);
         let t = dot(nx, ny, nz, cx, cy, cz).mul(inv_det);
         // t = 0 counts: spawned origins sit strictly off their own surface, but may lie
-        // exactly on an adjacent wall at a corner, and must not slip through it. inv_det − inv_det
-        // is 0 exactly when inv_det is finite.
+        // exactly on an adjacent wall at a corner, and must not slip through it. A non-finite
+        // inv_det (det = ±0 or tiny) needs no test of its own: u and v are then ±∞ or NaN, both
+        // pass 0 ≤ u, v only as +∞, and then w = 1 − ∞ − ∞ = −∞ fails.
         let hit = zero
             .le(u)
             .and(zero.le(v))
             .and(zero.le(w))
-            .and(inv_det.sub(inv_det).eq(zero))
             .and(zero.le(t))
             .and(t.lt(F8::splat(tmax)));
-        F8::select(hit, t, F8::splat(f32::INFINITY))
+        (hit, t)
     }
 }
 

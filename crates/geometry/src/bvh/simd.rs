@@ -7,10 +7,12 @@
 #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
 mod imp {
     use std::arch::x86_64::{
-        __m256, _CMP_EQ_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _mm256_add_ps, _mm256_and_ps, _mm256_blendv_ps,
-        _mm256_cmp_ps, _mm256_div_ps, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_ps,
-        _mm256_movemask_ps, _mm256_mul_ps, _mm256_permute2f128_ps, _mm256_set1_ps,
-        _mm256_shuffle_ps, _mm256_storeu_ps, _mm256_sub_ps,
+        __m128i, __m256, __m256i, _CMP_EQ_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _mm_loadl_epi64,
+        _mm256_add_ps, _mm256_and_ps, _mm256_blendv_ps, _mm256_cmp_ps, _mm256_cvtepu8_epi32,
+        _mm256_div_ps, _mm256_loadu_ps, _mm256_loadu_si256, _mm256_max_ps, _mm256_min_ps,
+        _mm256_movemask_ps, _mm256_mul_ps, _mm256_permute2f128_ps, _mm256_permutevar8x32_epi32,
+        _mm256_permutevar8x32_ps, _mm256_set1_ps, _mm256_shuffle_ps, _mm256_storeu_ps,
+        _mm256_storeu_si256, _mm256_sub_ps,
     };
 
     // SAFETY (every `unsafe` block of this module): the intrinsics need AVX (and AVX2), which the
@@ -114,6 +116,56 @@ mod imp {
                 let m = _mm256_min_ps(m, _mm256_shuffle_ps::<0b01_00_11_10>(m, m));
                 Self(_mm256_min_ps(m, _mm256_shuffle_ps::<0b10_11_00_01>(m, m)))
             }
+        }
+    }
+
+    /// Per 8-bit mask, the indices of its set bits in increasing order, one per byte from the
+    /// lowest (the unused high bytes are 0).
+    static COMPRESS: [u64; 256] = {
+        let mut table = [0u64; 256];
+        let mut mask = 0;
+        while mask < 256 {
+            let (mut bits, mut at) = (0u64, 0);
+            let mut lane = 0;
+            while lane < 8 {
+                if mask & (1 << lane) != 0 {
+                    bits |= (lane as u64) << (8 * at);
+                    at += 1;
+                }
+                lane += 1;
+            }
+            table[mask] = bits;
+            mask += 1;
+        }
+        table
+    };
+
+    /// Writes the lanes of `refs` and `t` whose bits are set in `mask` (below 2⁸) to the front of
+    /// `refs_out` and `t_out`, in lane order; the lanes after them get arbitrary values of the
+    /// inputs.
+    #[inline(always)]
+    pub(in crate::bvh) fn compress(
+        mask: u32,
+        refs: &[u32; 8],
+        t: F8,
+        refs_out: &mut [std::mem::MaybeUninit<u32>; 8],
+        t_out: &mut [std::mem::MaybeUninit<f32>; 8],
+    ) {
+        let indices = &COMPRESS[(mask & 0xff) as usize];
+        // SAFETY: as for the whole module; `indices` points to 8 readable bytes, `refs` to 32
+        // and the outputs to 32 writable bytes each (unaligned accesses).
+        unsafe {
+            let p =
+                _mm256_cvtepu8_epi32(_mm_loadl_epi64((indices as *const u64).cast::<__m128i>()));
+            let r = _mm256_loadu_si256(refs.as_ptr().cast::<__m256i>());
+            _mm256_storeu_si256(
+                refs_out.as_mut_ptr().cast::<__m256i>(),
+                _mm256_permutevar8x32_epi32(r, p),
+            );
+            _mm256_storeu_ps(
+                t_out.as_mut_ptr().cast::<f32>(),
+                _mm256_permutevar8x32_ps(t.0, p),
+            );
         }
     }
 }
@@ -230,6 +282,22 @@ mod imp {
             )
         }
     }
+
+    /// Writes the lanes of `refs` and `t` whose bits are set in `mask` (below 2⁸) to the front of
+    /// `refs_out` and `t_out`, in lane order (the AVX form also writes the lanes after them).
+    #[inline(always)]
+    pub(in crate::bvh) fn compress(
+        mask: u32,
+        refs: &[u32; 8],
+        t: F8,
+        refs_out: &mut [std::mem::MaybeUninit<u32>; 8],
+        t_out: &mut [std::mem::MaybeUninit<f32>; 8],
+    ) {
+        for (at, lane) in (0..8).filter(|&lane| mask & (1 << lane) != 0).enumerate() {
+            refs_out[at].write(refs[lane]);
+            t_out[at].write(t.0[lane]);
+        }
+    }
 }
 
-pub(super) use imp::F8;
+pub(super) use imp::{F8, compress};

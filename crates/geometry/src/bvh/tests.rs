@@ -220,6 +220,33 @@ fn tiny_scenes() {
     );
 }
 
+/// A ray with a non-finite origin or direction component hits nothing (the one-SIMD-test check
+/// of `Accel::internal_ray`), while ±0 components are fine.
+#[test]
+fn non_finite_rays_miss() {
+    let tris = [tri(
+        Vec3::new(-1.0, -1.0, 1.0),
+        Vec3::new(1.0, -1.0, 1.0),
+        Vec3::new(0.0, 1.0, 1.0),
+        0,
+    )];
+    let accel = Accel::build(&tris, &[], &[]);
+    let good = Ray::infinite(Vec3::new(-0.0, 0.0, -0.0), Vec3::Z);
+    assert!(accel.intersect(&good).is_some() && accel.occluded(&good));
+    for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        for axis in 0..6 {
+            let mut ray = good;
+            if axis < 3 {
+                ray.origin[axis] = bad;
+            } else {
+                ray.direction[axis - 3] = bad;
+            }
+            assert!(accel.intersect(&ray).is_none(), "{ray:?}");
+            assert!(!accel.occluded(&ray), "{ray:?}");
+        }
+    }
+}
+
 /// Tens of thousands of primitives, so that the tree is many levels deep.
 #[test]
 fn large_scene() {
