@@ -996,7 +996,8 @@ impl<'s> PhotonMapper<'s> {
                 if !self.is_valid(slot) || freq.clear_level != GEOMETRY_UNKNOWN {
                     return None;
                 }
-                let r_freq = freq.estimate().radius(f64::from(freq.normal_distance), k)?;
+                // Not probed yet, so this is the unbounded frequency radius.
+                let r_freq = freq.hold_radius(k, self.kernel_scale)?;
                 if slots.radius()[slot] > r_freq {
                     return None;
                 }
