@@ -358,6 +358,7 @@ impl Progress {
                     "trace": stats.timings.trace,
                     "gather": stats.timings.gather,
                     "update": stats.timings.update,
+                    "frequency": stats.timings.frequency,
                 },
                 "photons_emitted": renderer.photons_emitted(),
                 "elapsed_seconds": elapsed.as_secs_f64(),

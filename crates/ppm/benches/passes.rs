@@ -155,26 +155,44 @@ fn main() {
                     phase(|t| t.trace),
                     phase(|t| t.gather),
                     phase(|t| t.update),
+                    phase(|t| t.frequency),
+                    phase(|t| t.total()),
                 ],
+                stats.iter().map(|s| s.photons_deposited).sum::<u64>() as f64
+                    / stats.iter().map(|s| s.photons_stored).sum::<u64>().max(1) as f64,
             ));
         }
     }
     println!(
-        "{:<10} {:>7} {:>9} {:>9} {:>9} {:>9} {:>9}   (median seconds per phase)",
-        "method", "threads", "camera", "index", "trace", "gather", "update"
+        "{:<10} {:>7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>11}   (median seconds per phase)",
+        "method",
+        "threads",
+        "camera",
+        "index",
+        "trace",
+        "gather",
+        "update",
+        "(freq)",
+        "hitp./phot."
     );
-    for (method, threads, p) in &phases {
+    for (method, threads, p, per_photon) in &phases {
         println!(
-            "{:<10} {:>7} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
+            "{:<10} {:>7} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>11.2}",
             method.name(),
             threads,
             p[0],
             p[1],
             p[2],
             p[3],
-            p[4]
+            p[4],
+            p[5],
+            per_photon
         );
     }
+    println!(
+        "(freq): the frequency deposits and clear-disc probes inside gather and update; \
+         hitp./phot.: hitpoints each stored photon reached"
+    );
     let find = |m: Method, t: usize| {
         pass_seconds
             .iter()
@@ -192,14 +210,32 @@ fn main() {
             );
         }
     }
+    let find_phases = |m: Method, t: usize| {
+        phases
+            .iter()
+            .find(|&&(method, threads, _, _)| method == m && threads == t)
+            .map(|&(_, _, p, per_photon)| (p, per_photon))
+    };
     for threads in [1, 2] {
-        if let (Some((ppm, _)), Some((freq, _))) =
-            (find(Method::Ppm, threads), find(Method::FreqPpm, threads))
-        {
+        if let (Some((ppm, ppm_reach)), Some((freq, freq_reach))) = (
+            find_phases(Method::Ppm, threads),
+            find_phases(Method::FreqPpm, threads),
+        ) {
+            // Bookkeeping: what frequency photons add to tracing (spectra, occlusion probes),
+            // plus their deposits and the clear-disc probes. The rest of the difference is the
+            // flux gather over kernels the frequency floor holds larger than PPM's.
+            let bookkeeping = (freq[2] - ppm[2]).max(0.0) + freq[5];
             println!(
-                "frequency photons (default fraction {}): {:+.1} % pass time vs classical PPM ({threads} threads)",
+                "frequency photons (default fraction {}, {threads} threads): {:+.1} % pass time vs \
+                 classical PPM; bookkeeping (trace {:+.3} s, deposits and probes {:.3} s) {:.1} % of \
+                 the freq pass; held kernels reach {:.2} hitpoints per photon against {:.2}",
                 RenderParams::preview().freq_fraction,
-                (freq / ppm - 1.0) * 100.0
+                (freq[6] / ppm[6] - 1.0) * 100.0,
+                freq[2] - ppm[2],
+                freq[5],
+                bookkeeping / freq[6] * 100.0,
+                freq_reach,
+                ppm_reach
             );
         }
     }

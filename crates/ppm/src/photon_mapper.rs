@@ -81,6 +81,12 @@ pub struct PassTimings {
     pub gather: f64,
     /// Folding the pass into the hitpoint statistics.
     pub update: f64,
+    /// The frequency bookkeeping inside `gather` and `update` (already counted there, not a
+    /// phase of its own): sorting and gathering the frequency photons' deposits, merging them
+    /// into the slots, and the clear-disc probes. Zero for methods without frequency photons.
+    /// The rest of the bookkeeping, spectra and occlusion probes along photon paths, is inside
+    /// `trace`.
+    pub frequency: f64,
 }
 
 impl PassTimings {
@@ -386,6 +392,7 @@ impl<'s> PhotonMapper<'s> {
             trace: trace_seconds,
             gather: photons_done - camera - index - trace_seconds,
             update: clock.elapsed().as_secs_f64() - photons_done,
+            frequency: stats.timings.frequency + deposits.frequency_seconds,
         };
         self.pass += 1;
         stats
@@ -697,6 +704,7 @@ impl<'s> PhotonMapper<'s> {
             frequency_photons,
             photons_stored: 0,
             trace_seconds,
+            frequency_seconds: 0.0,
         };
         // Slot → grid entry (`NOT_IN_GRID` for slots the grid does not index).
         deposits.slot_entry.clear();
@@ -766,6 +774,7 @@ impl<'s> PhotonMapper<'s> {
         // depend on the order anyway), then that pass estimate is merged into the slot's. The
         // photons are Morton-sorted like the flux photons: grid queries in random order are
         // several times slower.
+        let frequency_clock = Instant::now();
         let policy = self.params.freq_merge;
         photon::morton_sort(
             &[&scratch.frequency[..]],
@@ -785,17 +794,7 @@ impl<'s> PhotonMapper<'s> {
                     return None;
                 }
                 let material = self.scene.material(slots.material_idx()[slot])?;
-                // The field the hitpoint's radius reads (design §8.1): the photon's spectrum
-                // reflected by the hitpoint's lobe, with μo = 1 so that a stays in surface units
-                // (b does not depend on μo) and μi = 1 for the conservative 3D collapse (§8.5:
-                // the out-of-plane axis keeps its width).
-                let lobe = spectrum_lobe(material.kind.lobe());
-                Some(photon.spectrum.reflect_isotropic(
-                    1.0,
-                    f64::from(photon.curvature),
-                    lobe,
-                    &self.caps,
-                ))
+                Some(photon.field(material.kind.lobe(), &self.caps))
             },
             |acc: &mut FrequencyEstimate, spectrum| acc.deposit(spectrum, policy),
         );
@@ -808,6 +807,7 @@ impl<'s> PhotonMapper<'s> {
                 freq.set_estimate(merged);
             }
         }
+        deposits.frequency_seconds = frequency_clock.elapsed().as_secs_f64();
         self.scratch = scratch;
         deposits
     }
@@ -878,11 +878,13 @@ impl<'s> PhotonMapper<'s> {
                 };
                 out.photons.push(photon);
                 if let Some(s) = spectrum {
-                    out.frequency.push(FrequencyPhoton {
+                    out.frequency.push(FrequencyPhoton::new(
                         photon,
-                        curvature: hit.curvature,
-                        spectrum: s,
-                    });
+                        hit.curvature,
+                        material.kind.lobe(),
+                        s,
+                        &self.caps,
+                    ));
                 }
             }
             // Scatter.
@@ -1021,9 +1023,11 @@ impl<'s> PhotonMapper<'s> {
         let k = self.params.kernel_k;
         let floor = self.params.freq_floor;
         let uses_frequency = self.params.method.uses_frequency();
+        let probe_clock = Instant::now();
         if uses_frequency && self.params.freq_geometry {
             self.probe_clear_radii();
         }
+        let probe_seconds = probe_clock.elapsed().as_secs_f64();
         let r0 = self.kernel_scale;
         let columns = self.slots.columns_mut();
         let held: Vec<bool> = columns
@@ -1071,7 +1075,10 @@ impl<'s> PhotonMapper<'s> {
             max_radius: 0.0,
             frequency_held: 0.0,
             photons_stored: 0,
-            timings: PassTimings::default(),
+            timings: PassTimings {
+                frequency: probe_seconds,
+                ..PassTimings::default()
+            },
         };
         let mut sum = 0.0;
         let mut n_held = 0u64;
@@ -1161,13 +1168,55 @@ impl AsRef<[Photon]> for TracedPhotons {
     }
 }
 
-/// A frequency photon as the gather reads it: the stored photon, the curvature at its hit and
-/// its spectrum on arrival.
+/// A frequency photon as the gather reads it: the stored photon, the curvature at its hit, its
+/// spectrum on arrival, and that spectrum already reflected by the lobe of the surface it landed
+/// on (`field`, for `field_lobe`).
+///
+/// A hitpoint that accepts the photon nearly always lies on the same surface, so the reflection
+/// a deposit needs (design §8.1) is computed once per photon instead of once per photon and
+/// hitpoint; a hitpoint of another lobe recomputes it from `spectrum` and `curvature`, with the
+/// same result either way.
 #[derive(Clone, Copy)]
 struct FrequencyPhoton {
     photon: Photon,
     curvature: f32,
+    field_lobe: MaterialLobe,
     spectrum: Spectrum,
+    field: Spectrum,
+}
+
+impl FrequencyPhoton {
+    fn new(
+        photon: Photon,
+        curvature: f32,
+        lobe: MaterialLobe,
+        spectrum: Spectrum,
+        caps: &Caps,
+    ) -> Self {
+        Self {
+            photon,
+            curvature,
+            field_lobe: lobe,
+            spectrum,
+            field: deposit_field(spectrum, curvature, lobe, caps),
+        }
+    }
+
+    /// The field a hitpoint of lobe `lobe` reads from this photon.
+    fn field(&self, lobe: MaterialLobe, caps: &Caps) -> Spectrum {
+        if lobe == self.field_lobe {
+            self.field
+        } else {
+            deposit_field(self.spectrum, self.curvature, lobe, caps)
+        }
+    }
+}
+
+/// The field a hitpoint's radius reads (design §8.1): the photon's spectrum reflected by the
+/// hitpoint's lobe, with μo = 1 so that a stays in surface units (b does not depend on μo) and
+/// μi = 1 for the conservative 3D collapse (§8.5: the out-of-plane axis keeps its width).
+fn deposit_field(spectrum: Spectrum, curvature: f32, lobe: MaterialLobe, caps: &Caps) -> Spectrum {
+    spectrum.reflect_isotropic(1.0, f64::from(curvature), spectrum_lobe(lobe), caps)
 }
 
 impl AsRef<Photon> for FrequencyPhoton {
@@ -1216,6 +1265,8 @@ struct PassDeposits {
     frequency_photons: u64,
     photons_stored: u64,
     trace_seconds: f64,
+    /// Seconds spent on the frequency deposits (sort, gather, merge).
+    frequency_seconds: f64,
 }
 
 impl PassDeposits {
