@@ -344,6 +344,10 @@ struct Row {
     photons: u64,
     all: Errors,
     masked: [Errors; 3],
+    /// The pointwise reference's own noise in relMSE units (whole image, then the three masks;
+    /// NaN against a golden reference): the part of `all.rel_mse` and `masked[i].rel_mse` that
+    /// the reference, not the method, contributes.
+    noise: [f64; 4],
 }
 
 pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
@@ -387,19 +391,28 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         }
     };
     let golden_masks = build_masks(&scene, &reference);
-    let reference = match flags.pointwise {
-        None => reference,
+    let (reference, reference_variance) = match flags.pointwise {
+        None => (reference, None),
         Some(paths) => {
             let mut params = base_params(entry, ppm::Method::Ppm, &flags);
             flags.overrides.apply(&mut params);
             let start = Instant::now();
-            let pixels = ppm::pointwise_reference(&scene, params, paths, POINTWISE_EMISSION_PASSES)
-                .context("pointwise reference")?;
+            // Two independent halves: their mean is the reference, their difference measures
+            // its noise.
+            let half = paths.div_ceil(2);
+            let halves = [0..half, half..paths.max(half + 1)].map(|range| {
+                ppm::pointwise_reference_paths(&scene, params, range, POINTWISE_EMISSION_PASSES)
+                    .context("pointwise reference")
+            });
+            let [a, b] = halves;
+            let (a, b) = (a?, b?);
             println!(
                 "converge: pointwise reference, {paths} paths per hitpoint, {:.1} s",
                 start.elapsed().as_secs_f64()
             );
-            Image::new(reference.width, reference.height, pixels)
+            let (w, h) = (reference.width, reference.height);
+            let (mean, variance) = reference_from_halves(&a, &b);
+            (Image::new(w, h, mean), Some(variance))
         }
     };
     let masks = if flags.film.is_some() {
@@ -411,6 +424,18 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         return sweep(&scene, entry, &reference, &masks, &flags, &out);
     }
     let transport = suite::transport_mask(&scene);
+    let noise = match &reference_variance {
+        None => [f64::NAN; 4],
+        Some(variance) => {
+            let all = noise_rel_mse(variance, &reference, &transport);
+            let [low, caustic, glossy] =
+                [0, 1, 2].map(|i| noise_rel_mse(variance, &reference, &masks.masks[i]));
+            println!(
+                "converge: the reference's own noise, in relMSE: {all:.5} [low {low:.5} caustic {caustic:.5} glossy {glossy:.5}] (from the difference of its two halves; subtracted in the \"net\" figures)"
+            );
+            [all, low, caustic, glossy]
+        }
+    };
     write_masks(
         &out.join(format!("{}-masks.png", entry.name)),
         &masks,
@@ -454,6 +479,16 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
                 masked[1].mean_ratio,
                 masked[2].mean_ratio
             );
+            if reference_variance.is_some() {
+                println!(
+                    "  {:>6} net of the reference's noise: relMSE {:.5}  [low {:.5} caustic {:.5} glossy {:.5}]",
+                    "",
+                    all.rel_mse - noise[0],
+                    masked[0].rel_mse - noise[1],
+                    masked[1].rel_mse - noise[2],
+                    masked[2].rel_mse - noise[3]
+                );
+            }
             rows.push(Row {
                 method,
                 budget,
@@ -462,6 +497,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
                 photons: renderer.photons_emitted(),
                 all,
                 masked,
+                noise,
             });
         }
         let stem = format!("{}-{}", entry.name, method.name());
@@ -494,7 +530,21 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
             .filter(|r| r.method == method)
             .map(|r| (r.seconds.ln(), r.all.rel_mse.ln()))
             .collect();
-        println!("  {:<9} {:+.3}", method.name(), slope(&points));
+        if reference_variance.is_some() {
+            let net: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.method == method)
+                .map(|r| (r.seconds.ln(), (r.all.rel_mse - r.noise[0]).ln()))
+                .collect();
+            println!(
+                "  {:<9} {:+.3} ({:+.3} net of the reference's noise)",
+                method.name(),
+                slope(&points),
+                slope(&net)
+            );
+        } else {
+            println!("  {:<9} {:+.3}", method.name(), slope(&points));
+        }
     }
     println!("converge: wrote {}", out.display());
     Ok(true)
@@ -504,6 +554,43 @@ fn base_params(entry: &SuiteScene, method: ppm::Method, flags: &Flags) -> ppm::R
     let mut params = suite::params(entry, method, flags.seed);
     params.photons_per_pass = flags.photons;
     params
+}
+
+/// The reference of two independent halves A and B (pixels of linear RGB): their mean, and
+/// per pixel and channel the unbiased estimate (A − B)²/4 of that mean's variance.
+pub(crate) fn reference_from_halves(
+    a: &[[f32; 3]],
+    b: &[[f32; 3]],
+) -> (Vec<[f32; 3]>, Vec<[f64; 3]>) {
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| {
+            let mean = [0, 1, 2].map(|c| 0.5 * (a[c] + b[c]));
+            let variance = [0, 1, 2].map(|c| {
+                let d = f64::from(a[c]) - f64::from(b[c]);
+                d * d / 4.0
+            });
+            (mean, variance)
+        })
+        .unzip()
+}
+
+/// The expected contribution of the reference's noise to a relMSE over `mask`: E[(x − ref)²] =
+/// (x − L)² + Var(ref) for an image x independent of the reference, so this is the mean of
+/// Var(ref) / (ref² + ε) with the relMSE's own normalisation (`image_io::errors`).
+pub(crate) fn noise_rel_mse(variance: &[[f64; 3]], reference: &Image, mask: &[bool]) -> f64 {
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for ((v, r), &inside) in variance.iter().zip(&reference.pixels).zip(mask) {
+        if !inside {
+            continue;
+        }
+        for c in 0..3 {
+            let y = f64::from(r[c]);
+            sum += v[c] / (y * y + image_io::REL_MSE_EPSILON);
+            n += 1;
+        }
+    }
+    sum / n.max(1) as f64
 }
 
 /// Least-squares slope of y over x.
@@ -650,6 +737,10 @@ fn write_csv(path: &Path, entry: &SuiteScene, masks: &Masks, rows: &[Row]) -> Re
     for name in masks.names {
         let _ = write!(csv, ",rmse_{name},rel_mse_{name}");
     }
+    csv.push_str(",ref_noise_rel_mse");
+    for name in masks.names {
+        let _ = write!(csv, ",ref_noise_rel_mse_{name}");
+    }
     csv.push('\n');
     for r in rows {
         let _ = write!(
@@ -667,6 +758,9 @@ fn write_csv(path: &Path, entry: &SuiteScene, masks: &Masks, rows: &[Row]) -> Re
         );
         for m in &r.masked {
             let _ = write!(csv, ",{:.6e},{:.6e}", m.rmse, m.rel_mse);
+        }
+        for n in r.noise {
+            let _ = write!(csv, ",{n:.6e}");
         }
         csv.push('\n');
     }
@@ -701,6 +795,7 @@ fn read_csv(path: &Path) -> Result<Vec<Row>> {
                 mean_ratio: f[8].parse()?,
             },
             masked: [none; 3],
+            noise: [f64::NAN; 4],
         });
     }
     Ok(rows)

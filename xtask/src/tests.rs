@@ -103,3 +103,32 @@ fn exr_round_trip_is_exact() {
     std::fs::remove_dir_all(&dir).unwrap();
     assert_eq!(back, r);
 }
+
+/// Two halves ref ± e: their mean is ref and the variance estimate e² per channel, which
+/// `noise_rel_mse` turns into the relMSE a noise-free image would show against that reference.
+#[test]
+fn reference_noise_from_two_halves() {
+    use crate::converge::{noise_rel_mse, reference_from_halves};
+    let reference = reference();
+    let e = 0.01f32;
+    let plus: Vec<[f32; 3]> = reference.pixels.iter().map(|p| p.map(|v| v + e)).collect();
+    let minus: Vec<[f32; 3]> = reference.pixels.iter().map(|p| p.map(|v| v - e)).collect();
+    let (mean, variance) = reference_from_halves(&plus, &minus);
+    for (m, r) in mean.iter().zip(&reference.pixels) {
+        for c in 0..3 {
+            assert!((m[c] - r[c]).abs() < 1e-6);
+        }
+    }
+    let mask = vec![true; reference.pixels.len()];
+    let mean = Image::new(reference.width, reference.height, mean);
+    let noise = noise_rel_mse(&variance, &mean, &mask);
+    // An image off the mean by e everywhere has the relMSE e² / (ref² + ε) the noise predicts.
+    let plus = Image::new(reference.width, reference.height, plus);
+    let expected = errors(&plus, &mean, None).unwrap().rel_mse;
+    assert!(
+        (noise - expected).abs() < 0.02 * expected,
+        "noise {noise} vs relMSE {expected}"
+    );
+    let none = vec![false; reference.pixels.len()];
+    assert_eq!(noise_rel_mse(&variance, &mean, &none), 0.0);
+}

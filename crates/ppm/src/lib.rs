@@ -51,7 +51,7 @@ pub use crate::params::{Method, ParamError, RenderParams};
 pub use crate::photon_mapper::{
     MemoryUse, PassStats, PassTimings, auto_initial_radius, bytes_per_hitpoint,
 };
-pub use crate::pointwise::pointwise_reference;
+pub use crate::pointwise::{pointwise_reference, pointwise_reference_paths};
 pub use crate::renderer::{Aov, Renderer};
 pub use crate::rng::Sampler;
 pub use crate::state::{STATE_VERSION, StateError, StateHeader, scene_fingerprint};

@@ -40,6 +40,23 @@ pub fn pointwise_reference(
     paths_per_point: u32,
     emission_passes: u32,
 ) -> Result<Vec<[f32; 3]>, ParamError> {
+    pointwise_reference_paths(scene, params, 0..paths_per_point, emission_passes)
+}
+
+/// [`pointwise_reference`] with the reference paths of indices `paths` only (the full reference
+/// of `n` paths uses `0..n`). Disjoint ranges give independent estimates of the same image, so
+/// the noise of a reference can be measured: with A from `0..n/2` and B from `n/2..n`, (A + B)/2
+/// is the reference of `n` paths (up to rounding) and (A − B)²/4 estimates its variance per pixel.
+///
+/// # Errors
+///
+/// As [`pointwise_reference`].
+pub fn pointwise_reference_paths(
+    scene: &Scene,
+    params: RenderParams,
+    paths: std::ops::Range<u32>,
+    emission_passes: u32,
+) -> Result<Vec<[f32; 3]>, ParamError> {
     if params.method.is_stochastic() || !params.method.is_photon_mapper() || params.direct_lighting
     {
         return Err(ParamError::NoFixedHitpoints {
@@ -69,8 +86,8 @@ pub fn pointwise_reference(
             );
         }
         if let Some(end) = first.end {
-            let scale = 1.0 / f64::from(paths_per_point.max(1));
-            for path in 0..paths_per_point {
+            let scale = 1.0 / paths.len().max(1) as f64;
+            for path in paths.clone() {
                 let mut sampler =
                     Sampler::new(params.seed, path, REFERENCE_STREAM | u64::from(slot));
                 let l = tracer.scattered(end.hit, end.outgoing, end.bounces, &mut sampler);

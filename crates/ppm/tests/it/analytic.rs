@@ -285,6 +285,18 @@ fn pointwise_reference_is_the_radiance_at_the_hitpoints() {
         off_average > reference.len() / 2,
         "only {off_average} slots differ from the pixel average"
     );
+    // Disjoint path ranges are independent estimates of the same image; light sampling being
+    // exact here, each equals the whole reference, and their mean is it.
+    for range in [0..1, 1..2] {
+        let half =
+            ppm::pointwise_reference_paths(&scene, params(Method::Ppm, 1), range, 1).unwrap();
+        for (h, r) in half.iter().zip(&reference) {
+            assert!(
+                (h[1] - r[1]).abs() <= 1e-5 * r[1].abs() + 1e-7,
+                "{h:?} vs {r:?}"
+            );
+        }
+    }
     let mut sppm = params(Method::Sppm, 1);
     assert!(ppm::pointwise_reference(&scene, sppm, 1, 1).is_err());
     sppm.method = Method::Ppm;
