@@ -19,6 +19,12 @@
 //! CPU s" is the process CPU time of a pass (all threads): with 1 thread it is the work
 //! itself, whatever else runs on the machine.
 //!
+//! The frequency line splits freq's extra pass time into its bookkeeping (the tracing phase's
+//! extra time over ppm's: spectra and occlusion probes along the frequency photons' paths; plus
+//! `PassTimings::frequency`: their deposits and the clear-disc probes) and the rest, which is the
+//! flux gather over the larger kernels the frequency floor holds (the hitpoints each stored
+//! photon reaches, printed for both methods).
+//!
 //! Memory is `Renderer::memory` after the timed passes (allocated capacities), per hitpoint
 //! slot: the state kept from pass to pass (records, the renderer's slot columns, the grid and
 //! its slot map) and the per-pass buffers, sized by the hitpoints (M, Φ and frequency
