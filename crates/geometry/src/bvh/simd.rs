@@ -7,14 +7,14 @@
 #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
 mod imp {
     use std::arch::x86_64::{
-        __m128i, __m256, __m256i, _CMP_EQ_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _CMP_NLE_UQ, _mm_loadl_epi64,
+        __m128i, __m256, __m256i, _CMP_EQ_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _mm_loadl_epi64,
         _mm256_add_ps, _mm256_and_ps, _mm256_blendv_ps, _mm256_castps_si256, _mm256_castsi256_ps,
-        _mm256_cmp_ps, _mm256_cmpeq_epi32, _mm256_cvtepu8_epi32, _mm256_div_ps, _mm256_loadu_ps,
-        _mm256_loadu_si256, _mm256_max_ps, _mm256_min_epu32, _mm256_min_ps, _mm256_movemask_ps,
-        _mm256_mul_ps, _mm256_or_ps, _mm256_permute2f128_ps, _mm256_permute4x64_epi64,
-        _mm256_permutevar8x32_epi32, _mm256_permutevar8x32_ps, _mm256_set1_ps,
-        _mm256_shuffle_epi32, _mm256_shuffle_ps, _mm256_storeu_ps, _mm256_storeu_si256,
-        _mm256_sub_ps,
+        _mm256_cmp_ps, _mm256_cmpeq_epi32, _mm256_cmpgt_epi32, _mm256_cvtepu8_epi32, _mm256_div_ps,
+        _mm256_loadu_ps, _mm256_loadu_si256, _mm256_max_ps, _mm256_min_epu32, _mm256_min_ps,
+        _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_permute2f128_ps,
+        _mm256_permute4x64_epi64, _mm256_permutevar8x32_epi32, _mm256_permutevar8x32_ps,
+        _mm256_set1_ps, _mm256_shuffle_epi32, _mm256_shuffle_ps, _mm256_storeu_ps,
+        _mm256_storeu_si256, _mm256_sub_ps,
     };
 
     // SAFETY (every `unsafe` block of this module): the intrinsics need AVX (and AVX2), which the
@@ -92,12 +92,6 @@ mod imp {
             Self(unsafe { _mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, o.0) })
         }
 
-        /// All-ones lanes where `self <= o` is false (also for NaN), zero elsewhere.
-        #[inline(always)]
-        pub(in crate::bvh) fn not_le(self, o: Self) -> Self {
-            Self(unsafe { _mm256_cmp_ps::<_CMP_NLE_UQ>(self.0, o.0) })
-        }
-
         /// Bitwise and (of comparison results).
         #[inline(always)]
         pub(in crate::bvh) fn and(self, o: Self) -> Self {
@@ -115,6 +109,18 @@ mod imp {
         pub(in crate::bvh) fn eq_bits(self, o: Self) -> Self {
             Self(unsafe {
                 _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+                    _mm256_castps_si256(self.0),
+                    _mm256_castps_si256(o.0),
+                ))
+            })
+        }
+
+        /// All-ones lanes where the bits of `self`, read as a signed integer, exceed those of
+        /// `o`, zero elsewhere (one cycle, against four for a float comparison).
+        #[inline(always)]
+        pub(in crate::bvh) fn gt_bits(self, o: Self) -> Self {
+            Self(unsafe {
+                _mm256_castsi256_ps(_mm256_cmpgt_epi32(
                     _mm256_castps_si256(self.0),
                     _mm256_castps_si256(o.0),
                 ))
@@ -293,11 +299,6 @@ mod imp {
         }
 
         #[inline(always)]
-        pub(in crate::bvh) fn not_le(self, o: Self) -> Self {
-            self.zip(o, |a, b| Self::flag(!(a <= b)))
-        }
-
-        #[inline(always)]
         pub(in crate::bvh) fn and(self, o: Self) -> Self {
             self.zip(o, |a, b| f32::from_bits(a.to_bits() & b.to_bits()))
         }
@@ -310,6 +311,13 @@ mod imp {
         #[inline(always)]
         pub(in crate::bvh) fn eq_bits(self, o: Self) -> Self {
             self.zip(o, |a, b| Self::flag(a.to_bits() == b.to_bits()))
+        }
+
+        #[inline(always)]
+        pub(in crate::bvh) fn gt_bits(self, o: Self) -> Self {
+            self.zip(o, |a, b| {
+                Self::flag(a.to_bits() as i32 > b.to_bits() as i32)
+            })
         }
 
         #[inline(always)]

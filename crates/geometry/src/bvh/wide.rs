@@ -35,6 +35,18 @@ const MIXED_BIT: u32 = 1 << 30;
 pub(super) const MAX_LEAF_PRIMS: u32 = 8;
 /// Leaves are numbered below this bound in a leaf reference.
 const MAX_LEAVES: u32 = 1 << 30;
+/// A node's reference is its index times this, its byte offset in [`Wide::nodes`] divided by 8,
+/// so that the node test reads its rows at (row address) + 8 · (reference), one addressing mode
+/// of x86 (an index would take a shift and an addition before the first load of every node).
+const NODE_REF_SCALE: u32 = (size_of::<Node>() / 8) as u32;
+/// Nodes are numbered below this bound (their references stay below [`LEAF_BIT`]).
+const MAX_NODES: usize = (LEAF_BIT / NODE_REF_SCALE) as usize;
+
+/// The reference of node `index`.
+fn node_ref(index: usize) -> u32 {
+    assert!(index < MAX_NODES, "too many BVH nodes");
+    index as u32 * NODE_REF_SCALE
+}
 /// The reference in an unused child slot; its box is empty, so it is never followed.
 const EMPTY: u32 = u32::MAX;
 
@@ -169,9 +181,15 @@ impl Node {
         let (tz0, tz1) = (near(4, 2), far(5, 2));
         let tnear = tx0.max(ty0).max(tz0.max(F8::splat(0.0)));
         let tfar = tx1.min(ty1).min(tz1.min(F8::splat(tmax)));
-        // Two comparisons rather than one and a complement of its mask: one step less before
-        // the mask, from which the next node's address follows.
-        (tnear.le(tfar).bitmask(), tnear.or(tnear.not_le(tfar)))
+        // tnear is +0 or positive (or +∞), never NaN, so its bits order like a signed integer,
+        // and tnear > tfar as floats exactly when the bits compare so, except for tfar = −0
+        // (whose bits are the most negative integer): that box is culled, and rightly, since a
+        // box whose computed exit distance is ±0 holds nothing the ray meets at t ≥ 0 (every
+        // box extends at least the smallest normal float beyond its primitives, and the exit
+        // distance is computed conservatively). A NaN tfar (from a NaN tmax) gives no hit as
+        // floats but may as integers; no primitive test passes t < NaN.
+        let miss = tnear.gt_bits(tfar);
+        (!miss.bitmask() & 0xff, tnear.or(miss))
     }
 }
 
@@ -377,7 +395,7 @@ impl<F: Fn(u32, u32) -> bool> Collapse<'_, F> {
             }
         }
         self.nodes[at] = node.build();
-        (at as u32, depth + 1)
+        (node_ref(at), depth + 1)
     }
 }
 
@@ -431,7 +449,7 @@ impl Wide {
                         index,
                         depth: p.depth + 1,
                     });
-                    index as u32
+                    node_ref(index)
                 };
                 node.set_child(slot, &child_node.aabb, reference);
             }
@@ -469,6 +487,21 @@ impl Wide {
         open
     }
 
+    /// The node of reference `r` (without [`LEAF_BIT`]).
+    #[inline(always)]
+    fn node(&self, r: u32) -> &Node {
+        // SAFETY: `from_bvh2` makes every child reference without `LEAF_BIT` (and a root without
+        // it) the reference of a node it pushed, `node_ref`: a byte offset of 8 · r.
+        unsafe {
+            &*self
+                .nodes
+                .as_ptr()
+                .cast::<u8>()
+                .add(r as usize * 8)
+                .cast::<Node>()
+        }
+    }
+
     /// Closest-hit traversal. `leaf` tests a leaf's primitives against the ray with the current
     /// upper bound and lowers it on a hit; nodes are visited nearest first, and those
     /// entered beyond the bound are skipped.
@@ -492,9 +525,7 @@ impl Wide {
                 if current & LEAF_BIT != 0 {
                     leaves.closest(leaf_of(current), tmax);
                 } else {
-                    // SAFETY: `from_bvh2` makes every child reference without `LEAF_BIT` (and a
-                    // root without it) the index of a node it pushed.
-                    let node = unsafe { self.nodes.get_unchecked(current as usize) };
+                    let node = self.node(current);
                     let (mask, tnear) = node.intersect(ray, *tmax);
                     if mask != 0 {
                         if mask & (mask - 1) == 0 {
@@ -540,9 +571,7 @@ impl Wide {
                         return true;
                     }
                 } else {
-                    // SAFETY: `from_bvh2` makes every child reference without `LEAF_BIT` (and a
-                    // root without it) the index of a node it pushed.
-                    let node = unsafe { self.nodes.get_unchecked(current as usize) };
+                    let node = self.node(current);
                     let (mask, tnear) = node.intersect(ray, tmax);
                     if mask != 0 {
                         current = node.children[mask.trailing_zeros() as usize & (WIDTH - 1)];
