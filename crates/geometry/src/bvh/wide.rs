@@ -356,6 +356,100 @@ struct Pending {
     depth: usize,
 }
 
+/// Which `Bvh2` inner nodes become wide nodes: those of a minimal total surface area (the
+/// expected number of node tests, in the SAH's terms) over all collapses in which every wide node
+/// has at most [`WIDTH`] children, found by dynamic programming over the binary tree (as in Ylitie
+/// et al. 2017, "Efficient incoherent ray traversal on GPUs through compressed wide BVHs", with
+/// the leaves kept as obvhs made them: every leaf is one child slot somewhere, so their cost does
+/// not depend on the collapse).
+struct Plan {
+    /// Per `Bvh2` node and `i` in 1..=WIDTH (at `i − 1`): the least total half-area of the wide
+    /// nodes in its subtree (itself included if it is one) when the subtree takes at most `i`
+    /// child slots of the wide node above.
+    cost: Vec<[f64; WIDTH]>,
+    /// Per `Bvh2` inner node and `i` (at `i − 1`): 0 where the node takes one slot itself, else
+    /// the number of slots `k` given to its first child (`i − k` to the second); at `WIDTH − 1`,
+    /// the split of its `WIDTH` slots when it is opened (the wide node made from it).
+    split: Vec<[u8; WIDTH]>,
+    open_split: Vec<u8>,
+}
+
+impl Plan {
+    fn new(bvh2: &Bvh2) -> Self {
+        let n = bvh2.nodes.len();
+        let mut plan = Self {
+            cost: vec![[0.0; WIDTH]; n],
+            split: vec![[0; WIDTH]; n],
+            open_split: vec![0; n],
+        };
+        // Children before parents: the reverse of a preorder.
+        let mut preorder = Vec::with_capacity(n);
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            preorder.push(i);
+            let node = &bvh2.nodes[i];
+            if !node.is_leaf() {
+                let first = node.first_index as usize;
+                stack.extend([first, first + 1]);
+            }
+        }
+        for &i in preorder.iter().rev() {
+            let node = &bvh2.nodes[i];
+            if node.is_leaf() {
+                continue;
+            }
+            let (l, r) = (node.first_index as usize, node.first_index as usize + 1);
+            // opened[i − 1]: cost of the two children sharing i slots (i ≥ 2), and the split.
+            let mut opened = [(f64::INFINITY, 0u8); WIDTH];
+            for (slots, entry) in opened.iter_mut().enumerate().skip(1) {
+                let slots = slots + 1;
+                for k in 1..slots {
+                    let c = plan.cost[l][k - 1] + plan.cost[r][slots - k - 1];
+                    if c < entry.0 {
+                        *entry = (c, k as u8);
+                    }
+                }
+            }
+            let own = f64::from(node.aabb.half_area()) + opened[WIDTH - 1].0;
+            plan.open_split[i] = opened[WIDTH - 1].1;
+            plan.cost[i][0] = own;
+            for slots in 2..=WIDTH {
+                let (c, k) = opened[slots - 1];
+                (plan.cost[i][slots - 1], plan.split[i][slots - 1]) =
+                    if c <= own { (c, k) } else { (own, 0) };
+            }
+        }
+        plan
+    }
+
+    /// The `Bvh2` nodes that take the slots of the wide node made from inner node `index`, in
+    /// tree order, padded with `usize::MAX`.
+    fn children(&self, bvh2: &Bvh2, index: usize) -> [usize; WIDTH] {
+        let mut out = [usize::MAX; WIDTH];
+        let mut len = 0;
+        let first = bvh2.nodes[index].first_index as usize;
+        let k = self.open_split[index] as usize;
+        let mut work = vec![(first + 1, WIDTH - k), (first, k)];
+        while let Some((n, slots)) = work.pop() {
+            let node = &bvh2.nodes[n];
+            let k = if node.is_leaf() {
+                0
+            } else {
+                self.split[n][slots - 1] as usize
+            };
+            if k == 0 {
+                out[len] = n;
+                len += 1;
+            } else {
+                let first = node.first_index as usize;
+                work.push((first + 1, slots - k));
+                work.push((first, k));
+            }
+        }
+        out
+    }
+}
+
 /// What the collapse accumulates besides the work list.
 struct Collapse<'a, F> {
     nodes: Vec<Node>,
@@ -420,6 +514,7 @@ impl Wide {
                 leaves: c.leaves,
             };
         }
+        let plan = Plan::new(bvh2);
         c.nodes.push(NodeBuilder::EMPTY.build());
         let mut work = vec![Pending {
             bvh2_node: 0,
@@ -430,7 +525,7 @@ impl Wide {
         while let Some(p) = work.pop() {
             max_depth = max_depth.max(p.depth);
             let mut node = NodeBuilder::EMPTY;
-            let open = Self::open(bvh2, p.bvh2_node);
+            let open = plan.children(bvh2, p.bvh2_node);
             for (slot, &child) in open.iter().enumerate().filter(|&(_, &n)| n != usize::MAX) {
                 let child_node = &bvh2.nodes[child];
                 let reference = if child_node.is_leaf() {
@@ -462,29 +557,6 @@ impl Wide {
             stack_need: max_depth * (WIDTH - 1) + 1,
             leaves: c.leaves,
         }
-    }
-
-    /// Up to [`WIDTH`] `Bvh2` nodes under the inner node `index`: its children, with the inner node of
-    /// largest surface area replaced by its own children while there is room.
-    fn open(bvh2: &Bvh2, index: usize) -> [usize; WIDTH] {
-        let first = bvh2.nodes[index].first_index as usize;
-        let mut open = [usize::MAX; WIDTH];
-        (open[0], open[1]) = (first, first + 1);
-        for len in 2..WIDTH {
-            let largest = (0..len)
-                .filter(|&i| !bvh2.nodes[open[i]].is_leaf())
-                .max_by(|&a, &b| {
-                    let area = |i: usize| bvh2.nodes[open[i]].aabb.half_area();
-                    area(a).total_cmp(&area(b))
-                });
-            let Some(at) = largest else {
-                break;
-            };
-            let first = bvh2.nodes[open[at]].first_index as usize;
-            open[at] = first;
-            open[len] = first + 1;
-        }
-        open
     }
 
     /// The node of reference `r` (without [`LEAF_BIT`]).
