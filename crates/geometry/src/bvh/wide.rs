@@ -494,9 +494,11 @@ impl<F: Fn(u32, u32) -> bool> Collapse<'_, F> {
 }
 
 impl Wide {
-    /// Collapses a `Bvh2` (no spatial splits, at least one primitive): each wide node takes a
-    /// binary node's two children and keeps opening its inner child of largest surface area until
-    /// it has [`WIDTH`] children (the usual greedy collapse). Nodes are laid out depth
+    /// Collapses a `Bvh2` (no spatial splits, at least one primitive) into the wide nodes that
+    /// [`Plan`] chooses: each wide node takes up to [`WIDTH`] binary nodes under the binary node
+    /// it replaces. (The greedy collapse, which opened the inner child of largest surface area
+    /// while there was room, left many nodes near the leaves with two or three children: on the
+    /// bunny 3886 nodes for 11805 leaves against the plan's 2406.) Nodes are laid out depth
     /// first. `mixed(first, count)` says whether a leaf's primitives are not all triangles.
     pub(super) fn from_bvh2(bvh2: &Bvh2, mixed: &impl Fn(u32, u32) -> bool) -> Self {
         let mut c = Collapse {
