@@ -49,6 +49,50 @@
 //! nearest on top and popping it, without those two branches, saved 1.9 of them but cost 48 %
 //! more instructions as compiled, and was ×0.7 as fast.
 //!
+//! The round after that (same figures, before: 656 / 528 / 485) started from the clock: at about
+//! 2.9 GHz, 4.3 M bounce rays/s is ~680 cycles per ray for 656 instructions, so the traversal waits
+//! mostly on the chain from a node's loads to its mask of hit children, its nearest child and that
+//! child's reference, the next node's address (~40 cycles per node, ~55 with two hits or more), and
+//! on mispredicted branches. Shortening that chain, with the same bits: the nearest hit child from
+//! an unsigned-integer minimum of the entry distances' bits (one cycle per step instead of four;
+//! lanes not hit are all-ones bits rather than a blend of ∞), the slab minima and maxima as trees
+//! of two levels rather than chains of three, and the exit widening folded into the inverse
+//! direction (one multiplication less), 636 / 532 / 479, ×1.1–1.2 (4.6 → 5.2 M/s); the child
+//! references moved into the first cache line of the node, fetched with the bounds instead of after
+//! the mask, and the hit mask from a comparison of its own rather than the complement of another's,
+//! 634 / 532 / 478, ×1.08 (medians 4.86 → 5.27 M/s); the hit mask from an integer comparison of the
+//! distances' bits (exact here, see `wide::Node::intersect`; one cycle instead of four), and node
+//! references scaled so that a node's row is one addressing mode away (no shift and addition before
+//! its loads), 637 / 524 / 479, ×1.04 (5.37 → 5.56 M/s); 0 ≤ u, v, w in the leaf test as one
+//! comparison of min(min(u, v), w), 633 / 519 / 477; the collapse into wide nodes by dynamic
+//! programming (least total surface area of the wide nodes, `wide::Plan`) instead of greedily
+//! opening the largest child, which leaves fewer nearly empty nodes near the leaves (the greedy
+//! collapse gave the bunny 3886 nodes for 11805 leaves, four children per node on average; the plan
+//! gives 2406, 5.9 children per node; MetalRoughSpheres: 37098 nodes for 183165 leaves), 621 / 513
+//! / 477, its time within the noise (medians of 6 and 10 runs 5.03 → 4.74 and 5.53 → 5.53 M/s, best
+//! 5.62 → 5.72 and 5.84 → 5.75). Checksums of every answer (bunny and MetalRoughSpheres, primary
+//! and bounce, closest and occluded) are unchanged.
+//!
+//! All of it (old and new `examples/prof.rs` alternating, rays per CPU-second, best of 10 queries
+//! per run, loaded 2-core machine): bunny diffuse-bounce closest hits ×1.18–1.27 (medians of 8 and
+//! 10 runs: 4.33 → 5.12 and 3.79 → 4.80 M/s; best runs 4.71 → 5.88), occluded ×1.08 (5.33 → 5.76,
+//! best 5.85 → 6.49), primary closest hits ×1.16 (7.58 → 8.83, best 8.06 → 9.44). `benches/bvh.rs`
+//! (two alternations, 1 thread, per CPU-second) agreed: bunny bounce closest hits 3.50, 3.92 →
+//! 4.77, 5.52 M/s, occluded 4.48, 4.61 → 5.33, 5.68, primary 7.53, 8.05 → 9.25, 9.64;
+//! MetalRoughSpheres bounce closest hits 1.24, 1.28 → 1.67, 1.92. The plan costs `Scene::new` of
+//! MetalRoughSpheres ~0.06 s (thread CPU time of the collapse and the packing 0.13–0.16 → 0.19–0.23
+//! s, of all of `Accel::build` 0.74–0.90 → 0.83–0.98 s; wall-clock `Scene::new` said 2–5 s for both
+//! on the loaded machine); walking the binary nodes in memory order instead of a preorder saved
+//! nothing measurable.
+//!
+//! What did not pay: the six row addresses precomputed per ray (so that a node's loads need no
+//! address arithmetic at all), 15 more instructions per ray (registers spilled) and no faster (5.76
+//! vs 5.74 M/s); unchecked indexing of the child references and leaf packs, as fast (5.27 vs 5.27
+//! M/s); taking the multi-hit path for a single hit too (no branch on the number of hits), 621 →
+//! 681 instructions and ×0.91 (5.59 → 5.11 M/s); leaves of up to four primitives from obvhs merged
+//! into packs of up to eight by the plan (leaf cost 0.8–3 times a node's), 621 → 618 instructions,
+//! not worth the code.
+//!
 //! Exactness: the box test is conservative (exit distances are widened by 1 + 2γ₃, and every
 //! primitive's box is padded by a few ulps so that no primitive touches a box face), so the BVH
 //! never culls a primitive that the ray meets and the primitive tests alone decide

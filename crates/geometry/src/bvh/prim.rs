@@ -220,10 +220,13 @@ impl TriPack {
         // exactly on an adjacent wall at a corner, and must not slip through it. A non-finite
         // inv_det (det = ±0 or tiny) needs no test of its own: u and v are then ±∞ or NaN, both
         // pass 0 ≤ u, v only as +∞, and then w = 1 − ∞ − ∞ = −∞ fails.
+        //
+        // 0 ≤ u, v, w as 0 ≤ min(min(u, v), w), which is the same test: `min` returns its second
+        // operand when either is NaN, and w = 1 − u − v is NaN whenever u or v is, so a NaN
+        // among the three reaches the comparison; without NaN, the minimum of the three is ≥ 0
+        // exactly when all are (a ±0 minimum passes, as ±0 would).
         let hit = zero
-            .le(u)
-            .and(zero.le(v))
-            .and(zero.le(w))
+            .le(u.min(v).min(w))
             .and(zero.le(t))
             .and(t.lt(F8::splat(tmax)));
         (hit, t)

@@ -35,11 +35,24 @@ const MIXED_BIT: u32 = 1 << 30;
 pub(super) const MAX_LEAF_PRIMS: u32 = 8;
 /// Leaves are numbered below this bound in a leaf reference.
 const MAX_LEAVES: u32 = 1 << 30;
+/// A node's reference is its index times this, its byte offset in [`Wide::nodes`] divided by 8,
+/// so that the node test reads its rows at (row address) + 8 · (reference), one addressing mode
+/// of x86 (an index would take a shift and an addition before the first load of every node).
+const NODE_REF_SCALE: u32 = (size_of::<Node>() / 8) as u32;
+/// Nodes are numbered below this bound (their references stay below [`LEAF_BIT`]).
+const MAX_NODES: usize = (LEAF_BIT / NODE_REF_SCALE) as usize;
+
+/// The reference of node `index`.
+fn node_ref(index: usize) -> u32 {
+    assert!(index < MAX_NODES, "too many BVH nodes");
+    index as u32 * NODE_REF_SCALE
+}
 /// The reference in an unused child slot; its box is empty, so it is never followed.
 const EMPTY: u32 = u32::MAX;
 
-/// Factor (1 + 2γ₃, rounded up) applied to the exit distance of a box so that rounding in the slab
-/// test never culls a box the exact ray enters (pbrt-v4, "Robust ray–bounds intersection").
+/// Factor (1 + 8u with u = 2⁻²⁴, above 1 + 2γ₃) by which the exit distance of a box is widened so
+/// that rounding in the slab test never culls a box the exact ray enters (pbrt-v4, "Robust
+/// ray–bounds intersection"); applied to the inverse direction ([`Node::intersect`]).
 const ROBUST_EXIT: f32 = 1.0 + 4.0 * f32::EPSILON;
 
 /// Capacity of the on-stack traversal stack of ordinary trees (the bunny needs 50 entries, a
@@ -73,16 +86,18 @@ fn leaf_of(r: u32) -> Leaf {
     }
 }
 
-/// A node: the child boxes in SoA form, one row of eight lanes per bound, and the child
-/// references (256 bytes, four cache lines).
+/// A node: the child references and the child boxes in SoA form, one row of eight lanes per
+/// bound (224 bytes in four cache lines). The references come first, in the cache line of the
+/// first row, so that the node test (which reads every row) brings them in with the bounds
+/// instead of leaving their line to be fetched once the mask of hit children is known.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct Node {
+    /// Node index, leaf reference or [`EMPTY`], per child.
+    children: [u32; WIDTH],
     /// `bounds[2 * axis]`: the lower bounds of the children along `axis`;
     /// `bounds[2 * axis + 1]`: their upper bounds.
     bounds: [F8; 6],
-    /// Node index, leaf reference or [`EMPTY`], per child.
-    children: [u32; WIDTH],
 }
 
 /// A [`Node`] under construction.
@@ -117,22 +132,29 @@ impl NodeBuilder {
 
     fn build(&self) -> Node {
         Node {
-            bounds: self.bounds.map(F8::from_array),
             children: self.children,
+            bounds: self.bounds.map(F8::from_array),
         }
     }
 }
 
 impl Node {
-    /// The mask of the child boxes the ray enters within [0, tmax], and their entry distances
-    /// (∞ for the others).
+    /// The mask of the child boxes the ray enters within [0, tmax], and per child the distance at
+    /// which it enters (meaningful in the lanes of the mask: +0, positive or +∞; the other lanes
+    /// hold all-ones bits, a NaN that [`nearest_lane`] ranks last).
     ///
     /// Slab distances are (bound − origin) · (1 / direction), computed as (origin − bound) ·
     /// (−1 / direction), which is the same number (IEEE subtraction and multiplication are
     /// symmetric under negation) except that an exact 0 may come out as −0 instead of +0; the
     /// clamp of the entry distance to +0 and the `≤` comparison do not see the difference. In this
     /// form the bound is the second operand of the subtraction, which AVX reads straight from
-    /// memory.
+    /// memory. The exit distances use −(1 + 2γ₃) / direction, rounded ([`BoxRay::neg_inv_far`]):
+    /// with the roundings of the inverse, of that product, of the difference and of the last
+    /// product, the exit distance comes out at least (1 + 8u)(1 − u)⁴ > 1 times the exact one, as
+    /// conservative as widening the exit distance afterwards (pbrt-v4, "Robust ray–bounds
+    /// intersection") and one multiplication shorter. The minima and maxima are taken as two
+    /// levels of a tree rather than a chain of three, which shortens the critical path of the
+    /// traversal (a node test, then the next node's address) by a step.
     ///
     /// A zero direction component gives an infinite inverse, and NaN where the origin lies
     /// exactly on a bound; NaN then either culls the box or is ignored, and both are right
@@ -152,21 +174,22 @@ impl Node {
                     .cast::<F8>()
             }
         };
-        let slab = |row: usize, axis: usize| ray.origin[axis].sub(b(row)).mul(ray.neg_inv[axis]);
-        let (tx0, tx1) = (slab(0, 0), slab(1, 0));
-        let (ty0, ty1) = (slab(2, 1), slab(3, 1));
-        let (tz0, tz1) = (slab(4, 2), slab(5, 2));
-        let tnear = tx0.max(ty0).max(tz0).max(F8::splat(0.0));
-        let tfar = tx1
-            .min(ty1)
-            .min(tz1)
-            .mul(F8::splat(ROBUST_EXIT))
-            .min(F8::splat(tmax));
-        let hit = tnear.le(tfar);
-        (
-            hit.bitmask(),
-            F8::select(hit, tnear, F8::splat(f32::INFINITY)),
-        )
+        let near = |row: usize, axis: usize| ray.origin[axis].sub(b(row)).mul(ray.neg_inv[axis]);
+        let far = |row: usize, axis: usize| ray.origin[axis].sub(b(row)).mul(ray.neg_inv_far[axis]);
+        let (tx0, tx1) = (near(0, 0), far(1, 0));
+        let (ty0, ty1) = (near(2, 1), far(3, 1));
+        let (tz0, tz1) = (near(4, 2), far(5, 2));
+        let tnear = tx0.max(ty0).max(tz0.max(F8::splat(0.0)));
+        let tfar = tx1.min(ty1).min(tz1.min(F8::splat(tmax)));
+        // tnear is +0 or positive (or +∞), never NaN, so its bits order like a signed integer,
+        // and tnear > tfar as floats exactly when the bits compare so, except for tfar = −0
+        // (whose bits are the most negative integer): that box is culled, and rightly, since a
+        // box whose computed exit distance is ±0 holds nothing the ray meets at t ≥ 0 (every
+        // box extends at least the smallest normal float beyond its primitives, and the exit
+        // distance is computed conservatively). A NaN tfar (from a NaN tmax) gives no hit as
+        // floats but may as integers; no primitive test passes t < NaN.
+        let miss = tnear.gt_bits(tfar);
+        (!miss.bitmask() & 0xff, tnear.or(miss))
     }
 }
 
@@ -178,6 +201,8 @@ pub(super) struct BoxRay {
     origin: [F8; 3],
     /// −1 / direction.
     neg_inv: [F8; 3],
+    /// −1 / direction, times [`ROBUST_EXIT`] (each rounded), for the exit distances.
+    neg_inv_far: [F8; 3],
     /// Byte offsets in [`Node::bounds`] of the entry row along x and of the exit row along x,
     /// then the same for y and z (byte offsets spare the traversal a multiplication per row).
     rows: [usize; 6],
@@ -190,6 +215,7 @@ impl BoxRay {
     pub(super) fn new(origin: Vec3A, direction: Vec3A) -> Self {
         let inv = Vec3A::ONE / direction;
         let neg_inv = -inv;
+        let neg_inv_far = neg_inv * ROBUST_EXIT;
         let row = size_of::<F8>();
         // Bit `axis`: whether the ray runs towards −axis (one comparison of all three).
         let negative = inv.cmplt(Vec3A::ZERO).bitmask() as usize;
@@ -205,6 +231,11 @@ impl BoxRay {
                 F8::splat(neg_inv.x),
                 F8::splat(neg_inv.y),
                 F8::splat(neg_inv.z),
+            ],
+            neg_inv_far: [
+                F8::splat(neg_inv_far.x),
+                F8::splat(neg_inv_far.y),
+                F8::splat(neg_inv_far.z),
             ],
             rows: [near(0), far(0), near(1), far(1), near(2), far(2)],
         }
@@ -325,6 +356,100 @@ struct Pending {
     depth: usize,
 }
 
+/// Which `Bvh2` inner nodes become wide nodes: those of a minimal total surface area (the
+/// expected number of node tests, in the SAH's terms) over all collapses in which every wide node
+/// has at most [`WIDTH`] children, found by dynamic programming over the binary tree (as in Ylitie
+/// et al. 2017, "Efficient incoherent ray traversal on GPUs through compressed wide BVHs", with
+/// the leaves kept as obvhs made them: every leaf is one child slot somewhere, so their cost does
+/// not depend on the collapse).
+struct Plan {
+    /// Per `Bvh2` node and `i` in 1..=WIDTH (at `i − 1`): the least total half-area of the wide
+    /// nodes in its subtree (itself included if it is one) when the subtree takes at most `i`
+    /// child slots of the wide node above.
+    cost: Vec<[f64; WIDTH]>,
+    /// Per `Bvh2` inner node and `i` (at `i − 1`): 0 where the node takes one slot itself, else
+    /// the number of slots `k` given to its first child (`i − k` to the second); at `WIDTH − 1`,
+    /// the split of its `WIDTH` slots when it is opened (the wide node made from it).
+    split: Vec<[u8; WIDTH]>,
+    open_split: Vec<u8>,
+}
+
+impl Plan {
+    fn new(bvh2: &Bvh2) -> Self {
+        let n = bvh2.nodes.len();
+        let mut plan = Self {
+            cost: vec![[0.0; WIDTH]; n],
+            split: vec![[0; WIDTH]; n],
+            open_split: vec![0; n],
+        };
+        // Children before parents: the reverse of a preorder.
+        let mut preorder = Vec::with_capacity(n);
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            preorder.push(i);
+            let node = &bvh2.nodes[i];
+            if !node.is_leaf() {
+                let first = node.first_index as usize;
+                stack.extend([first, first + 1]);
+            }
+        }
+        for &i in preorder.iter().rev() {
+            let node = &bvh2.nodes[i];
+            if node.is_leaf() {
+                continue;
+            }
+            let (l, r) = (node.first_index as usize, node.first_index as usize + 1);
+            // opened[i − 1]: cost of the two children sharing i slots (i ≥ 2), and the split.
+            let mut opened = [(f64::INFINITY, 0u8); WIDTH];
+            for (slots, entry) in opened.iter_mut().enumerate().skip(1) {
+                let slots = slots + 1;
+                for k in 1..slots {
+                    let c = plan.cost[l][k - 1] + plan.cost[r][slots - k - 1];
+                    if c < entry.0 {
+                        *entry = (c, k as u8);
+                    }
+                }
+            }
+            let own = f64::from(node.aabb.half_area()) + opened[WIDTH - 1].0;
+            plan.open_split[i] = opened[WIDTH - 1].1;
+            plan.cost[i][0] = own;
+            for slots in 2..=WIDTH {
+                let (c, k) = opened[slots - 1];
+                (plan.cost[i][slots - 1], plan.split[i][slots - 1]) =
+                    if c <= own { (c, k) } else { (own, 0) };
+            }
+        }
+        plan
+    }
+
+    /// The `Bvh2` nodes that take the slots of the wide node made from inner node `index`, in
+    /// tree order, padded with `usize::MAX`.
+    fn children(&self, bvh2: &Bvh2, index: usize) -> [usize; WIDTH] {
+        let mut out = [usize::MAX; WIDTH];
+        let mut len = 0;
+        let first = bvh2.nodes[index].first_index as usize;
+        let k = self.open_split[index] as usize;
+        let mut work = vec![(first + 1, WIDTH - k), (first, k)];
+        while let Some((n, slots)) = work.pop() {
+            let node = &bvh2.nodes[n];
+            let k = if node.is_leaf() {
+                0
+            } else {
+                self.split[n][slots - 1] as usize
+            };
+            if k == 0 {
+                out[len] = n;
+                len += 1;
+            } else {
+                let first = node.first_index as usize;
+                work.push((first + 1, slots - k));
+                work.push((first, k));
+            }
+        }
+        out
+    }
+}
+
 /// What the collapse accumulates besides the work list.
 struct Collapse<'a, F> {
     nodes: Vec<Node>,
@@ -364,14 +489,16 @@ impl<F: Fn(u32, u32) -> bool> Collapse<'_, F> {
             }
         }
         self.nodes[at] = node.build();
-        (at as u32, depth + 1)
+        (node_ref(at), depth + 1)
     }
 }
 
 impl Wide {
-    /// Collapses a `Bvh2` (no spatial splits, at least one primitive): each wide node takes a
-    /// binary node's two children and keeps opening its inner child of largest surface area until
-    /// it has [`WIDTH`] children (the usual greedy collapse). Nodes are laid out depth
+    /// Collapses a `Bvh2` (no spatial splits, at least one primitive) into the wide nodes that
+    /// [`Plan`] chooses: each wide node takes up to [`WIDTH`] binary nodes under the binary node
+    /// it replaces. (The greedy collapse, which opened the inner child of largest surface area
+    /// while there was room, left many nodes near the leaves with two or three children: on the
+    /// bunny 3886 nodes for 11805 leaves against the plan's 2406.) Nodes are laid out depth
     /// first. `mixed(first, count)` says whether a leaf's primitives are not all triangles.
     pub(super) fn from_bvh2(bvh2: &Bvh2, mixed: &impl Fn(u32, u32) -> bool) -> Self {
         let mut c = Collapse {
@@ -389,6 +516,7 @@ impl Wide {
                 leaves: c.leaves,
             };
         }
+        let plan = Plan::new(bvh2);
         c.nodes.push(NodeBuilder::EMPTY.build());
         let mut work = vec![Pending {
             bvh2_node: 0,
@@ -399,7 +527,7 @@ impl Wide {
         while let Some(p) = work.pop() {
             max_depth = max_depth.max(p.depth);
             let mut node = NodeBuilder::EMPTY;
-            let open = Self::open(bvh2, p.bvh2_node);
+            let open = plan.children(bvh2, p.bvh2_node);
             for (slot, &child) in open.iter().enumerate().filter(|&(_, &n)| n != usize::MAX) {
                 let child_node = &bvh2.nodes[child];
                 let reference = if child_node.is_leaf() {
@@ -418,7 +546,7 @@ impl Wide {
                         index,
                         depth: p.depth + 1,
                     });
-                    index as u32
+                    node_ref(index)
                 };
                 node.set_child(slot, &child_node.aabb, reference);
             }
@@ -433,27 +561,19 @@ impl Wide {
         }
     }
 
-    /// Up to [`WIDTH`] `Bvh2` nodes under the inner node `index`: its children, with the inner node of
-    /// largest surface area replaced by its own children while there is room.
-    fn open(bvh2: &Bvh2, index: usize) -> [usize; WIDTH] {
-        let first = bvh2.nodes[index].first_index as usize;
-        let mut open = [usize::MAX; WIDTH];
-        (open[0], open[1]) = (first, first + 1);
-        for len in 2..WIDTH {
-            let largest = (0..len)
-                .filter(|&i| !bvh2.nodes[open[i]].is_leaf())
-                .max_by(|&a, &b| {
-                    let area = |i: usize| bvh2.nodes[open[i]].aabb.half_area();
-                    area(a).total_cmp(&area(b))
-                });
-            let Some(at) = largest else {
-                break;
-            };
-            let first = bvh2.nodes[open[at]].first_index as usize;
-            open[at] = first;
-            open[len] = first + 1;
+    /// The node of reference `r` (without [`LEAF_BIT`]).
+    #[inline(always)]
+    fn node(&self, r: u32) -> &Node {
+        // SAFETY: `from_bvh2` makes every child reference without `LEAF_BIT` (and a root without
+        // it) the reference of a node it pushed, `node_ref`: a byte offset of 8 · r.
+        unsafe {
+            &*self
+                .nodes
+                .as_ptr()
+                .cast::<u8>()
+                .add(r as usize * 8)
+                .cast::<Node>()
         }
-        open
     }
 
     /// Closest-hit traversal. `leaf` tests a leaf's primitives against the ray with the current
@@ -479,9 +599,7 @@ impl Wide {
                 if current & LEAF_BIT != 0 {
                     leaves.closest(leaf_of(current), tmax);
                 } else {
-                    // SAFETY: `from_bvh2` makes every child reference without `LEAF_BIT` (and a
-                    // root without it) the index of a node it pushed.
-                    let node = unsafe { self.nodes.get_unchecked(current as usize) };
+                    let node = self.node(current);
                     let (mask, tnear) = node.intersect(ray, *tmax);
                     if mask != 0 {
                         if mask & (mask - 1) == 0 {
@@ -490,7 +608,7 @@ impl Wide {
                         }
                         // Two or more: continue with the nearest, push the others (in lane order:
                         // sorting them cost more than it saved, measured).
-                        let nearest = nearest_lane(tnear, mask);
+                        let nearest = nearest_lane(tnear);
                         stack.push(mask & !(1 << nearest), node, tnear);
                         current = node.children[nearest & (WIDTH - 1)];
                         continue;
@@ -527,9 +645,7 @@ impl Wide {
                         return true;
                     }
                 } else {
-                    // SAFETY: `from_bvh2` makes every child reference without `LEAF_BIT` (and a
-                    // root without it) the index of a node it pushed.
-                    let node = unsafe { self.nodes.get_unchecked(current as usize) };
+                    let node = self.node(current);
                     let (mask, tnear) = node.intersect(ray, tmax);
                     if mask != 0 {
                         current = node.children[mask.trailing_zeros() as usize & (WIDTH - 1)];
@@ -549,9 +665,14 @@ impl Wide {
     }
 }
 
-/// The lane of smallest entry distance among the children in `mask` (the first such lane on
-/// ties) in the output of [`Node::intersect`].
+/// The lane of smallest entry distance among the children in the mask (the first such lane on
+/// ties) in the output of [`Node::intersect`], whose entry distances are +0, positive or +∞ and
+/// whose other lanes are all-ones bits: the order of the bits as unsigned integers is that of the
+/// distances, with the other lanes last.
 #[inline(always)]
-fn nearest_lane(entries: F8, mask: u32) -> usize {
-    (entries.eq(entries.min_all()).bitmask() & mask).trailing_zeros() as usize
+fn nearest_lane(entries: F8) -> usize {
+    entries
+        .eq_bits(entries.min_all_unsigned())
+        .bitmask()
+        .trailing_zeros() as usize
 }
