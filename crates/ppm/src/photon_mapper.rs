@@ -848,12 +848,16 @@ impl<'s> PhotonMapper<'s> {
     ///
     /// What paid: inlining `Scene::intersect` with `triangle_hit` (forced: a plain `#[inline]`
     /// on `triangle_hit` made LLVM outline `Scene::intersect` instead, +1.5 % instructions and
-    /// about 13 % more pass CPU time), `Bsdf::new` and the origin offset into this loop, so that
-    /// the `Hit` is not returned through memory; hoisting the per-triangle centroid and bounds
-    /// (`Scene::triangle_hit`, 232 → 203 instructions per hit) and the emitter frame and
-    /// corners (`sample_emission`, 272 → 257 per photon). All exact: the images are bit for
+    /// 1.86 against 1.64 pass CPU s in 3 alternated runs), `Bsdf::new` and the origin offset
+    /// into this loop, so that the `Hit` is not returned through memory; hoisting the
+    /// per-triangle centroid and bounds (`Scene::triangle_hit`, 232 → 203 instructions per
+    /// hit) and the emitter frame and corners (`sample_emission`, 272 → 257 per photon).
+    /// Not worth it: the seeding of the sampler. All exact: the images are bit for
     /// bit those of before. Not inlined itself (one call per path), so that it stays visible in
-    /// profiles.
+    /// profiles. In time (1 thread, 10⁶ photons, old and new binaries alternated, 2 × 3 runs on
+    /// the shared machine): trace paths/s median 0.99 → 1.02 M and 0.92 → 0.96 M, pass CPU s
+    /// median 1.55 → 1.54 and 1.70 → 1.62, i.e. about +4 %, far from the +22 % of issue #4: with
+    /// the meshed spheres, what remains is mostly the traversal and the hit itself.
     #[inline(never)]
     fn trace_photon(&self, index: u64, out: &mut TracedPhotons) {
         let mut sampler = Sampler::new(self.params.seed, self.pass, index);
