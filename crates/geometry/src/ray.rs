@@ -129,7 +129,7 @@ impl Hit {
 }
 
 /// pbrt-v4's `OffsetRayOrigin`: moves `p` along `n` (to the side of `w`) by `|n|·error`, then one ulp further away.
-#[inline]
+#[inline(always)]
 pub(crate) fn offset_ray_origin(p: Vec3, error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     // A floor on the offset: exact coordinates have zero error, but the origin must still leave the
     // plane strictly (triangle queries accept t = 0).

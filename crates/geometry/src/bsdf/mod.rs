@@ -99,12 +99,14 @@ impl MaterialKind {
 impl Bsdf {
     /// The BSDF of `material` at `hit`, in the frame of its shading normal. A dielectric's inside is
     /// behind the front face: a hit on the front face enters the medium.
+    #[inline]
     pub fn new(material: &Material, hit: &Hit) -> Self {
         Self::from_normal(material.kind, hit.shading_normal, hit.front_face)
     }
 
     /// The BSDF of `kind` around the unit `normal`; `front_face` tells whether `normal` points to the
     /// outside of a dielectric.
+    #[inline]
     pub fn from_normal(kind: MaterialKind, normal: Vec3, front_face: bool) -> Self {
         let eta = match kind {
             MaterialKind::Dielectric { ior } => {

@@ -91,6 +91,7 @@ pub struct EmissionSample {
 
 impl EmissionSample {
     /// The photon's ray, with its origin pushed off an area emitter so it cannot hit it at t ≈ 0.
+    #[inline]
     pub fn ray(&self) -> Ray {
         Ray::infinite(
             offset_ray_origin(self.origin, self.origin_error, self.normal, self.direction),
@@ -128,6 +129,14 @@ enum Emitter {
         normal: Vec3,
         area: f32,
         radiance: Rgb,
+        /// What [`LightSampler::sample_emission`] needs, computed once here by the same
+        /// expressions it evaluated per photon before (so photons are bit-identical):
+        /// `p0 + e1`, `p0 + e2`, the frame about `normal`, √area and π·L·A.
+        p1: Vec3,
+        p2: Vec3,
+        frame: Frame,
+        size: f32,
+        flux: Rgb,
     },
     Sphere {
         center: Vec3,
@@ -233,13 +242,19 @@ impl LightSampler {
                 triangle_emitter = vec![u32::MAX; desc.triangles.len()];
             }
             triangle_emitter[i] = emitters.len() as u32;
+            let normal = n / (2.0 * area);
             emitters.push(Emitter::Triangle {
                 p0,
                 e1,
                 e2,
-                normal: n / (2.0 * area),
+                normal,
                 area,
                 radiance,
+                p1: p0 + e1,
+                p2: p0 + e2,
+                frame: Frame::from_normal(normal),
+                size: area.sqrt(),
+                flux: radiance * (PI * area),
             });
         }
         let mut sphere_emitter = Vec::new();
@@ -343,6 +358,7 @@ impl LightSampler {
                 normal,
                 area,
                 radiance,
+                ..
             } => {
                 let b = uniform_triangle(u);
                 (p0 + b.x * e1 + b.y * e2, radiance, (normal, area))
@@ -478,27 +494,28 @@ impl LightSampler {
             }
             Emitter::Triangle {
                 p0,
-                e1,
-                e2,
                 normal,
-                area,
-                radiance,
+                p1,
+                p2,
+                frame,
+                size,
+                flux,
+                ..
             } => {
                 let b = uniform_triangle(u_pos);
                 let b0 = 1.0 - b.x - b.y;
-                let (p1, p2) = (p0 + e1, p0 + e2);
                 let origin = b0 * p0 + b.x * p1 + b.y * p2;
                 let error =
                     (7.0 * f32::EPSILON) * ((b0 * p0).abs() + (b.x * p1).abs() + (b.y * p2).abs());
                 let local = cosine_hemisphere(u_dir);
-                let direction = Frame::from_normal(normal).to_world(local);
+                let direction = frame.to_world(local);
                 EmissionSample {
                     origin,
                     direction,
-                    power: radiance * (PI * area),
+                    power: flux,
                     normal,
                     emitter: EmitterShape::Area {
-                        size: area.sqrt(),
+                        size,
                         cos_theta: local.z,
                     },
                     origin_error: error,

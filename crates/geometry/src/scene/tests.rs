@@ -141,8 +141,13 @@ fn intersect_matches_brute_force() {
                 assert!(grazing, "{ray:?}: got {got:?}, want {want:?}");
             }
         }
-        // occluded agrees with intersect.
+        // occluded agrees with intersect, and hit_distance is its t (bit for bit).
         assert_eq!(scene.occluded(&ray), got.is_some(), "{ray:?}");
+        assert_eq!(
+            scene.hit_distance(&ray).map(f32::to_bits),
+            got.map(|h| h.t.to_bits()),
+            "{ray:?}"
+        );
     }
     assert!(n_hits > 2000, "{n_hits}");
 }
