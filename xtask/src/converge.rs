@@ -400,11 +400,10 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
             // Two independent halves: their mean is the reference, their difference measures
             // its noise.
             let half = paths.div_ceil(2);
-            let halves = [0..half, half..paths.max(half + 1)].map(|range| {
+            let [a, b] = [0..half, half..paths.max(half + 1)].map(|range| {
                 ppm::pointwise_reference_paths(&scene, params, range, POINTWISE_EMISSION_PASSES)
                     .context("pointwise reference")
             });
-            let [a, b] = halves;
             let (a, b) = (a?, b?);
             println!(
                 "converge: pointwise reference, {paths} paths per hitpoint, {:.1} s",
@@ -525,25 +524,22 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
     plot_error_curves(&out, &entry.name, &rows)?;
     println!("converge: slopes of log relMSE versus log seconds (least squares over the budgets):");
     for &method in &flags.methods {
-        let points: Vec<(f64, f64)> = rows
-            .iter()
-            .filter(|r| r.method == method)
-            .map(|r| (r.seconds.ln(), r.all.rel_mse.ln()))
-            .collect();
-        if reference_variance.is_some() {
-            let net: Vec<(f64, f64)> = rows
-                .iter()
+        // log relMSE, less `floor`, against log seconds.
+        let points = |floor: f64| -> Vec<(f64, f64)> {
+            rows.iter()
                 .filter(|r| r.method == method)
-                .map(|r| (r.seconds.ln(), (r.all.rel_mse - r.noise[0]).ln()))
-                .collect();
+                .map(|r| (r.seconds.ln(), (r.all.rel_mse - floor).ln()))
+                .collect()
+        };
+        let raw = slope(&points(0.0));
+        if reference_variance.is_some() {
+            let net = slope(&points(noise[0]));
             println!(
-                "  {:<9} {:+.3} ({:+.3} net of the reference's noise)",
-                method.name(),
-                slope(&points),
-                slope(&net)
+                "  {:<9} {raw:+.3} ({net:+.3} net of the reference's noise)",
+                method.name()
             );
         } else {
-            println!("  {:<9} {:+.3}", method.name(), slope(&points));
+            println!("  {:<9} {raw:+.3}", method.name());
         }
     }
     println!("converge: wrote {}", out.display());

@@ -14,16 +14,11 @@ use std::{path::PathBuf, time::Instant};
 use geometry::{Ray, Scene};
 use rayon::prelude::*;
 
-/// CPU time consumed so far by the calling thread, in seconds (Linux: the first field of
-/// `/proc/thread-self/schedstat`, in nanoseconds); `None` elsewhere.
-fn thread_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    Some(stat.split_whitespace().next()?.parse::<f64>().ok()? * 1e-9)
-}
-
 /// CPU time consumed so far by the threads of `pool`, in seconds.
 fn pool_cpu_seconds(pool: &rayon::ThreadPool) -> Option<f64> {
-    pool.broadcast(|_| thread_cpu_seconds()).into_iter().sum()
+    pool.broadcast(|_| common::thread_cpu_seconds())
+        .into_iter()
+        .sum()
 }
 
 /// Best-of-3 throughput in Mrays/s of wall time and in Mrays per CPU-second (the per-core rate,

@@ -56,10 +56,7 @@ fn checksum(scene: &Scene, rays: &[Ray], occluded: bool) -> u64 {
 
 /// CPU time consumed so far by the calling thread, in seconds (Linux); 0 elsewhere.
 fn thread_cpu_seconds() -> f64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
-        .map_or(0.0, |ns| ns * 1e-9)
+    common::thread_cpu_seconds().unwrap_or(0.0)
 }
 
 fn main() {

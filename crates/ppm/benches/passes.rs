@@ -123,7 +123,6 @@ fn main() {
         .map_or(vec![1, 2], |list| {
             list.split(',').map(|t| t.parse().unwrap()).collect()
         });
-    let mut pass_seconds = Vec::new();
     let mut phases = Vec::new();
     let mut memory = Vec::new();
     for &method in &methods {
@@ -148,7 +147,6 @@ fn main() {
                 total,
                 cpu
             );
-            pass_seconds.push((method, threads, total, trace));
             let phase = |f: fn(&ppm::PassTimings) -> f64| {
                 median(stats.iter().map(|s| f(&s.timings)).collect())
             };
@@ -199,29 +197,24 @@ fn main() {
         "(freq): the frequency deposits and clear-disc probes inside gather and update; \
          hitp./phot.: hitpoints each stored photon reached"
     );
-    let find = |m: Method, t: usize| {
-        pass_seconds
-            .iter()
-            .find(|&&(method, threads, _, _)| method == m && threads == t)
-            .map(|&(_, _, total, trace)| (total, trace))
-    };
-    for method in [Method::Ppm, Method::FreqPpm] {
-        if let (Some((one, trace_one)), Some((two, trace_two))) = (find(method, 1), find(method, 2))
-        {
-            println!(
-                "{}: parallel speed-up 1 -> 2 threads: {:.2}x pass, {:.2}x trace",
-                method.name(),
-                one / two,
-                trace_one / trace_two
-            );
-        }
-    }
+    // Median seconds per phase ([camera, index, trace, gather, update, frequency, total]) and
+    // hitpoints per stored photon of one method and thread count.
     let find_phases = |m: Method, t: usize| {
         phases
             .iter()
             .find(|&&(method, threads, _, _)| method == m && threads == t)
             .map(|&(_, _, p, per_photon)| (p, per_photon))
     };
+    for method in [Method::Ppm, Method::FreqPpm] {
+        if let (Some((one, _)), Some((two, _))) = (find_phases(method, 1), find_phases(method, 2)) {
+            println!(
+                "{}: parallel speed-up 1 -> 2 threads: {:.2}x pass, {:.2}x trace",
+                method.name(),
+                one[6] / two[6],
+                one[2] / two[2]
+            );
+        }
+    }
     for threads in [1, 2] {
         if let (Some((ppm, ppm_reach)), Some((freq, freq_reach))) = (
             find_phases(Method::Ppm, threads),

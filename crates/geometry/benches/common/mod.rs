@@ -1,4 +1,5 @@
-//! Shared by the BVH benchmark and the `rayset` example: scene loading and ray sets.
+//! Shared by the BVH benchmark and the `rayset` and `prof` examples: scene loading, ray sets and
+//! thread CPU time.
 #![allow(
     dead_code,
     clippy::unwrap_used,
@@ -88,4 +89,11 @@ pub fn diffuse_bounce_rays(scene: &Scene, primary: &[Ray]) -> Vec<Ray> {
         rays.push(hit.spawn_ray(frame.to_world(local)));
     }
     rays
+}
+
+/// CPU time consumed so far by the calling thread, in seconds (Linux: the first field of
+/// `/proc/thread-self/schedstat`, in nanoseconds); `None` elsewhere.
+pub fn thread_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    Some(stat.split_whitespace().next()?.parse::<f64>().ok()? * 1e-9)
 }
