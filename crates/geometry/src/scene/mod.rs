@@ -339,14 +339,12 @@ impl Scene {
         let geometric_normal = sign * extra.front_normal;
         let shading_normal = match tri.normals {
             Some([n0, n1, n2]) => {
-                let n = (b0 * n0 + b1 * n1 + b2 * n2).normalize_or_zero();
-                if n == Vec3::ZERO {
-                    geometric_normal
-                } else if n.dot(geometric_normal) < 0.0 {
-                    -n
-                } else {
-                    n
-                }
+                // The geometric normal where the interpolated one has no direction. Not
+                // `normalize_or_zero` and a comparison with zero, which is the same but compiles
+                // to a branch on n.x = 0 first: data dependent (axis-aligned walls against
+                // curved meshes), about two mispredictions per photon path in the Cornell box.
+                let n = (b0 * n0 + b1 * n1 + b2 * n2).normalize_or(geometric_normal);
+                if n.dot(geometric_normal) < 0.0 { -n } else { n }
             }
             None => geometric_normal,
         };
