@@ -40,14 +40,6 @@ impl TriGeom {
         let ng = self.e1.cross(self.e2);
         ng.is_finite() && ng != Vec3A::ZERO
     }
-
-    /// Barycentrics (weight of v1, weight of v2) of the ray's hit with the triangle's plane.
-    pub(super) fn barycentrics(&self, origin: Vec3A, direction: Vec3A) -> (f32, f32) {
-        let c = self.v0 - origin;
-        let r = direction.cross(c);
-        let inv_det = 1.0 / self.e1.cross(self.e2).dot(direction);
-        (r.dot(self.e2) * inv_det, r.dot(self.e1) * inv_det)
-    }
 }
 
 /// A sphere in internal (scaled) coordinates.
@@ -174,27 +166,16 @@ impl TriPackBuilder {
 }
 
 impl TriPack {
-    /// The triangle in `lane`.
-    pub(super) fn get(&self, lane: usize) -> TriGeom {
-        let v = |rows: &[F8; 3]| {
-            Vec3A::new(
-                rows[0].to_array()[lane],
-                rows[1].to_array()[lane],
-                rows[2].to_array()[lane],
-            )
-        };
-        TriGeom {
-            v0: v(&self.v0),
-            e1: v(&self.e1),
-            e2: v(&self.e2),
-        }
-    }
-
     /// Möller–Trumbore in the form of obvhs' `RtTriangle::intersect` (with the stored
     /// ng = e1 × e2), with inclusive edges, on eight triangles at once: the lanes hit with t in
     /// [0, tmax) (a comparison result), and t per lane (meaningful only in those lanes).
+    ///
+    /// Also returns the barycentrics u (of v1) and v (of v2) per lane. A closest-hit query reports
+    /// those of the hit lane rather than recomputing them for the one triangle (which cost about
+    /// 50 instructions per ray, and gave numbers that could differ by rounding from the ones the
+    /// inside test accepted: glam's `cross` uses FMA where the CPU has it).
     #[inline(always)]
-    pub(super) fn intersect(&self, ray: &Ray8, tmax: f32) -> (F8, F8) {
+    pub(super) fn intersect(&self, ray: &Ray8, tmax: f32) -> (F8, F8, F8, F8) {
         let [ox, oy, oz] = ray.origin;
         let [dx, dy, dz] = ray.direction;
         let [ax, ay, az] = self.e1;
@@ -229,7 +210,7 @@ impl TriPack {
             .le(u.min(v).min(w))
             .and(zero.le(t))
             .and(t.lt(F8::splat(tmax)));
-        (hit, t)
+        (hit, t, u, v)
     }
 }
 

@@ -15,10 +15,11 @@ fn linear_scan(accel: &Accel, ray: &Ray) -> (Option<(f32, u32)>, bool) {
         return (None, false);
     };
     let (mut t, mut closest, mut any) = (tmax, None, false);
+    let mut uv = (super::F8::splat(0.0), super::F8::splat(0.0));
     for index in 0..accel.packs.len() {
         let leaf = Leaf { index, mixed: true };
         any |= accel.leaf_any(&rays, leaf, tmax);
-        accel.leaf_closest(&rays, leaf, &mut t, &mut closest);
+        accel.leaf_closest(&rays, leaf, &mut t, &mut closest, &mut uv);
     }
     (closest.map(|slot| (t / accel.scale, accel.ids[slot])), any)
 }
@@ -30,13 +31,21 @@ fn raw_t(hit: RawHit) -> f32 {
 }
 
 /// Checks every ray: same closest t as the linear scan (ties between primitives may pick either),
-/// same occlusion. Returns the number of hits.
+/// same occlusion, and barycentrics of triangle hits that pass the inside test (b1, b2 and
+/// 1 − b1 − b2 at least 0, exactly: they are the numbers the leaf test accepted). Returns the
+/// number of hits.
 fn check(accel: &Accel, rays: &[Ray]) -> usize {
     let mut hits = 0;
     for ray in rays {
         let (want, want_any) = linear_scan(accel, ray);
         let got = accel.intersect(ray);
         assert_eq!(got.map(raw_t), want.map(|w| w.0), "{ray:?}: {got:?}");
+        if let Some(RawHit::Triangle { b1, b2, .. }) = got {
+            assert!(
+                b1 >= 0.0 && b2 >= 0.0 && 1.0 - b1 - b2 >= 0.0,
+                "{ray:?}: {got:?}"
+            );
+        }
         assert_eq!(accel.occluded(ray), want_any, "{ray:?}");
         hits += usize::from(got.is_some());
     }
