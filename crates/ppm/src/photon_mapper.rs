@@ -911,7 +911,10 @@ impl<'s> PhotonMapper<'s> {
                     ));
                 }
             }
-            // Scatter.
+            // Scatter, unless no later hit could count.
+            if depth + 1 == self.params.max_depth {
+                break;
+            }
             let u_lobe = sampler.next_f32();
             let u = sampler.next_2d();
             let u_roulette = sampler.next_f32();
