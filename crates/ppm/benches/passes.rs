@@ -4,7 +4,10 @@
 //! Prints, for 1 and 2 threads: photon paths per second (tracing only, and whole passes),
 //! gather queries per second, hitpoints per pixel, memory per hitpoint, and the extra cost of
 //! frequency photons at the default fraction. Times are wall-clock medians over a few passes,
-//! measured side by side in one run (absolute numbers on a shared machine are noisy).
+//! measured side by side in one run: the configurations (method × thread count) take turns, one
+//! pass each, so that their ratios hold even though the shared machine's speed drifts by ±20 %
+//! over minutes. Absolute numbers are as noisy as the machine; "(best pass)" is the tracing rate
+//! of the fastest timed pass.
 //!
 //! "trace paths/s" is the photon paths started in a pass (all of them, including those that
 //! end at the first hit) over the wall time of the tracing phase alone (`PassTimings::trace`:
@@ -64,34 +67,65 @@ fn process_cpu_seconds() -> f64 {
         .unwrap_or(0.0)
 }
 
-/// Per-pass statistics, the process CPU seconds of each pass and the memory at the end.
-fn run(
-    scene: &geometry::Scene,
+/// One configuration under test: a renderer of one method in a pool of some threads, and what
+/// its timed passes gave.
+struct Run<'s> {
     method: Method,
     threads: usize,
+    pool: rayon::ThreadPool,
+    renderer: Renderer<'s>,
+    stats: Vec<PassStats>,
+    cpu: Vec<f64>,
+}
+
+/// Renders `passes` timed passes of every (method, thread count), interleaved: one pass of each
+/// configuration in turn, so that every configuration sees the same machine. The speed of the
+/// shared machine drifts by ±20 % over minutes; measured one after the other, the ratios of the
+/// summary (frequency overhead, parallel speed-up) drifted with it.
+fn run<'s>(
+    scene: &'s geometry::Scene,
+    configs: &[(Method, usize)],
     photons_per_pass: u32,
     passes: usize,
-) -> (Vec<PassStats>, Vec<f64>, ppm::MemoryUse) {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap();
-    pool.install(|| {
-        let mut params = RenderParams::preview();
-        params.method = method;
-        params.photons_per_pass = photons_per_pass;
-        let mut renderer = Renderer::new(scene, params).unwrap();
-        // The first pass traces the hitpoints and builds the grid: not part of the steady state.
-        renderer.iterate();
-        let (stats, cpu) = (0..passes)
-            .map(|_| {
-                let cpu = process_cpu_seconds();
-                let stats = renderer.iterate();
-                (stats, process_cpu_seconds() - cpu)
-            })
-            .unzip();
-        (stats, cpu, renderer.memory().unwrap())
-    })
+) -> Vec<Run<'s>> {
+    let mut runs: Vec<Run<'s>> = configs
+        .iter()
+        .map(|&(method, threads)| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut params = RenderParams::preview();
+            params.method = method;
+            params.photons_per_pass = photons_per_pass;
+            let mut renderer = Renderer::new(scene, params).unwrap();
+            // The first pass traces the hitpoints and builds the grid: not the steady state.
+            pool.install(|| renderer.iterate());
+            Run {
+                method,
+                threads,
+                pool,
+                renderer,
+                stats: Vec::new(),
+                cpu: Vec::new(),
+            }
+        })
+        .collect();
+    for _ in 0..passes {
+        for run in &mut runs {
+            let Run {
+                pool,
+                renderer,
+                stats,
+                cpu,
+                ..
+            } = run;
+            let before = process_cpu_seconds();
+            stats.push(pool.install(|| renderer.iterate()));
+            cpu.push(process_cpu_seconds() - before);
+        }
+    }
+    runs
 }
 
 fn main() {
@@ -109,8 +143,15 @@ fn main() {
         "CornellBox-Sphere, 512x512, {photons_per_pass} photons per pass, median of {passes} passes"
     );
     println!(
-        "{:<10} {:>7} {:>16} {:>16} {:>16} {:>12} {:>12}",
-        "method", "threads", "trace paths/s", "pass paths/s", "gather q/s", "pass s", "pass CPU s"
+        "{:<10} {:>7} {:>16} {:>16} {:>16} {:>16} {:>12} {:>12}",
+        "method",
+        "threads",
+        "trace paths/s",
+        "(best pass)",
+        "pass paths/s",
+        "gather q/s",
+        "pass s",
+        "pass CPU s"
     );
     let methods: Vec<Method> = [Method::Ppm, Method::FreqPpm, Method::Sppm]
         .into_iter()
@@ -123,49 +164,64 @@ fn main() {
         .map_or(vec![1, 2], |list| {
             list.split(',').map(|t| t.parse().unwrap()).collect()
         });
+    let configs: Vec<(Method, usize)> = methods
+        .iter()
+        .flat_map(|&m| thread_counts.iter().map(move |&t| (m, t)))
+        .collect();
+    let runs = run(&scene, &configs, photons_per_pass, passes);
     let mut phases = Vec::new();
     let mut memory = Vec::new();
-    for &method in &methods {
-        for &threads in &thread_counts {
-            let (stats, cpu, mem) = run(&scene, method, threads, photons_per_pass, passes);
-            if !memory.iter().any(|&(m, _)| m == method) {
-                memory.push((method, mem));
-            }
-            let cpu = median(cpu);
-            let trace = median(stats.iter().map(|s| s.timings.trace).collect());
-            let gather = median(stats.iter().map(|s| s.timings.gather).collect());
-            let total = median(stats.iter().map(|s| s.timings.total()).collect());
-            let stored = stats.iter().map(|s| s.photons_stored).sum::<u64>() as f64 / passes as f64;
-            let photons = f64::from(photons_per_pass);
-            println!(
-                "{:<10} {:>7} {:>16.0} {:>16.0} {:>16.0} {:>12.3} {:>12.2}",
-                method.name(),
-                threads,
-                photons / trace,
-                photons / total,
-                stored / gather,
-                total,
-                cpu
-            );
-            let phase = |f: fn(&ppm::PassTimings) -> f64| {
-                median(stats.iter().map(|s| f(&s.timings)).collect())
-            };
-            phases.push((
-                method,
-                threads,
-                [
-                    phase(|t| t.camera),
-                    phase(|t| t.index),
-                    phase(|t| t.trace),
-                    phase(|t| t.gather),
-                    phase(|t| t.update),
-                    phase(|t| t.frequency),
-                    phase(|t| t.total()),
-                ],
-                stats.iter().map(|s| s.photons_deposited).sum::<u64>() as f64
-                    / stats.iter().map(|s| s.photons_stored).sum::<u64>().max(1) as f64,
-            ));
+    for Run {
+        method,
+        threads,
+        renderer,
+        stats,
+        cpu,
+        ..
+    } in &runs
+    {
+        let (method, threads) = (*method, *threads);
+        if !memory.iter().any(|&(m, _)| m == method) {
+            memory.push((method, renderer.memory().unwrap()));
         }
+        let cpu = median(cpu.clone());
+        let trace = median(stats.iter().map(|s| s.timings.trace).collect());
+        let best_trace = stats
+            .iter()
+            .map(|s| s.timings.trace)
+            .fold(f64::INFINITY, f64::min);
+        let gather = median(stats.iter().map(|s| s.timings.gather).collect());
+        let total = median(stats.iter().map(|s| s.timings.total()).collect());
+        let stored = stats.iter().map(|s| s.photons_stored).sum::<u64>() as f64 / passes as f64;
+        let photons = f64::from(photons_per_pass);
+        println!(
+            "{:<10} {:>7} {:>16.0} {:>16.0} {:>16.0} {:>16.0} {:>12.3} {:>12.2}",
+            method.name(),
+            threads,
+            photons / trace,
+            photons / best_trace,
+            photons / total,
+            stored / gather,
+            total,
+            cpu
+        );
+        let phase =
+            |f: fn(&ppm::PassTimings) -> f64| median(stats.iter().map(|s| f(&s.timings)).collect());
+        phases.push((
+            method,
+            threads,
+            [
+                phase(|t| t.camera),
+                phase(|t| t.index),
+                phase(|t| t.trace),
+                phase(|t| t.gather),
+                phase(|t| t.update),
+                phase(|t| t.frequency),
+                phase(|t| t.total()),
+            ],
+            stats.iter().map(|s| s.photons_deposited).sum::<u64>() as f64
+                / stats.iter().map(|s| s.photons_stored).sum::<u64>().max(1) as f64,
+        ));
     }
     println!(
         "{:<10} {:>7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>11}   (median seconds per phase)",
