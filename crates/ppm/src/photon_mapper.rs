@@ -943,16 +943,37 @@ impl<'s> PhotonMapper<'s> {
             let u_lobe = sampler.next_f32();
             let u = sampler.next_2d();
             let u_roulette = sampler.next_f32();
+            // Russian roulette (pbrt-v4 SPPM): keep the photon's power roughly constant, killing
+            // it with probability q = 1 − lum(scattered power) / lum(power) and dividing the
+            // survivor by 1 − q. On a Lambertian surface the scattered power is power × albedo
+            // whatever the direction (up to the shading-normal correction, which the roulette
+            // leaves out there), so the roulette runs before the direction is drawn and a killed
+            // photon costs no BSDF sample; elsewhere it needs the sampled weight. Either way q
+            // is fixed before `u_roulette` is compared with it: unbiased.
+            let roulette = depth + 1 >= ROULETTE_DEPTH;
+            let kill_probability = |scattered: Rgb| {
+                let ratio = luminance(scattered) / luminance(power).max(f32::MIN_POSITIVE);
+                (1.0 - ratio).max(0.0)
+            };
+            let mut survive = 1.0f32;
+            let lambertian = match material.kind {
+                MaterialKind::Diffuse { albedo } => Some(albedo),
+                _ => None,
+            };
+            if let (true, Some(albedo)) = (roulette, lambertian) {
+                let q = kill_probability(power * albedo);
+                if u_roulette < q {
+                    break;
+                }
+                survive = 1.0 - q;
+            }
             let Some(sample) = bsdf.sample(incoming, u_lobe, u, TransportMode::Importance) else {
                 break;
             };
             let new_power =
                 power * sample.weight * shading_normal_correction(&hit, incoming, sample.incoming);
-            // Russian roulette (pbrt-v4 SPPM): keep the photon's power roughly constant.
-            let mut survive = 1.0f32;
-            if depth + 1 >= ROULETTE_DEPTH {
-                let ratio = luminance(new_power) / luminance(power).max(f32::MIN_POSITIVE);
-                let q = (1.0 - ratio).max(0.0);
+            if roulette && lambertian.is_none() {
+                let q = kill_probability(new_power);
                 if u_roulette < q {
                     break;
                 }
