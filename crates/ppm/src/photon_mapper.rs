@@ -869,15 +869,18 @@ impl<'s> PhotonMapper<'s> {
     ///
     /// Second round (same measure, plus callgrind's branch simulator for mispredictions, which
     /// it overstates for loop counters but ranks data-dependent branches well): 4229
-    /// instructions and 21.6 simulated mispredictions per path before, 3824 and 12.9 after.
+    /// instructions and 21.6 simulated mispredictions per path before, 3721 and 13.8 after.
     /// What paid: branch-free rounding of offset ray origins (the sign of the offset is a coin
     /// toss; 1.1 mispredictions per spawned ray); the shading normal's fallback through
     /// `normalize_or` (the comparison of the normal with zero branched on n.x = 0, walls against
     /// spheres, 2 per path); the leaf test's own barycentrics (no per-hit recomputation, 130 per
     /// path); no scatter after the last countable bounce; the concentric disc without libm's
     /// `sincosf` (polynomials on |q| ≤ π/4, 100 per path and 1.8 mispredictions); `triangle_hit`
-    /// on `Vec3A` (60 per path). In time, old and new binaries alternated 16 times on the
-    /// shared machine, 1 thread: median paired ratio ×1.135 (mean ×1.19) of trace paths/s. What
+    /// on `Vec3A` (60 per path); the roulette before the direction on Lambertian surfaces (105
+    /// per path). In time, before the roulette change, old and new binaries alternated 16 times
+    /// on the shared machine, 1 thread: median paired ratio ×1.135 (mean ×1.19) of trace
+    /// paths/s; the roulette change alone ×1.01 (mean ×1.02, 14 alternations). See
+    /// `docs/performance.md`. What
     /// did not pay: pushing all hit children in the traversal (no branch on a single hit:
     /// 3.5 fewer simulated mispredictions, 1.3 % more instructions, slower in 8 of 8 alternated
     /// runs: the real predictor handles that branch); inlining the Lambertian case of
