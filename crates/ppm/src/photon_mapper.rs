@@ -869,7 +869,7 @@ impl<'s> PhotonMapper<'s> {
     ///
     /// Second round (same measure, plus callgrind's branch simulator for mispredictions, which
     /// it overstates for loop counters but ranks data-dependent branches well): 4229
-    /// instructions and 21.6 simulated mispredictions per path before, 3721 and 13.8 after.
+    /// instructions and 21.6 simulated mispredictions per path before, 3578 and 14.0 after.
     /// What paid: branch-free rounding of offset ray origins (the sign of the offset is a coin
     /// toss; 1.1 mispredictions per spawned ray); the shading normal's fallback through
     /// `normalize_or` (the comparison of the normal with zero branched on n.x = 0, walls against
@@ -877,7 +877,8 @@ impl<'s> PhotonMapper<'s> {
     /// path); no scatter after the last countable bounce; the concentric disc without libm's
     /// `sincosf` (polynomials on |q| ≤ π/4, 100 per path and 1.8 mispredictions); `triangle_hit`
     /// on `Vec3A` (60 per path); the roulette before the direction on Lambertian surfaces (105
-    /// per path). In time, before the roulette change, old and new binaries alternated 16 times
+    /// per path); the traversal compiled into this loop (`Scene::intersect_inlined`, 143 per
+    /// path, ×1.049 in 20 alternations). In time, before the last two, old and new binaries alternated 16 times
     /// on the shared machine, 1 thread: median paired ratio ×1.135 (mean ×1.19) of trace
     /// paths/s; the roulette change alone ×1.01 (mean ×1.02, 14 alternations). See
     /// `docs/performance.md`. What
@@ -906,7 +907,7 @@ impl<'s> PhotonMapper<'s> {
         // `depth`: the photon's bounces before this hit. A hitpoint adds one more, so hits at
         // depth max_depth − 1 are the last that can count.
         for depth in 0..self.params.max_depth {
-            let Some(hit) = self.scene.intersect(&ray) else {
+            let Some(hit) = self.scene.intersect_inlined(&ray) else {
                 break;
             };
             let Some(material) = self.scene.material(hit.material) else {
