@@ -878,15 +878,14 @@ impl<'s> PhotonMapper<'s> {
     /// `sincosf` (polynomials on |q| ≤ π/4, 100 per path and 1.8 mispredictions); `triangle_hit`
     /// on `Vec3A` (60 per path); the roulette before the direction on Lambertian surfaces (105
     /// per path); the traversal compiled into this loop (`Scene::intersect_inlined`, 143 per
-    /// path, ×1.049 in 20 alternations). In time, before the last two, old and new binaries alternated 16 times
-    /// on the shared machine, 1 thread: median paired ratio ×1.135 (mean ×1.19) of trace
-    /// paths/s; the roulette change alone ×1.01 (mean ×1.02, 14 alternations). See
-    /// `docs/performance.md`. What
-    /// did not pay: pushing all hit children in the traversal (no branch on a single hit:
-    /// 3.5 fewer simulated mispredictions, 1.3 % more instructions, slower in 8 of 8 alternated
-    /// runs: the real predictor handles that branch); inlining the Lambertian case of
-    /// `Bsdf::sample` (12 instructions per path); fat LTO with one codegen unit (1.3 % fewer
-    /// instructions, no measurable time, a slower build).
+    /// path). In time (old and new binaries alternated on the shared machine, 1 thread, median
+    /// paired ratio of trace paths/s): ×1.135 for all but the last two (16 alternations), ×1.01
+    /// for the roulette (14), ×1.049 for the inlined traversal (20). What did not pay: pushing
+    /// all hit children in the traversal (no branch on a single hit: 3.5 fewer simulated
+    /// mispredictions, 1.3 % more instructions, slower in 8 of 8 alternated runs: the real
+    /// predictor handles that branch); inlining the Lambertian case of `Bsdf::sample` (12
+    /// instructions per path); fat LTO with one codegen unit (1.3 % fewer instructions, no
+    /// measurable time, a slower build). See `docs/performance.md`.
     #[inline(never)]
     fn trace_photon(&self, index: u64, out: &mut TracedPhotons) {
         let mut sampler = Sampler::new(self.params.seed, self.pass, index);
