@@ -3,7 +3,7 @@
 //!
 //! Prints, for 1 and 2 threads: photon paths per second (tracing only, and whole passes),
 //! gather queries per second, hitpoints per pixel, memory per hitpoint, and the extra cost of
-//! frequency photons at the default fraction. Times are wall-clock medians over a few passes,
+//! frequency photons at the default fraction. Times are wall-clock medians over 9 passes,
 //! measured side by side in one run: the configurations (method × thread count) take turns, one
 //! pass each, so that their ratios hold even though the shared machine's speed drifts by ±20 %
 //! over minutes. Absolute numbers are as noisy as the machine; "(best pass)" is the tracing rate
@@ -21,6 +21,11 @@
 //! under callgrind). A second table gives the median seconds of each phase of a pass. "pass
 //! CPU s" is the process CPU time of a pass (all threads): with 1 thread it is the work
 //! itself, whatever else runs on the machine.
+//!
+//! The summary lines are medians over pass rounds of ratios or differences within a round (the
+//! passes compared ran seconds apart). Even so, the tracing phase's extra time of freq over
+//! ppm varies by ±0.03 s from run to run: with 5 passes the bookkeeping share read 7–16 %,
+//! with 9 it reads 10–12 %.
 //!
 //! The frequency line splits freq's extra pass time into its bookkeeping (the tracing phase's
 //! extra time over ppm's: spectra and occlusion probes along the frequency photons' paths; plus
@@ -138,7 +143,7 @@ fn main() {
     };
     let scene = geometry::Scene::new(description).unwrap();
     let photons_per_pass: u32 = env_or("FPPM_BENCH_PHOTONS", 1_000_000);
-    let passes: usize = env_or("FPPM_BENCH_PASSES", 5);
+    let passes: usize = env_or("FPPM_BENCH_PASSES", 9);
     println!(
         "CornellBox-Sphere, 512x512, {photons_per_pass} photons per pass, median of {passes} passes"
     );
@@ -253,42 +258,51 @@ fn main() {
         "(freq): the frequency deposits and clear-disc probes inside gather and update; \
          hitp./phot.: hitpoints each stored photon reached"
     );
-    // Median seconds per phase ([camera, index, trace, gather, update, frequency, total]) and
-    // hitpoints per stored photon of one method and thread count.
-    let find_phases = |m: Method, t: usize| {
-        phases
+    // The timed passes of one configuration, and the hitpoints per stored photon.
+    let find = |m: Method, t: usize| {
+        let run = runs.iter().find(|r| r.method == m && r.threads == t)?;
+        let per_photon = phases
             .iter()
             .find(|&&(method, threads, _, _)| method == m && threads == t)
-            .map(|&(_, _, p, per_photon)| (p, per_photon))
+            .map(|&(_, _, _, per_photon)| per_photon)?;
+        Some((&run.stats, per_photon))
+    };
+    // Ratios are medians over pass rounds of ratios within a round (the passes compared ran
+    // seconds apart, so the machine's drift mostly cancels).
+    let paired = |a: &[PassStats], b: &[PassStats], f: &dyn Fn(&PassStats, &PassStats) -> f64| {
+        median(a.iter().zip(b).map(|(a, b)| f(a, b)).collect())
     };
     for method in [Method::Ppm, Method::FreqPpm] {
-        if let (Some((one, _)), Some((two, _))) = (find_phases(method, 1), find_phases(method, 2)) {
+        if let (Some((one, _)), Some((two, _))) = (find(method, 1), find(method, 2)) {
             println!(
-                "{}: parallel speed-up 1 -> 2 threads: {:.2}x pass, {:.2}x trace",
+                "{}: parallel speed-up 1 -> 2 threads: {:.2}x pass, {:.2}x trace (medians of \
+                 paired passes)",
                 method.name(),
-                one[6] / two[6],
-                one[2] / two[2]
+                paired(one, two, &|a, b| a.timings.total() / b.timings.total()),
+                paired(one, two, &|a, b| a.timings.trace / b.timings.trace)
             );
         }
     }
     for threads in [1, 2] {
-        if let (Some((ppm, ppm_reach)), Some((freq, freq_reach))) = (
-            find_phases(Method::Ppm, threads),
-            find_phases(Method::FreqPpm, threads),
-        ) {
+        if let (Some((ppm, ppm_reach)), Some((freq, freq_reach))) =
+            (find(Method::Ppm, threads), find(Method::FreqPpm, threads))
+        {
             // Bookkeeping: what frequency photons add to tracing (spectra, occlusion probes),
             // plus their deposits and the clear-disc probes. The rest of the difference is the
             // flux gather over kernels the frequency floor holds larger than PPM's.
-            let bookkeeping = (freq[2] - ppm[2]).max(0.0) + freq[5];
+            let extra_trace = |p: &PassStats, f: &PassStats| f.timings.trace - p.timings.trace;
+            let bookkeeping =
+                |p: &PassStats, f: &PassStats| extra_trace(p, f).max(0.0) + f.timings.frequency;
             println!(
                 "frequency photons (default fraction {}, {threads} threads): {:+.1} % pass time vs \
                  classical PPM; bookkeeping (trace {:+.3} s, deposits and probes {:.3} s) {:.1} % of \
-                 the freq pass; held kernels reach {:.2} hitpoints per photon against {:.2}",
+                 the freq pass (medians of paired passes); held kernels reach {:.2} hitpoints per \
+                 photon against {:.2}",
                 RenderParams::preview().freq_fraction,
-                (freq[6] / ppm[6] - 1.0) * 100.0,
-                freq[2] - ppm[2],
-                freq[5],
-                bookkeeping / freq[6] * 100.0,
+                (paired(ppm, freq, &|p, f| f.timings.total() / p.timings.total()) - 1.0) * 100.0,
+                paired(ppm, freq, &extra_trace),
+                median(freq.iter().map(|f| f.timings.frequency).collect()),
+                paired(ppm, freq, &|p, f| bookkeeping(p, f) / f.timings.total()) * 100.0,
                 freq_reach,
                 ppm_reach
             );
