@@ -2,9 +2,9 @@
 //!
 //! Keys are 30-bit Morton codes (10 bits per axis over the points' bounding box, so cells of a
 //! thousandth of the box: far finer than any gather radius, which is all the order is for),
-//! packed with the point's index as `key << 32 | index` and sorted by a stable least-significant
-//! digit radix sort on the key. Ties (points in one cell) therefore keep their index order, and
-//! the order is a pure function of the points.
+//! packed with the point's place in the input as `key << 32 | item` and sorted by a stable
+//! least-significant-digit radix sort on the key. Ties (points in one cell) therefore keep their
+//! input order, and the order is a pure function of the points.
 //!
 //! The earlier 63-bit keys with one counting pass on the top bits and a comparison sort per
 //! bucket took three times as long to sort and sped up only ×1.3 on 2 threads (the counting
@@ -110,8 +110,8 @@ impl MortonScratch {
 /// The key of non-finite points: after every Morton code.
 const NON_FINITE: u64 = 1 << 30;
 
-/// Fills `scratch.keys` with `key << 32 | index` of every item, sorted, and `scratch.starts`
-/// with the chunks' first indices. The bounding box is a min/max reduction (exact in any
+/// Fills `scratch.keys` with `key << 32 | item` of every item (see [`MortonScratch::keys`]),
+/// sorted, `scratch.starts` with the chunks' first indices and `scratch.item_bits`. The bounding box is a min/max reduction (exact in any
 /// order).
 fn morton_keys<T, C>(
     chunks: &[C],
@@ -204,8 +204,8 @@ const RADIX: usize = 1 << DIGIT_BITS;
 /// Blocks of a radix pass (the same for any thread count, so the result is too).
 const BLOCKS: usize = 32;
 
-/// Sorts `packed = key << 32 | index` values, given in increasing index order, by key with ties
-/// in index order (so in increasing order of `packed`): three stable least-significant-digit
+/// Sorts `packed = key << 32 | item` values, given in increasing item order, by key with ties
+/// in item order (so in increasing order of `packed`): three stable least-significant-digit
 /// radix passes over the key's 31 bits, with `spare` as the other buffer.
 fn sort_keys(keys: &mut Vec<u64>, spare: &mut Vec<u64>) {
     let n = keys.len();

@@ -867,25 +867,8 @@ impl<'s> PhotonMapper<'s> {
     /// median 1.55 → 1.54 and 1.70 → 1.62, i.e. about +4 %, far from the +22 % of issue #4: with
     /// the meshed spheres, what remains is mostly the traversal and the hit itself.
     ///
-    /// Second round (same measure, plus callgrind's branch simulator for mispredictions, which
-    /// it overstates for loop counters but ranks data-dependent branches well): 4229
-    /// instructions and 21.6 simulated mispredictions per path before, 3578 and 14.0 after.
-    /// What paid: branch-free rounding of offset ray origins (the sign of the offset is a coin
-    /// toss; 1.1 mispredictions per spawned ray); the shading normal's fallback through
-    /// `normalize_or` (the comparison of the normal with zero branched on n.x = 0, walls against
-    /// spheres, 2 per path); the leaf test's own barycentrics (no per-hit recomputation, 130 per
-    /// path); no scatter after the last countable bounce; the concentric disc without libm's
-    /// `sincosf` (polynomials on |q| ≤ π/4, 100 per path and 1.8 mispredictions); `triangle_hit`
-    /// on `Vec3A` (60 per path); the roulette before the direction on Lambertian surfaces (105
-    /// per path); the traversal compiled into this loop (`Scene::intersect_inlined`, 143 per
-    /// path). In time (old and new binaries alternated on the shared machine, 1 thread, median
-    /// paired ratio of trace paths/s): ×1.135 for all but the last two (16 alternations), ×1.01
-    /// for the roulette (14), ×1.049 for the inlined traversal (20). What did not pay: pushing
-    /// all hit children in the traversal (no branch on a single hit: 3.5 fewer simulated
-    /// mispredictions, 1.3 % more instructions, slower in 8 of 8 alternated runs: the real
-    /// predictor handles that branch); inlining the Lambertian case of `Bsdf::sample` (12
-    /// instructions per path); fat LTO with one codegen unit (1.3 % fewer instructions, no
-    /// measurable time, a slower build). See `docs/performance.md`.
+    /// Second round: 4229 → 3578 instructions and 21.6 → 14.0 simulated mispredictions per
+    /// path, about ×1.2 in time; what paid and what did not is in `docs/performance.md`.
     #[inline(never)]
     fn trace_photon(&self, index: u64, out: &mut TracedPhotons) {
         let mut sampler = Sampler::new(self.params.seed, self.pass, index);
@@ -958,30 +941,33 @@ impl<'s> PhotonMapper<'s> {
                 let ratio = luminance(scattered) / luminance(power).max(f32::MIN_POSITIVE);
                 (1.0 - ratio).max(0.0)
             };
-            let mut survive = 1.0f32;
-            let lambertian = match material.kind {
-                MaterialKind::Diffuse { albedo } => Some(albedo),
+            // The survival probability, when the roulette is decided before sampling.
+            let decided = match material.kind {
+                MaterialKind::Diffuse { albedo } if roulette => {
+                    let q = kill_probability(power * albedo);
+                    if u_roulette < q {
+                        break;
+                    }
+                    Some(1.0 - q)
+                }
                 _ => None,
             };
-            if let (true, Some(albedo)) = (roulette, lambertian) {
-                let q = kill_probability(power * albedo);
-                if u_roulette < q {
-                    break;
-                }
-                survive = 1.0 - q;
-            }
             let Some(sample) = bsdf.sample(incoming, u_lobe, u, TransportMode::Importance) else {
                 break;
             };
             let new_power =
                 power * sample.weight * shading_normal_correction(&hit, incoming, sample.incoming);
-            if roulette && lambertian.is_none() {
-                let q = kill_probability(new_power);
-                if u_roulette < q {
-                    break;
+            let survive = match decided {
+                Some(survive) => survive,
+                None if roulette => {
+                    let q = kill_probability(new_power);
+                    if u_roulette < q {
+                        break;
+                    }
+                    1.0 - q
                 }
-                survive = 1.0 - q;
-            }
+                None => 1.0,
+            };
             power = new_power / survive;
             if power == Rgb::ZERO || !power.is_finite() {
                 break;

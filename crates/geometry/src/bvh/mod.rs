@@ -436,7 +436,7 @@ impl Accel {
     }
 
     /// [`Accel::intersect`] compiled into its caller: for the photon loop, where the call and
-    /// the caller's vector registers saved around it cost about 30 instructions per ray.
+    /// the caller's vector registers saved around it cost about 40 instructions per ray.
     #[inline(always)]
     pub(crate) fn intersect_inlined(&self, ray: &Ray) -> Option<RawHit> {
         let bvh = self.bvh.as_ref()?;

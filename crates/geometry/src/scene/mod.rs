@@ -255,9 +255,10 @@ impl Scene {
 
     /// The closest hit with 0 < t < `ray.t_max`, or `None`.
     ///
-    /// Always inlined, with [`Scene::triangle_hit`], so that the photon loop gets the `Hit` in
-    /// registers rather than through two copies in memory (4.5 % fewer instructions per photon
-    /// path with the other changes of that round; see `ppm`'s `trace_photon`).
+    /// Always inlined, with [`Scene::triangle_hit`], so that callers get the `Hit` in registers
+    /// rather than through two copies in memory (4.5 % fewer instructions per photon path with
+    /// the other changes of that round; see `ppm`'s `trace_photon`); the traversal itself stays
+    /// a call ([`Scene::intersect_inlined`] compiles it in too).
     #[inline(always)]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let raw = self.accel.intersect(ray)?;
@@ -265,7 +266,7 @@ impl Scene {
     }
 
     /// [`Scene::intersect`], with the BVH traversal compiled into the caller instead of called:
-    /// the same answer, for a hot loop that does little else (the photon tracer: about 110
+    /// the same answer, for a hot loop that does little else (the photon tracer: about 140
     /// fewer instructions per photon path, the call and the vector registers saved around it).
     /// Every caller gets its own copy of the traversal, so use it sparingly.
     #[inline(always)]
