@@ -287,6 +287,7 @@ fn gather_pass_sorted(bencher: Bencher, threads: usize) {
             power: Vec3::ONE,
             normal: position,
             bounces: 0,
+            tag: 0,
         })
         .collect();
     let pool = pool(threads);

@@ -70,6 +70,16 @@ where
 pub struct GatherScratch<T> {
     /// Per photon chunk, per hitpoint range.
     bins: Vec<Vec<Vec<(u32, T)>>>,
+    /// The bins the last gather filled: its photon chunks, its hitpoint count and range length.
+    last: Option<LastGather>,
+}
+
+/// The shape of the bins of the last gather, for [`accumulate_again`].
+#[derive(Clone, Copy, Debug)]
+struct LastGather {
+    n_chunks: usize,
+    n_hitpoints: usize,
+    range_len: usize,
 }
 
 impl<T> GatherScratch<T> {
@@ -93,7 +103,10 @@ impl<T> GatherScratch<T> {
 
 impl<T> Default for GatherScratch<T> {
     fn default() -> Self {
-        Self { bins: Vec::new() }
+        Self {
+            bins: Vec::new(),
+            last: None,
+        }
     }
 }
 
@@ -123,6 +136,11 @@ pub fn gather_with<P, T, A>(
     if scratch.bins.len() < n_chunks {
         scratch.bins.resize_with(n_chunks, Vec::new);
     }
+    scratch.last = Some(LastGather {
+        n_chunks,
+        n_hitpoints,
+        range_len,
+    });
     let bins = &mut scratch.bins[..n_chunks];
     bins.par_iter_mut()
         .zip(photons.par_chunks(GATHER_CHUNK))
@@ -152,6 +170,50 @@ pub fn gather_with<P, T, A>(
             for chunk_bins in bins {
                 for &(idx, value) in &chunk_bins[range_idx] {
                     accumulate(&mut accs[idx as usize - first], value);
+                }
+            }
+        });
+}
+
+/// Folds the `(hitpoint, value)` pairs that the last [`gather_with`] on `scratch` recorded into
+/// a second set of accumulators, in the same order (photon order for every hitpoint) and as
+/// deterministically, without querying the grid again.
+///
+/// For a second quantity carried by some of the photons: the contribution of the gather returns
+/// both (e.g. a flux and a tag naming a record with more state, see [`Photon::tag`]), its
+/// accumulation folds the first, and this folds the second, with the hitpoint's index at hand
+/// (`accumulate(&mut acc[h], h, value)`) for whatever the hitpoint's side of it needs.
+/// `accumulators` is overwritten with one `B::default()` per hitpoint of that gather.
+///
+/// # Panics
+/// If `scratch` has not been through [`gather_with`].
+pub fn accumulate_again<T, B>(
+    scratch: &GatherScratch<T>,
+    accumulators: &mut Vec<B>,
+    accumulate: impl Fn(&mut B, u32, T) + Sync,
+) where
+    T: Copy + Send + Sync,
+    B: Default + Clone + Send,
+{
+    let LastGather {
+        n_chunks,
+        n_hitpoints,
+        range_len,
+    } = scratch
+        .last
+        .expect("accumulate_again needs the bins of a gather_with");
+    accumulators.clear();
+    accumulators.reserve_exact(n_hitpoints);
+    accumulators.resize(n_hitpoints, B::default());
+    let bins = &scratch.bins[..n_chunks];
+    accumulators
+        .par_chunks_mut(range_len)
+        .enumerate()
+        .for_each(|(range_idx, accs)| {
+            let first = range_idx * range_len;
+            for chunk_bins in bins {
+                for &(idx, value) in &chunk_bins[range_idx] {
+                    accumulate(&mut accs[idx as usize - first], idx, value);
                 }
             }
         });

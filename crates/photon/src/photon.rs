@@ -4,7 +4,7 @@ use glam::Vec3;
 
 /// A photon stored on a surface: plain data, public fields.
 ///
-/// 52 bytes.
+/// 56 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Photon {
     /// Where the photon hit the surface.
@@ -19,6 +19,10 @@ pub struct Photon {
     /// Scattering events on the photon's path before this hit (0 for a hit straight from the
     /// emitter), so that a renderer can bound the bounces of the whole light path.
     pub bounces: u32,
+    /// Free for the caller: this crate never reads it. E.g. the index of a record with more
+    /// state about some of the photons, which a gather's contribution can carry to the
+    /// accumulators ([`crate::gather_with`], [`crate::accumulate_again`]).
+    pub tag: u32,
 }
 
 impl AsRef<Photon> for Photon {
@@ -109,6 +113,7 @@ mod tests {
             incoming: incoming.normalize(),
             power: Vec3::ONE,
             normal,
+            tag: 0,
         }
     }
 

@@ -358,11 +358,11 @@ impl<'s> PhotonMapper<'s> {
                 + s.frequency_per_entry.capacity() * size_of::<FrequencyEstimate>()
                 + s.slot_entry.capacity() * size_of::<u32>(),
             pass_photon_buffers: traced
-                + s.frequency_sorted.capacity() * size_of::<FrequencyPhoton>()
+                + s.frequency.capacity() * size_of::<FrequencyPhoton>()
                 + s.sorted.capacity() * size_of::<Photon>()
                 + s.keys.heap_bytes()
                 + s.gather.heap_bytes()
-                + s.frequency_gather.heap_bytes(),
+                + s.tagged_gather.heap_bytes(),
         }
     }
 
@@ -672,6 +672,13 @@ impl<'s> PhotonMapper<'s> {
         let mut scratch = std::mem::take(&mut self.scratch);
         let n_chunks = usize::try_from(n.div_ceil(PHOTON_CHUNK)).unwrap_or(usize::MAX);
         scratch.traced.resize_with(n_chunks, TracedPhotons::default);
+        let layout = TagLayout::new(n_chunks, self.params.max_depth);
+        #[cfg(test)]
+        let layout = if scratch.force_global_tags {
+            TagLayout::Global
+        } else {
+            layout
+        };
         scratch
             .traced
             .par_iter_mut()
@@ -680,14 +687,20 @@ impl<'s> PhotonMapper<'s> {
                 out.clear();
                 let start = chunk as u64 * PHOTON_CHUNK;
                 let end = (start + PHOTON_CHUNK).min(n);
+                let tag_base = layout.chunk_base(chunk);
                 for idx in start..end {
-                    self.trace_photon(first_index + idx, out);
+                    self.trace_photon(first_index + idx, tag_base, out);
                 }
             });
         self.n_emitted += n;
-
         let frequency_photons = scratch.traced.iter().map(|c| c.frequency_photons).sum();
         let trace_seconds = clock.elapsed().as_secs_f64();
+        let uses_frequency = self.params.method.uses_frequency();
+        let frequency_clock = Instant::now();
+        if uses_frequency && layout == TagLayout::Global {
+            tag_frequency_photons(&mut scratch.traced, &mut scratch.frequency);
+        }
+        let mut frequency_seconds = frequency_clock.elapsed().as_secs_f64();
         let n_slots = self.slots.len();
         let mut deposits = PassDeposits {
             per_entry: Vec::new(),
@@ -697,7 +710,7 @@ impl<'s> PhotonMapper<'s> {
             frequency_photons,
             photons_stored: 0,
             trace_seconds,
-            frequency_seconds: 0.0,
+            frequency_seconds,
         };
         // Slot → grid entry (`NOT_IN_GRID` for slots the grid does not index).
         deposits.slot_entry.clear();
@@ -719,83 +732,97 @@ impl<'s> PhotonMapper<'s> {
 
         let slots = &self.slots;
         let grid_slots = &self.grid_slots;
-        photon::gather_with::<Photon, _, _>(
-            &mut scratch.gather,
-            grid,
-            &scratch.sorted,
-            &mut scratch.per_entry,
-            grid_slots.len(),
-            |photon, entry| {
-                let slot = grid_slots[entry as usize] as usize;
-                self.accepts(photon, slot).then(|| {
-                    let material = self.scene.material(slots.material_idx()[slot])?;
-                    let (normal, outgoing) = (slots.shading_normal()[slot], slots.outgoing()[slot]);
-                    let f = match material.kind {
-                        // `Bsdf::eval` of a Lambertian without building the shading frame: the
-                        // same hemisphere test on the same dot products (the frame's z is the
-                        // normal), the same value.
-                        MaterialKind::Diffuse { albedo } => {
-                            if outgoing.dot(normal) * photon.incoming.dot(normal) <= 0.0 {
-                                Rgb::ZERO
-                            } else {
-                                albedo * std::f32::consts::FRAC_1_PI
-                            }
+        let flux = |photon: &Photon, entry: u32| {
+            let slot = grid_slots[entry as usize] as usize;
+            self.accepts(photon, slot).then(|| {
+                let material = self.scene.material(slots.material_idx()[slot])?;
+                let (normal, outgoing) = (slots.shading_normal()[slot], slots.outgoing()[slot]);
+                let f = match material.kind {
+                    // `Bsdf::eval` of a Lambertian without building the shading frame: the
+                    // same hemisphere test on the same dot products (the frame's z is the
+                    // normal), the same value.
+                    MaterialKind::Diffuse { albedo } => {
+                        if outgoing.dot(normal) * photon.incoming.dot(normal) <= 0.0 {
+                            Rgb::ZERO
+                        } else {
+                            albedo * std::f32::consts::FRAC_1_PI
                         }
-                        kind => {
-                            Bsdf::from_normal(kind, normal, true).eval(outgoing, photon.incoming)
-                        }
-                    };
-                    Some(f * photon.power * slots.weight()[slot])
-                })?
-            },
-            |acc: &mut (u32, [f64; 3]), flux: Rgb| {
-                acc.0 += 1;
-                acc.1[0] += f64::from(flux.x);
-                acc.1[1] += f64::from(flux.y);
-                acc.1[2] += f64::from(flux.z);
-            },
-        );
+                    }
+                    kind => Bsdf::from_normal(kind, normal, true).eval(outgoing, photon.incoming),
+                };
+                Some(f * photon.power * slots.weight()[slot])
+            })?
+        };
+        let add = |acc: &mut (u32, [f64; 3]), flux: Rgb| {
+            acc.0 += 1;
+            acc.1[0] += f64::from(flux.x);
+            acc.1[1] += f64::from(flux.y);
+            acc.1[2] += f64::from(flux.z);
+        };
+        if uses_frequency {
+            // The flux pairs carry the photon's tag, for the frequency deposits below.
+            photon::gather_with(
+                &mut scratch.tagged_gather,
+                grid,
+                &scratch.sorted,
+                &mut scratch.per_entry,
+                grid_slots.len(),
+                |photon, entry| flux(photon, entry).map(|f| (f, photon.tag)),
+                |acc, (f, _)| add(acc, f),
+            );
+        } else {
+            photon::gather_with(
+                &mut scratch.gather,
+                grid,
+                &scratch.sorted,
+                &mut scratch.per_entry,
+                grid_slots.len(),
+                flux,
+                add,
+            );
+        }
         deposits.photons_stored = scratch.sorted.len() as u64;
         for &(m, _) in &scratch.per_entry {
             deposits.photons_deposited += u64::from(m);
             deposits.hitpoints_hit += u64::from(m > 0);
         }
         deposits.per_entry = std::mem::take(&mut scratch.per_entry);
+        if !uses_frequency {
+            self.scratch = scratch;
+            return deposits;
+        }
 
-        // Frequency deposits, gathered like the flux: each grid entry merges the field of its
-        // frequency photons in photon order (the merges, a min or max per coefficient, do not
-        // depend on the order anyway), then that pass estimate is merged into the slot's. The
-        // photons are Morton-sorted like the flux photons: grid queries in random order are
-        // several times slower. They are sorted straight from the chunks that traced them, in
-        // parallel (sorting their concatenation, one chunk, ran on one thread after a serial
-        // copy: 30–40 ms and 10 ms of a 2-thread pass of a million photons).
+        // Frequency deposits: a frequency photon counts for exactly the hitpoints its flux
+        // counts for, so they ride the flux gather: its pairs carry the photon's tag, and each
+        // grid entry merges the fields of its tagged pairs, in photon order (the merges, a min
+        // or max per coefficient, do not depend on the order anyway). Then each slot merges its
+        // entry's estimate. (Before, the frequency photons had their own Morton sort of
+        // 128-byte records and their own grid queries: 0.06–0.1 s of a 1-thread pass of a
+        // million photons, against 0.01–0.02 s now.)
         let frequency_clock = Instant::now();
         let policy = self.params.freq_merge;
-        let frequency_chunks: Vec<&[FrequencyPhoton]> =
-            scratch.traced.iter().map(|c| &c.frequency[..]).collect();
-        photon::morton_sort(
-            &frequency_chunks,
-            |p: &FrequencyPhoton| p.photon.position,
-            &mut scratch.keys,
-            &mut scratch.frequency_sorted,
-        );
-        photon::gather_with(
-            &mut scratch.frequency_gather,
-            grid,
-            &scratch.frequency_sorted,
+        let (traced, concatenated) = (&scratch.traced, &scratch.frequency);
+        let record = |tag: u32| match layout {
+            TagLayout::Packed { local_bits } => {
+                &traced[(tag >> local_bits) as usize].frequency
+                    [(tag & ((1 << local_bits) - 1)) as usize]
+            }
+            TagLayout::Global => &concatenated[tag as usize],
+        };
+        photon::accumulate_again(
+            &scratch.tagged_gather,
             &mut scratch.frequency_per_entry,
-            grid_slots.len(),
-            |photon: &FrequencyPhoton, entry| {
-                let slot = grid_slots[entry as usize] as usize;
-                if !self.accepts(&photon.photon, slot) {
-                    return None;
+            |acc: &mut FrequencyEstimate, entry, (_, tag)| {
+                if tag == UNTAGGED {
+                    return;
                 }
-                let material = self.scene.material(slots.material_idx()[slot])?;
-                Some(photon.field(material.kind.lobe(), &self.caps))
+                let slot = grid_slots[entry as usize] as usize;
+                if let Some(material) = self.scene.material(slots.material_idx()[slot]) {
+                    let field = record(tag).field(material.kind.lobe(), &self.caps);
+                    acc.deposit(field, policy);
+                }
             },
-            |acc: &mut FrequencyEstimate, spectrum| acc.deposit(spectrum, policy),
         );
-        // Each slot merges its entry's estimate, in parallel over the slots.
         let per_entry = &scratch.frequency_per_entry;
         let slot_entry = &deposits.slot_entry;
         self.slots
@@ -815,7 +842,8 @@ impl<'s> PhotonMapper<'s> {
                     freq.set_estimate(merged);
                 }
             });
-        deposits.frequency_seconds = frequency_clock.elapsed().as_secs_f64();
+        frequency_seconds += frequency_clock.elapsed().as_secs_f64();
+        deposits.frequency_seconds = frequency_seconds;
         self.scratch = scratch;
         deposits
     }
@@ -870,7 +898,7 @@ impl<'s> PhotonMapper<'s> {
     /// Second round: 4229 → 3578 instructions and 21.6 → 14.0 simulated mispredictions per
     /// path, about ×1.2 in time; what paid and what did not is in `docs/performance.md`.
     #[inline(never)]
-    fn trace_photon(&self, index: u64, out: &mut TracedPhotons) {
+    fn trace_photon(&self, index: u64, tag_base: u32, out: &mut TracedPhotons) {
         let mut sampler = Sampler::new(self.params.seed, self.pass, index);
         let u_light = sampler.next_f32();
         let u_pos = sampler.next_2d();
@@ -904,23 +932,30 @@ impl<'s> PhotonMapper<'s> {
             // already accounted for at the hitpoints.
             let counted_by_light_sampling = self.params.direct_lighting && depth == 0;
             if !bsdf.is_specular() && !counted_by_light_sampling {
-                let photon = Photon {
+                // A frequency photon's tag names its record (see `TagLayout`); a chunk stores
+                // at most PHOTON_CHUNK × max_depth ≤ 2²¹ records, so the index fits.
+                let tag = match spectrum {
+                    Some(s) => {
+                        let tag = tag_base | out.frequency.len() as u32;
+                        out.frequency.push(FrequencyPhoton::new(
+                            out.photons.len() as u32,
+                            hit.curvature,
+                            material.kind.lobe(),
+                            s,
+                            &self.caps,
+                        ));
+                        tag
+                    }
+                    None => UNTAGGED,
+                };
+                out.photons.push(Photon {
                     position: hit.position,
                     incoming,
                     power,
                     normal: hit.geometric_normal,
                     bounces: depth,
-                };
-                out.photons.push(photon);
-                if let Some(s) = spectrum {
-                    out.frequency.push(FrequencyPhoton::new(
-                        photon,
-                        hit.curvature,
-                        material.kind.lobe(),
-                        s,
-                        &self.caps,
-                    ));
-                }
+                    tag,
+                });
             }
             // Scatter, unless no later hit could count.
             if depth + 1 == self.params.max_depth {
@@ -1220,7 +1255,7 @@ struct VisiblePoint {
 #[derive(Default)]
 struct TracedPhotons {
     photons: Vec<Photon>,
-    /// Frequency photons again, with the curvature at their hit and their spectrum.
+    /// The frequency records of the chunk's frequency photons, in trace order.
     frequency: Vec<FrequencyPhoton>,
     frequency_photons: u64,
 }
@@ -1240,9 +1275,10 @@ impl AsRef<[Photon]> for TracedPhotons {
     }
 }
 
-/// A frequency photon as the gather reads it: the stored photon, the curvature at its hit, its
-/// spectrum on arrival, and that spectrum already reflected by the lobe of the surface it landed
-/// on (`field`, for `field_lobe`).
+/// What a frequency photon brings to the hitpoints its flux counts for (its [`Photon`], whose
+/// `tag` names this record, is stored with the others): its spectrum on arrival, the curvature
+/// at its hit, and that spectrum already reflected by the lobe of the surface it landed on
+/// (`field`, for `field_lobe`). 64 bytes.
 ///
 /// A hitpoint that accepts the photon nearly always lies on the same surface, so the reflection
 /// a deposit needs (design §8.1) is computed once per photon instead of once per photon and
@@ -1250,27 +1286,28 @@ impl AsRef<[Photon]> for TracedPhotons {
 /// same result either way.
 #[derive(Clone, Copy)]
 struct FrequencyPhoton {
-    photon: Photon,
-    curvature: f32,
-    field_lobe: MaterialLobe,
-    spectrum: Spectrum,
     field: Spectrum,
+    field_lobe: MaterialLobe,
+    curvature: f32,
+    /// Index of its photon in the chunk's `photons`.
+    photon: u32,
+    spectrum: Spectrum,
 }
 
 impl FrequencyPhoton {
     fn new(
-        photon: Photon,
+        photon: u32,
         curvature: f32,
         lobe: MaterialLobe,
         spectrum: Spectrum,
         caps: &Caps,
     ) -> Self {
         Self {
-            photon,
-            curvature,
-            field_lobe: lobe,
-            spectrum,
             field: deposit_field(spectrum, curvature, lobe, caps),
+            field_lobe: lobe,
+            curvature,
+            photon,
+            spectrum,
         }
     }
 
@@ -1291,10 +1328,69 @@ fn deposit_field(spectrum: Spectrum, curvature: f32, lobe: MaterialLobe, caps: &
     spectrum.reflect_isotropic(1.0, f64::from(curvature), spectrum_lobe(lobe), caps)
 }
 
-impl AsRef<Photon> for FrequencyPhoton {
-    fn as_ref(&self) -> &Photon {
-        &self.photon
+/// [`Photon::tag`] of a photon without a frequency record.
+const UNTAGGED: u32 = u32::MAX;
+
+/// How a frequency photon's [`Photon::tag`] names its record.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum TagLayout {
+    /// `chunk << local_bits | index in the chunk's records`, set while tracing: the records
+    /// stay where the chunks stored them.
+    Packed { local_bits: u32 },
+    /// The index in the concatenation of the chunks' records ([`tag_frequency_photons`]), for
+    /// passes with too many chunks or too deep paths to pack both indices in 31 bits (more than
+    /// 2²⁰ chunks, i.e. 2·10⁹ photons per pass, at the default depth).
+    Global,
+}
+
+impl TagLayout {
+    fn new(n_chunks: usize, max_depth: u32) -> Self {
+        // Bits for indices below n.
+        let bits = |n: u64| u64::BITS - n.saturating_sub(1).leading_zeros();
+        let local_bits = bits(PHOTON_CHUNK * u64::from(max_depth));
+        let chunk_bits = bits(n_chunks as u64);
+        // At most 31 bits in all: no packed tag is UNTAGGED.
+        if local_bits + chunk_bits <= 31 {
+            Self::Packed { local_bits }
+        } else {
+            Self::Global
+        }
     }
+
+    /// What a chunk's tags start from: its index in the high bits, or 0 (the chunk's own
+    /// record indices, which `tag_frequency_photons` makes global after tracing).
+    fn chunk_base(self, chunk: usize) -> u32 {
+        match self {
+            Self::Packed { local_bits } => (chunk as u32) << local_bits,
+            Self::Global => 0,
+        }
+    }
+}
+
+/// For [`TagLayout::Global`]: gathers the frequency records of all chunks into `records`, in
+/// chunk order, and tags each record's photon with the record's index there, in parallel over
+/// the chunks. (With [`TagLayout::Packed`], the default, nothing to do: for 10⁶ photons this
+/// took 5–6 ms, mostly the scattered writes of the tags, on one thread or two.)
+///
+/// A pass would need 2³² frequency records (256 GiB of them) before an index reached
+/// [`UNTAGGED`]; photons past that are left untagged (their flux counts, their spectrum not).
+fn tag_frequency_photons(traced: &mut [TracedPhotons], records: &mut Vec<FrequencyPhoton>) {
+    // The copy is serial: a memcpy of 6 MB per 10⁵ frequency photons, about a millisecond.
+    records.clear();
+    let mut offsets = Vec::with_capacity(traced.len());
+    for chunk in traced.iter() {
+        offsets.push(records.len());
+        records.extend_from_slice(&chunk.frequency);
+    }
+    traced
+        .par_iter_mut()
+        .zip(offsets)
+        .for_each(|(chunk, offset)| {
+            for (k, record) in chunk.frequency.iter().enumerate() {
+                chunk.photons[record.photon as usize].tag =
+                    u32::try_from(offset + k).unwrap_or(UNTAGGED);
+            }
+        });
 }
 
 /// The photon pass's buffers, kept from one pass to the next: a pass of a million photons
@@ -1304,16 +1400,21 @@ impl AsRef<Photon> for FrequencyPhoton {
 struct PhotonScratch {
     /// Per chunk of [`PHOTON_CHUNK`] photon paths, what they stored.
     traced: Vec<TracedPhotons>,
-    /// The frequency photons of all chunks in Morton order.
-    frequency_sorted: Vec<FrequencyPhoton>,
+    /// With [`TagLayout::Global`], the frequency records of all chunks, in chunk order:
+    /// [`Photon::tag`] indexes them.
+    frequency: Vec<FrequencyPhoton>,
+    /// Tests: tag as [`TagLayout::Global`] whatever the pass size.
+    #[cfg(test)]
+    force_global_tags: bool,
     /// Morton keys of the stored photons.
     keys: MortonScratch,
     /// The stored photons in Morton order.
     sorted: Vec<Photon>,
     gather: GatherScratch<Rgb>,
+    /// The flux gather of the frequency-guided methods: each pair with its photon's tag.
+    tagged_gather: GatherScratch<(Rgb, u32)>,
     /// Per grid entry: M and Φ of the pass.
     per_entry: Vec<(u32, [f64; 3])>,
-    frequency_gather: GatherScratch<Spectrum>,
     /// Per grid entry: the merged frequency deposits of the pass.
     frequency_per_entry: Vec<FrequencyEstimate>,
     /// Per slot, its grid entry; lent to [`PassDeposits`] during a pass.
@@ -1427,4 +1528,64 @@ fn scatter_spectrum(
         spectrum_lobe(bsdf.lobe())
     };
     spectrum.reflect_isotropic(mu_o, curvature, lobe, caps)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Method;
+
+    #[test]
+    fn tags_pack_chunk_and_record_indices_when_they_fit() {
+        // 489 chunks (10⁶ photons), depth 8: 9 + 14 bits.
+        assert_eq!(TagLayout::new(489, 8), TagLayout::Packed { local_bits: 14 });
+        assert_eq!(TagLayout::new(1, 1), TagLayout::Packed { local_bits: 11 });
+        // Depth 1024: 21 bits per chunk leave 10 for 1024 chunks, not for 1025.
+        assert_eq!(
+            TagLayout::new(1024, 1024),
+            TagLayout::Packed { local_bits: 21 }
+        );
+        assert_eq!(TagLayout::new(1025, 1024), TagLayout::Global);
+        // The largest packed tag is below UNTAGGED.
+        let TagLayout::Packed { local_bits } = TagLayout::new(1024, 1024) else {
+            unreachable!()
+        };
+        let last = TagLayout::new(1024, 1024).chunk_base(1023) | ((1 << local_bits) - 1);
+        assert!(last < UNTAGGED);
+    }
+
+    #[test]
+    fn global_tags_deposit_exactly_what_packed_tags_do() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../../shared/scenes/cornell_box/CornellBox-Sphere.obj");
+        let mut description = geometry::load(&path).unwrap();
+        description.film = geometry::Film {
+            width: 24,
+            height: 24,
+        };
+        let scene = Scene::new(description).unwrap();
+        let mut params = RenderParams::preview();
+        params.method = Method::FreqPpm;
+        params.photons_per_pass = 5_000;
+        let render = |force_global_tags| {
+            let mut mapper = PhotonMapper::new(&scene, params).unwrap();
+            mapper.scratch.force_global_tags = force_global_tags;
+            let stats: Vec<PassStats> = (0..3).map(|_| mapper.iterate()).collect();
+            (mapper.image(), mapper.slots.freq().to_vec(), stats)
+        };
+        let (packed, global) = (render(false), render(true));
+        assert!(packed.1.iter().any(|f| f.estimate().has_freq()));
+        assert_eq!(packed.1, global.1, "frequency states differ");
+        let bits = |image: &[[f32; 3]]| {
+            image
+                .iter()
+                .map(|p| p.map(f32::to_bits))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(bits(&packed.0), bits(&global.0));
+        for (a, b) in packed.2.iter().zip(&global.2) {
+            assert_eq!(a.photons_deposited, b.photons_deposited);
+            assert_eq!(a.frequency_held.to_bits(), b.frequency_held.to_bits());
+        }
+    }
 }

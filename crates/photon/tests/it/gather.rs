@@ -1,7 +1,10 @@
 //! `gather`: bit-identical for any thread count and equal to a serial brute-force pass.
 
 use glam::Vec3;
-use photon::{AcceptParams, GridParams, HitPointGrid, Photon, accepts, gather};
+use photon::{
+    AcceptParams, GatherScratch, GridParams, HitPointGrid, Photon, accepts, accumulate_again,
+    gather, gather_with,
+};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
 
@@ -47,6 +50,7 @@ fn scene(seed: u64) -> Scene {
                 power,
                 normal,
                 bounces: 0,
+                tag: rng.random_range(0..4),
             }
         })
         .collect();
@@ -159,4 +163,68 @@ fn back_face_photons_never_count() {
         })
         .sum::<usize>();
     assert!(n_back > 1000, "{n_back} back-face photons within a radius");
+}
+
+#[test]
+fn accumulating_again_equals_a_second_gather() {
+    // The flux gather carries the photon's tag along; folding the tags again afterwards (only the
+    // odd ones, each with its hitpoint index) must give exactly what a second full gather gives,
+    // for any thread count.
+    let s = scene(3);
+    let grid = HitPointGrid::build(&s.positions, &s.radii, GridParams::DEFAULT);
+    let tagged = |photon: &Photon, idx| contribution(&s)(photon, idx).map(|v| (v, photon.tag));
+    let fold_odd = |acc: &mut Vec<(u32, u32)>, h: u32, (_, tag): ([f64; 3], u32)| {
+        if tag % 2 == 1 {
+            acc.push((h, tag));
+        }
+    };
+    let second: Vec<Vec<(u32, u32)>> = gather(
+        &grid,
+        &s.photons,
+        s.positions.len(),
+        tagged,
+        |acc: &mut Vec<(u32, u32)>, v| {
+            // `gather` does not pass the hitpoint: every entry of one accumulator has it.
+            if v.1 % 2 == 1 {
+                acc.push((u32::MAX, v.1));
+            }
+        },
+    );
+    for threads in [1, 2, 8] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let (flux, again) = pool.install(|| {
+            let mut scratch = GatherScratch::default();
+            let mut flux = Vec::new();
+            gather_with(
+                &mut scratch,
+                &grid,
+                &s.photons,
+                &mut flux,
+                s.positions.len(),
+                tagged,
+                |acc: &mut Acc, (v, _)| add(acc, v),
+            );
+            let mut again = Vec::new();
+            accumulate_again(&scratch, &mut again, fold_odd);
+            (flux, again)
+        });
+        let plain = gather(&grid, &s.photons, s.positions.len(), contribution(&s), add);
+        assert!(
+            flux.iter()
+                .zip(&plain)
+                .all(|(a, b)| a.0 == b.0 && a.1.map(f64::to_bits) == b.1.map(f64::to_bits))
+        );
+        assert_eq!(again.len(), s.positions.len());
+        let mut n_folded = 0;
+        for (h, (a, b)) in again.iter().zip(&second).enumerate() {
+            assert!(a.iter().all(|&(idx, _)| idx as usize == h));
+            let tags = |v: &Vec<(u32, u32)>| v.iter().map(|&(_, t)| t).collect::<Vec<_>>();
+            assert_eq!(tags(a), tags(b), "hitpoint {h}, {threads} threads");
+            n_folded += a.len();
+        }
+        assert!(n_folded > 500, "{n_folded} odd tags folded");
+    }
 }
