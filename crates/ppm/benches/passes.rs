@@ -24,14 +24,15 @@
 //!
 //! The summary lines are medians over pass rounds of ratios or differences within a round (the
 //! passes compared ran seconds apart). Even so, the tracing phase's extra time of freq over
-//! ppm varies by ±0.03 s from run to run: with 5 passes the bookkeeping share read 7–16 %,
-//! with 9 it reads 10–12 %.
+//! ppm varies by ±0.03 s from run to run: the bookkeeping share of single 9-pass runs reads
+//! 6–14 % (`docs/performance.md` has it without that noise: about 7.5 %).
 //!
 //! The frequency line splits freq's extra pass time into its bookkeeping (the tracing phase's
 //! extra time over ppm's: spectra and occlusion probes along the frequency photons' paths; plus
 //! `PassTimings::frequency`: their deposits and the clear-disc probes) and the rest, which is the
 //! flux gather over the larger kernels the frequency floor holds (the hitpoints each stored
-//! photon reaches, printed for both methods).
+//! photon reaches, printed for both methods), whose pairs also carry the photons' tags for the
+//! deposits (4 bytes each, not counted as bookkeeping).
 //!
 //! Memory is `Renderer::memory` after the timed passes (allocated capacities), per hitpoint
 //! slot: the state kept from pass to pass (records, the renderer's slot columns, the grid and
