@@ -157,22 +157,13 @@ pub fn gather_with<P, T, A>(
                 });
             }
         });
-    accumulators.clear();
-    // Exactly: the default growth would double the capacity when the count grows a little.
-    accumulators.reserve_exact(n_hitpoints);
-    accumulators.resize(n_hitpoints, A::default());
-    let bins = &*bins;
-    accumulators
-        .par_chunks_mut(range_len)
-        .enumerate()
-        .for_each(|(range_idx, accs)| {
-            let first = range_idx * range_len;
-            for chunk_bins in bins {
-                for &(idx, value) in &chunk_bins[range_idx] {
-                    accumulate(&mut accs[idx as usize - first], value);
-                }
-            }
-        });
+    fold_bins(
+        &scratch.bins[..n_chunks],
+        range_len,
+        n_hitpoints,
+        accumulators,
+        |acc, _, value| accumulate(acc, value),
+    );
 }
 
 /// Folds the `(hitpoint, value)` pairs that the last [`gather_with`] on `scratch` recorded into
@@ -202,10 +193,32 @@ pub fn accumulate_again<T, B>(
     } = scratch
         .last
         .expect("accumulate_again needs the bins of a gather_with");
+    fold_bins(
+        &scratch.bins[..n_chunks],
+        range_len,
+        n_hitpoints,
+        accumulators,
+        accumulate,
+    );
+}
+
+/// Phase 2 of a gather: `n_hitpoints` accumulators from `A::default()`, each folding its
+/// `(hitpoint, value)` pairs from `bins` (per photon chunk, per hitpoint range of `range_len`)
+/// in chunk order, in parallel over the ranges.
+fn fold_bins<T, A>(
+    bins: &[Vec<Vec<(u32, T)>>],
+    range_len: usize,
+    n_hitpoints: usize,
+    accumulators: &mut Vec<A>,
+    accumulate: impl Fn(&mut A, u32, T) + Sync,
+) where
+    T: Copy + Send + Sync,
+    A: Default + Clone + Send,
+{
     accumulators.clear();
+    // Exactly: the default growth would double the capacity when the count grows a little.
     accumulators.reserve_exact(n_hitpoints);
-    accumulators.resize(n_hitpoints, B::default());
-    let bins = &scratch.bins[..n_chunks];
+    accumulators.resize(n_hitpoints, A::default());
     accumulators
         .par_chunks_mut(range_len)
         .enumerate()
