@@ -3,7 +3,7 @@
 //!
 //! Prints, for 1 and 2 threads: photon paths per second (tracing only, and whole passes),
 //! gather queries per second, hitpoints per pixel, memory per hitpoint, and the extra cost of
-//! frequency photons at the default fraction. Times are wall-clock medians over 9 passes,
+//! frequency photons at the default fraction. Times are wall-clock medians over 15 passes,
 //! measured side by side in one run: the configurations (method × thread count) take turns, one
 //! pass each, so that their ratios hold even though the shared machine's speed drifts by ±20 %
 //! over minutes. Absolute numbers are as noisy as the machine; "(best pass)" is the tracing rate
@@ -24,8 +24,9 @@
 //!
 //! The summary lines are medians over pass rounds of ratios or differences within a round (the
 //! passes compared ran seconds apart). Even so, the tracing phase's extra time of freq over
-//! ppm varies by ±0.03 s from run to run: the bookkeeping share of single 9-pass runs reads
-//! 6–14 % (`docs/performance.md` has it without that noise: about 7.5 %).
+//! ppm varies by ±0.03 s from run to run: the bookkeeping share read 6–14 % in runs of 9
+//! passes, 7.0–8.3 % in runs of 15 (hence 15 by default; `docs/performance.md` has it without
+//! that noise: about 7.5 %).
 //!
 //! The frequency line splits freq's extra pass time into its bookkeeping (the tracing phase's
 //! extra time over ppm's: spectra and occlusion probes along the frequency photons' paths; plus
@@ -144,7 +145,7 @@ fn main() {
     };
     let scene = geometry::Scene::new(description).unwrap();
     let photons_per_pass: u32 = env_or("FPPM_BENCH_PHOTONS", 1_000_000);
-    let passes: usize = env_or("FPPM_BENCH_PASSES", 9);
+    let passes: usize = env_or("FPPM_BENCH_PASSES", 15);
     println!(
         "CornellBox-Sphere, 512x512, {photons_per_pass} photons per pass, median of {passes} passes"
     );
