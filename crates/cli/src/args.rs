@@ -1,6 +1,10 @@
 //! Stage one: the flags as clap parses them, as close to the command line as possible.
 //! Ranges are checked in `settings.rs`, where the flags meet the scene's `[render]` defaults.
 
+// The doc comments below are clap's help text, shown as written: `[render]` there names the
+// scene file's table, not an item to link.
+#![allow(rustdoc::broken_intra_doc_links)]
+
 use std::path::PathBuf;
 use std::time::Duration;
 

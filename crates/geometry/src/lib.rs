@@ -24,7 +24,7 @@
 //! (see `bvh/mod.rs`), which is exact: it never culls a primitive the ray meets.
 //!
 //! The loaders turn a scene file into a plain [`SceneDescription`]:
-//! [`load`] picks the loader by extension (`.toml` scene files of format version 1, lone
+//! [`load()`] picks the loader by extension (`.toml` scene files of format version 1, lone
 //! `.obj` files with their `.mtl`, `.gltf`/`.glb` files), [`load_toml_str`] reads a TOML scene
 //! held in memory, and [`load_with`] takes [`LoadOptions`] (e.g. to accept a scene without
 //! emitters for `fppm info`). Every failure is a [`LoadError`] naming the file.

@@ -5,7 +5,7 @@
 //! and in a deterministic order. Hitpoints live in [`HitPoints`], a structure of arrays whose
 //! progressive statistics (radius R, photon count N, flux τ) are `f64` and whose frequency state
 //! is a generic column the integrator chooses. [`accepts`] adds the side and normal tests that
-//! keep photons from the back of a thin wall out of a hitpoint's estimate, and [`gather`] runs a
+//! keep photons from the back of a thin wall out of a hitpoint's estimate, and [`gather()`] runs a
 //! photon pass in parallel while summing every hitpoint's contributions in photon order, so the
 //! result is bit-identical for any thread count.
 //!

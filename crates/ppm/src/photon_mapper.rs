@@ -270,7 +270,7 @@ pub fn auto_initial_radius(scene: &Scene) -> f64 {
 
 impl<'s> PhotonMapper<'s> {
     /// A renderer for `scene` with `params`; nothing is traced until the first
-    /// [`Renderer::iterate`].
+    /// [`crate::Renderer::iterate`].
     ///
     /// # Errors
     ///
@@ -1019,7 +1019,7 @@ impl<'s> PhotonMapper<'s> {
     /// A frequency photon's spectrum after the segment `ray` → `hit`: travel (design §4.1),
     /// plus partial occlusion (§4.7) when the occlusion probe finds a shadow edge nearby.
     ///
-    /// The occlusion estimate [UNV] (the poster does not say how it detected partial
+    /// The occlusion estimate \[UNV\] (the poster does not say how it detected partial
     /// occlusion): a probe ray from the segment's origin to a point beside the hit, offset
     /// perpendicular to the segment by w = 2·R₀ (R₀ the initial gather radius, the largest
     /// kernel a hitpoint can have, so w covers every hitpoint the photon can reach). If the

@@ -287,7 +287,7 @@ impl Spectrum {
     ///
     /// First-order Snell (ηi·μi·δθi = ηt·μt·δθt) scales angles by s and the footprint by
     /// t; det Q' = (ηi/ηt)²·det Q (étendue). Total internal reflection has no transmitted
-    /// field: check it with [`refracted_cosine`](crate::refracted_cosine) first. Cosines
+    /// field: check it with [`refracted_cosine`] first. Cosines
     /// are clamped to [[`MU_MIN`](crate::MU_MIN), 1], indices to [10⁻³, 10³].
     #[must_use]
     pub fn refract(
@@ -358,14 +358,14 @@ impl Spectrum {
     // ----------------------------------------------------------------------------------
     // Kernel radii.
 
-    /// Spatial radius `r_x = K·√a` \[m\], see [`spatial_radius`](crate::spatial_radius).
+    /// Spatial radius `r_x = K·√a` \[m\], see [`spatial_radius`].
     #[must_use]
     pub fn spatial_radius(&self, k: f64) -> f64 {
         spatial_radius(self.a, k)
     }
 
     /// Angular radius `r_θ = z·tan(K·√b)` \[m\] (+∞ once K·√b ≥ π/2, and for a Lambertian
-    /// spectrum), see [`angular_radius`](crate::angular_radius). `normal_distance` z \[m\]
+    /// spectrum), see [`angular_radius`]. `normal_distance` z \[m\]
     /// is the camera distance projected on the hitpoint normal.
     #[must_use]
     pub fn angular_radius(&self, normal_distance: f64, k: f64) -> f64 {
