@@ -157,13 +157,9 @@ pub fn gather_with<P, T, A>(
                 });
             }
         });
-    fold_bins(
-        &scratch.bins[..n_chunks],
-        range_len,
-        n_hitpoints,
-        accumulators,
-        |acc, _, value| accumulate(acc, value),
-    );
+    accumulate_again(scratch, accumulators, |acc, _, value| {
+        accumulate(acc, value)
+    });
 }
 
 /// Folds the `(hitpoint, value)` pairs that the last [`gather_with`] on `scratch` recorded into
@@ -175,6 +171,7 @@ pub fn gather_with<P, T, A>(
 /// accumulation folds the first, and this folds the second, with the hitpoint's index at hand
 /// (`accumulate(&mut acc[h], h, value)`) for whatever the hitpoint's side of it needs.
 /// `accumulators` is overwritten with one `B::default()` per hitpoint of that gather.
+/// ([`gather_with`] folds its own accumulators with this, ignoring the index.)
 ///
 /// # Panics
 /// If `scratch` has not been through [`gather_with`].
@@ -193,32 +190,11 @@ pub fn accumulate_again<T, B>(
     } = scratch
         .last
         .expect("accumulate_again needs the bins of a gather_with");
-    fold_bins(
-        &scratch.bins[..n_chunks],
-        range_len,
-        n_hitpoints,
-        accumulators,
-        accumulate,
-    );
-}
-
-/// Phase 2 of a gather: `n_hitpoints` accumulators from `A::default()`, each folding its
-/// `(hitpoint, value)` pairs from `bins` (per photon chunk, per hitpoint range of `range_len`)
-/// in chunk order, in parallel over the ranges.
-fn fold_bins<T, A>(
-    bins: &[Vec<Vec<(u32, T)>>],
-    range_len: usize,
-    n_hitpoints: usize,
-    accumulators: &mut Vec<A>,
-    accumulate: impl Fn(&mut A, u32, T) + Sync,
-) where
-    T: Copy + Send + Sync,
-    A: Default + Clone + Send,
-{
     accumulators.clear();
     // Exactly: the default growth would double the capacity when the count grows a little.
     accumulators.reserve_exact(n_hitpoints);
-    accumulators.resize(n_hitpoints, A::default());
+    accumulators.resize(n_hitpoints, B::default());
+    let bins = &scratch.bins[..n_chunks];
     accumulators
         .par_chunks_mut(range_len)
         .enumerate()

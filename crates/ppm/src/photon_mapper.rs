@@ -1280,7 +1280,7 @@ impl AsRef<[Photon]> for TracedPhotons {
 /// What a frequency photon brings to the hitpoints its flux counts for (its [`Photon`], whose
 /// `tag` names this record, is stored with the others): its spectrum on arrival, the curvature
 /// at its hit, and that spectrum already reflected by the lobe of the surface it landed on
-/// (`field`, for `field_lobe`). 64 bytes.
+/// (`field`, for `field_lobe`). 80 bytes.
 ///
 /// A hitpoint that accepts the photon nearly always lies on the same surface, so the reflection
 /// a deposit needs (design §8.1) is computed once per photon instead of once per photon and
@@ -1377,7 +1377,7 @@ impl TagLayout {
 /// A pass would need 2³² frequency records (256 GiB of them) before an index reached
 /// [`UNTAGGED`]; photons past that are left untagged (their flux counts, their spectrum not).
 fn tag_frequency_photons(traced: &mut [TracedPhotons], records: &mut Vec<FrequencyPhoton>) {
-    // The copy is serial: a memcpy of 6 MB per 10⁵ frequency photons, about a millisecond.
+    // The copy is serial: a memcpy of 8 MB per 10⁵ frequency records, about a millisecond.
     records.clear();
     let mut offsets = Vec::with_capacity(traced.len());
     for chunk in traced.iter() {
