@@ -171,6 +171,8 @@ pub(super) struct FrequencyPhoton {
     field: Spectrum,
     field_lobe: MaterialLobe,
     curvature: f32,
+    /// |cos θi| of the photon's arrival, for the tangential projection of the deposit.
+    mu_i: f32,
     /// Index of its photon in the chunk's `photons`.
     photon: u32,
     spectrum: Spectrum,
@@ -180,14 +182,16 @@ impl FrequencyPhoton {
     fn new(
         photon: u32,
         curvature: f32,
+        mu_i: f32,
         lobe: MaterialLobe,
         spectrum: Spectrum,
         caps: &Caps,
     ) -> Self {
         Self {
-            field: deposit_field(spectrum, curvature, lobe, caps),
+            field: deposit_field(spectrum, curvature, mu_i, lobe, caps),
             field_lobe: lobe,
             curvature,
+            mu_i,
             photon,
             spectrum,
         }
@@ -198,16 +202,29 @@ impl FrequencyPhoton {
         if lobe == self.field_lobe {
             self.field
         } else {
-            deposit_field(self.spectrum, self.curvature, lobe, caps)
+            deposit_field(self.spectrum, self.curvature, self.mu_i, lobe, caps)
         }
     }
 }
 
 /// The field a hitpoint's radius reads (design §8.1): the photon's spectrum reflected by the
-/// hitpoint's lobe, with μo = 1 so that a stays in surface units (b does not depend on μo) and
-/// μi = 1 for the conservative 3D collapse (§8.5: the out-of-plane axis keeps its width).
-fn deposit_field(spectrum: Spectrum, curvature: f32, lobe: MaterialLobe, caps: &Caps) -> Spectrum {
-    spectrum.reflect_isotropic(1.0, f64::from(curvature), spectrum_lobe(lobe), caps)
+/// hitpoint's lobe, with μo = 1 so that a stays in surface units (b does not depend on μo),
+/// under the conservative 3D collapse of §8.5 (the per-coefficient minimum of the tangential
+/// and sagittal reflections at the arrival cosine μi).
+fn deposit_field(
+    spectrum: Spectrum,
+    curvature: f32,
+    mu_i: f32,
+    lobe: MaterialLobe,
+    caps: &Caps,
+) -> Spectrum {
+    spectrum.reflect_isotropic(
+        f64::from(mu_i),
+        1.0,
+        f64::from(curvature),
+        spectrum_lobe(lobe),
+        caps,
+    )
 }
 
 /// [`photon::Photon::tag`] of a photon without a frequency record.
@@ -396,13 +413,14 @@ impl Setup<'_> {
             .then(|| emitter_spectrum(emitter, &self.caps))
     }
 
-    /// Stores the frequency record of a photon with `spectrum` landing at `hit` on a surface
-    /// of lobe `lobe` (the photon is the next one `out` stores), and returns the photon's tag:
-    /// [`UNTAGGED`] for a classical photon.
+    /// Stores the frequency record of a photon with `spectrum` arriving along `ray` at `hit`
+    /// on a surface of lobe `lobe` (the photon is the next one `out` stores), and returns the
+    /// photon's tag: [`UNTAGGED`] for a classical photon.
     #[inline]
     pub(super) fn record_frequency_photon(
         &self,
         spectrum: Option<Spectrum>,
+        ray: &Ray,
         hit: &Hit,
         lobe: MaterialLobe,
         tag_base: u32,
@@ -416,6 +434,7 @@ impl Setup<'_> {
                 out.frequency.push(FrequencyPhoton::new(
                     out.photons.len() as u32,
                     hit.curvature,
+                    ray.direction.dot(hit.shading_normal).abs(),
                     lobe,
                     s,
                     &self.caps,
@@ -513,8 +532,11 @@ fn emitter_spectrum(shape: EmitterShape, caps: &Caps) -> Spectrum {
             Spectrum::area_light(f64::from(size), f64::from(cos_theta), caps)
         }
         EmitterShape::Point => Spectrum::point_light(caps),
-        // A smooth falloff only lowers the angular frequency: the hard cone is conservative.
-        EmitterShape::Spot { cone_angle, .. } => Spectrum::spot_light(f64::from(cone_angle), caps),
+        // The falloff's own variance: narrower than the hard cone's, so the conservative one.
+        EmitterShape::Spot {
+            cone_angle,
+            falloff_start,
+        } => Spectrum::spot_light_smoothstep(f64::from(falloff_start), f64::from(cone_angle), caps),
         EmitterShape::Directional => Spectrum::directional_light(caps),
     }
 }
@@ -551,7 +573,7 @@ pub(super) fn scatter_spectrum(
     } else {
         spectrum_lobe(bsdf.lobe())
     };
-    spectrum.reflect_isotropic(mu_o, curvature, lobe, caps)
+    spectrum.reflect_isotropic(mu_i, mu_o, curvature, lobe, caps)
 }
 
 impl PhotonMapper<'_> {
