@@ -190,7 +190,7 @@ fn golden_path(root: &Path, name: &str) -> PathBuf {
 /// Renders the golden reference of `entry` with the path tracer (never a photon mapper).
 fn bless(root: &Path, entry: &SuiteScene, golden: &Path) -> Result<()> {
     let scene = suite::load_scene(root, entry)?;
-    let mut params = suite::params(entry, ppm::Method::Path, REFERENCE_SEED);
+    let mut params = suite::params(entry, &scene, ppm::Method::Path, REFERENCE_SEED)?;
     params.samples_per_pixel = entry.reference_spp;
     let rendered = suite::render(&scene, params, entry.reference_passes)?;
     std::fs::create_dir_all(golden.parent().context("golden path has a parent")?)?;
@@ -249,7 +249,11 @@ fn check_scene(
     let factor = if flags.full { FULL_FACTOR } else { 1 };
     for method in ppm::Method::ALL {
         let passes = suite::passes(entry, method) * factor;
-        let rendered = suite::render(&scene, suite::params(entry, method, CHECK_SEED), passes)?;
+        let rendered = suite::render(
+            &scene,
+            suite::params(entry, &scene, method, CHECK_SEED)?,
+            passes,
+        )?;
         let errors = image_io::errors(&rendered.image, &reference, Some(&mask))?;
         let tolerance = entry.tolerance.get(method.name()).copied();
         let perturbed = image_io::errors(&scale(&rendered.image, 1.1), &reference, Some(&mask))?;
@@ -319,7 +323,7 @@ fn calibrate(root: &Path, entry: &SuiteScene, seeds: &[u64]) -> Result<()> {
         for &seed in seeds {
             let rendered = suite::render(
                 &scene,
-                suite::params(entry, method, seed),
+                suite::params(entry, &scene, method, seed)?,
                 suite::passes(entry, method),
             )?;
             let e = image_io::errors(&rendered.image, &reference, Some(&mask))?;

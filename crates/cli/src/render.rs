@@ -205,44 +205,30 @@ fn write_images(job: &Job, renderer: &Renderer<'_>, elapsed: Duration) -> anyhow
         || DEFAULT_SCENE_NAME.to_string(),
         |p| p.display().to_string(),
     );
-    let metadata = [
-        ("scene", scene_name),
-        ("method", params.method.name().to_string()),
-        ("passes", renderer.passes().to_string()),
-        ("photons", renderer.photons_emitted().to_string()),
-        ("photons_per_pass", params.photons_per_pass.to_string()),
-        ("seed", params.seed.to_string()),
-        ("alpha", params.alpha.to_string()),
-        ("spp", params.samples_per_pixel.to_string()),
-        ("max_depth", params.max_depth.to_string()),
-        (
-            "render_seconds",
-            format!("{:.3}", job.earlier_seconds + elapsed.as_secs_f64()),
-        ),
-        ("version", env!("CARGO_PKG_VERSION").to_string()),
+    // Every render parameter (`ppm::PARAMS`), so that the image says exactly how it was made.
+    let mut metadata = vec![
+        ("scene".to_owned(), scene_name),
+        ("passes".to_owned(), renderer.passes().to_string()),
+        ("photons".to_owned(), renderer.photons_emitted().to_string()),
     ];
+    metadata.extend(
+        params
+            .entries()
+            .into_iter()
+            .map(|(name, value)| (name.to_owned(), value)),
+    );
+    metadata.push((
+        "render_seconds".to_owned(),
+        format!("{:.3}", job.earlier_seconds + elapsed.as_secs_f64()),
+    ));
+    metadata.push(("version".to_owned(), env!("CARGO_PKG_VERSION").to_owned()));
     let mut frame = Frame {
         width: width as usize,
         height: height as usize,
         beauty: renderer.image(),
         channels: Vec::new(),
-        metadata: metadata
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), v))
-            .collect(),
+        metadata,
     };
-    if params.method.uses_frequency() {
-        frame
-            .metadata
-            .push(("freq_fraction".into(), params.freq_fraction.to_string()));
-        frame
-            .metadata
-            .push(("kernel_k".into(), params.kernel_k.to_string()));
-        frame.metadata.push((
-            "freq_geometry".into(),
-            if params.freq_geometry { "on" } else { "off" }.into(),
-        ));
-    }
     for aov_flag in &job.outputs.aovs {
         for &aov in aov_flag.aovs() {
             match renderer.aov(aov) {
