@@ -10,8 +10,8 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use glam::Vec2;
 
-use crate::image_io::{self, Errors, Image};
 use crate::suite::{self, SuiteScene};
+use film::{Errors, Image};
 
 pub(crate) const HELP: &str = "\
 cargo xtask converge --scene NAME [--budgets 2,4,8,16,32] [--methods ppm,sppm,freq,freq-sppm,path]
@@ -342,7 +342,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
     let golden = root
         .join("tests/golden")
         .join(format!("{}.exr", entry.name));
-    let reference = image_io::read_exr(&golden)
+    let reference = film::read_exr(&golden)
         .with_context(|| format!("run `cargo xtask render-all --bless {}` first", entry.name))?;
     let out = flags.out.clone().map_or_else(
         || {
@@ -439,9 +439,9 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
                 elapsed += flags.clock.since(start);
             }
             let image = Image::new(reference.width, reference.height, renderer.image());
-            let all = image_io::errors(&image, &reference, Some(&transport))?;
+            let all = film::errors(&image, &reference, Some(&transport))?;
             let masked = [0, 1, 2].map(|i| {
-                image_io::errors(&image, &reference, Some(&masks.masks[i])).expect("sizes match")
+                film::errors(&image, &reference, Some(&masks.masks[i])).expect("sizes match")
             });
             println!(
                 "  {:>6.1} s ({:>5} passes): relMSE {:.5}  RMSE {:.5}  mean ratio {:.4}  [low {:.5} caustic {:.5} glossy {:.5}] [mean ratio low {:.4} caustic {:.4} glossy {:.4}]",
@@ -480,18 +480,18 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         }
         let stem = format!("{}-{}", entry.name, method.name());
         let image = Image::new(reference.width, reference.height, renderer.image());
-        image_io::write_png(
+        film::write_preview(
             &out.join(format!("{stem}.png")),
             &image,
-            image_io::auto_exposure(&reference),
+            film::Tonemap::linear(film::auto_exposure(&reference)),
             3,
         )?;
         write_maps(&renderer, &out, &stem, reference.width)?;
     }
-    image_io::write_png(
+    film::write_preview(
         &out.join(format!("{}-reference.png", entry.name)),
         &reference,
-        image_io::auto_exposure(&reference),
+        film::Tonemap::linear(film::auto_exposure(&reference)),
         3,
     )?;
     write_csv(
@@ -558,7 +558,7 @@ pub(crate) fn reference_from_halves(
 
 /// The expected contribution of the reference's noise to a relMSE over `mask`: E[(x − ref)²] =
 /// (x − L)² + Var(ref) for an image x independent of the reference, so this is the mean of
-/// Var(ref) / (ref² + ε) with the relMSE's own normalisation (`image_io::errors`).
+/// Var(ref) / (ref² + ε) with the relMSE's own normalisation (`film::errors`).
 pub(crate) fn noise_rel_mse(variance: &[[f64; 3]], reference: &Image, mask: &[bool]) -> f64 {
     let (mut sum, mut n) = (0.0f64, 0usize);
     for ((v, r), &inside) in variance.iter().zip(&reference.pixels).zip(mask) {
@@ -567,7 +567,7 @@ pub(crate) fn noise_rel_mse(variance: &[[f64; 3]], reference: &Image, mask: &[bo
         }
         for c in 0..3 {
             let y = f64::from(r[c]);
-            sum += v[c] / (y * y + image_io::REL_MSE_EPSILON);
+            sum += v[c] / (y * y + film::REL_MSE_EPSILON);
             n += 1;
         }
     }
@@ -662,14 +662,20 @@ fn write_masks(path: &Path, masks: &Masks, width: usize) -> Result<()> {
             [f(1), 0.6 * f(0), f(2)]
         })
         .collect();
-    image_io::write_png(path, &Image::new(width, n / width, pixels), 1.0, 3)
+    film::write_preview(
+        path,
+        &Image::new(width, n / width, pixels),
+        film::Tonemap::linear(1.0),
+        3,
+    )?;
+    Ok(())
 }
 
 /// Radius map (all photon mappers), frequency radius and held-by-floor maps (frequency methods).
 fn write_maps(renderer: &ppm::Renderer<'_>, out: &Path, stem: &str, width: usize) -> Result<()> {
     if let Some(radius) = renderer.aov(ppm::Aov::Radius) {
         let max = percentile(&radius, 0.99);
-        image_io::write_false_colour(
+        film::write_false_colour(
             &out.join(format!("{stem}-radius.png")),
             width,
             &radius,
@@ -679,7 +685,7 @@ fn write_maps(renderer: &ppm::Renderer<'_>, out: &Path, stem: &str, width: usize
         println!("  radius map: 99th percentile {max:.5} (red)");
     }
     if let Some(held) = renderer.aov(ppm::Aov::FreqHeld) {
-        image_io::write_false_colour(&out.join(format!("{stem}-held.png")), width, &held, 1.0, 3)?;
+        film::write_false_colour(&out.join(format!("{stem}-held.png")), width, &held, 1.0, 3)?;
         let share = held.iter().map(|&v| f64::from(v)).sum::<f64>() / held.len().max(1) as f64;
         println!(
             "  held by the frequency floor: {:.1} % of hitpoints",
@@ -688,7 +694,7 @@ fn write_maps(renderer: &ppm::Renderer<'_>, out: &Path, stem: &str, width: usize
     }
     if let Some(freq) = renderer.aov(ppm::Aov::FreqRadius) {
         let max = percentile(&freq, 0.99);
-        image_io::write_false_colour(
+        film::write_false_colour(
             &out.join(format!("{stem}-freq-radius.png")),
             width,
             &freq,
@@ -975,9 +981,9 @@ fn sweep(
                 elapsed += flags.clock.since(start);
             }
             let image = Image::new(reference.width, reference.height, renderer.image());
-            let e = image_io::errors(&image, reference, Some(&transport))?;
+            let e = film::errors(&image, reference, Some(&transport))?;
             let m = [0, 1, 2].map(|i| {
-                image_io::errors(&image, reference, Some(&masks.masks[i])).expect("sizes match")
+                film::errors(&image, reference, Some(&masks.masks[i])).expect("sizes match")
             });
             println!(
                 "sweep {} {:<9} {:<48} relMSE {:.5} [low {:.5} caustic {:.5} glossy {:.5}] mean {:.4} ({} passes)",

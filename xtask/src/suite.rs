@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use serde::Deserialize;
 
-use crate::image_io::Image;
+use film::Image;
 
 /// The whole suite file.
 #[derive(Debug, Deserialize)]

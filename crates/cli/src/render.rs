@@ -12,7 +12,6 @@ use ppm::{PassStats, Renderer, StateHeader};
 
 use crate::args::{RenderArgs, ResumeArgs};
 use crate::duration;
-use crate::output::{self, Frame};
 use crate::settings::{self, Budget, Job, Note};
 use crate::{DEFAULT_SCENE_NAME, Outcome, usage};
 
@@ -222,13 +221,12 @@ fn write_images(job: &Job, renderer: &Renderer<'_>, elapsed: Duration) -> anyhow
         format!("{:.3}", job.earlier_seconds + elapsed.as_secs_f64()),
     ));
     metadata.push(("version".to_owned(), env!("CARGO_PKG_VERSION").to_owned()));
-    let mut frame = Frame {
-        width: width as usize,
-        height: height as usize,
-        beauty: renderer.image(),
-        channels: Vec::new(),
-        metadata,
-    };
+    let mut frame = film::Frame::new(film::Image::new(
+        width as usize,
+        height as usize,
+        renderer.image(),
+    ));
+    frame.metadata = metadata;
     for aov_flag in &job.outputs.aovs {
         for &aov in aov_flag.aovs() {
             match renderer.aov(aov) {
@@ -240,8 +238,13 @@ fn write_images(job: &Job, renderer: &Renderer<'_>, elapsed: Duration) -> anyhow
             }
         }
     }
-    output::write_exr(&job.outputs.exr, &frame)?;
-    output::write_preview(&job.outputs.png, &frame, job.outputs.tonemap)?;
+    film::write_exr(&job.outputs.exr, &frame)?;
+    film::write_preview(
+        &job.outputs.png,
+        &frame.image,
+        job.outputs.tonemap.film(),
+        1,
+    )?;
     Ok(())
 }
 
@@ -269,10 +272,10 @@ fn write_checkpoint(
     let note = serde_json::to_string(&note)
         .context("internal error: cannot encode the checkpoint note")?;
     let bytes = renderer.save_state(&note);
-    output::write_atomically(path, |w| {
-        std::io::Write::write_all(w, &bytes)?;
-        Ok(())
-    })
+    film::write_atomically(path, |w| {
+        std::io::Write::write_all(w, &bytes).map_err(|e| film::lower_first(&e.to_string()))
+    })?;
+    Ok(())
 }
 
 /// `1.2M`, `350k`, `999`.
