@@ -256,9 +256,8 @@ impl Scene {
     /// The closest hit with 0 < t < `ray.t_max`, or `None`.
     ///
     /// Always inlined, with the triangle hit, so that callers get the `Hit` in registers
-    /// rather than through two copies in memory (4.5 % fewer instructions per photon path with
-    /// the other changes of that round; see `ppm`'s `trace_photon`); the traversal itself stays
-    /// a call ([`Scene::intersect_inlined`] compiles it in too).
+    /// rather than through two copies in memory; the traversal itself stays a call
+    /// ([`Scene::intersect_inlined`] compiles it in too).
     #[inline(always)]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let raw = self.accel.intersect(ray)?;
