@@ -390,7 +390,7 @@ material = "lamp"
     assert_eq!(red.triangles, 12);
     // The Box is a unit cube around the origin; moved to z = −3.
     let bounds = summary.bounds.unwrap();
-    assert!((bounds.min.0.z - -3.5).abs() < 1e-5 && (bounds.max.0.y - 2.0).abs() < 1e-5);
+    assert!((bounds.min.z - -3.5).abs() < 1e-5 && (bounds.max.y - 2.0).abs() < 1e-5);
     // The lamp quad's front is edge1 × edge2 = (0, 0, 2) × (2, 0, 0) = (0, 4, 0): up.
     let quad = scene.triangles.iter().find(|t| t.material == 0).unwrap();
     let [a, b, c] = quad.positions;
