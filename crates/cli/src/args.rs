@@ -41,6 +41,8 @@ pub(crate) struct Cli {
 }
 
 /// The subcommands.
+// Parsed once per process: the size of the render variant does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Subcommand)]
 pub(crate) enum Command {
     /// Render a scene file (.toml, .obj with its .mtl, .gltf, .glb).

@@ -20,7 +20,7 @@ use crate::update::FrequencyFloor;
 const MAGIC: &[u8; 8] = b"FPPMSTAT";
 /// Version of the checkpoint layout; bump it whenever the layout or the meaning of a field
 /// changes, so that old checkpoints are refused rather than misread.
-pub const STATE_VERSION: u32 = 3;
+pub const STATE_VERSION: u32 = 4;
 
 /// Why a checkpoint could not be restored.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -175,6 +175,10 @@ fn write_params(w: &mut Writer, p: &RenderParams) {
     w.u32(u32::from(p.direct_lighting));
     w.u32(u32::from(p.freq_occlusion));
     w.u32(u32::from(p.freq_geometry));
+    w.f64(p.freq_grow);
+    w.f64(p.freq_hold_alpha);
+    w.u32(p.freq_pilot);
+    w.u32(u32::from(p.freq_clear_cap));
 }
 
 fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
@@ -200,6 +204,10 @@ fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
     let direct_lighting = r.bool()?;
     let freq_occlusion = r.bool()?;
     let freq_geometry = r.bool()?;
+    let freq_grow = r.f64()?;
+    let freq_hold_alpha = r.f64()?;
+    let freq_pilot = r.u32()?;
+    let freq_clear_cap = r.bool()?;
     Ok(RenderParams {
         method,
         photons_per_pass,
@@ -215,6 +223,10 @@ fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
         freq_occlusion,
         freq_geometry,
         direct_lighting,
+        freq_grow,
+        freq_hold_alpha,
+        freq_pilot,
+        freq_clear_cap,
     })
 }
 
@@ -321,6 +333,7 @@ fn read_photon_mapper(
                 FrequencyEstimate::from_spectrum(spectrum),
                 normal_distance,
                 clear_level,
+                v[3].dot(v[1]).abs(),
             ),
         });
         stats.push((photon_count, flux));

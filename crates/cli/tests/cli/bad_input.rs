@@ -221,7 +221,7 @@ fn other_flag_ranges() {
     );
     check(
         "aov_method",
-        &["render", CORNELL, "--aov", "freq"],
+        &["render", CORNELL, "--method", "ppm", "--aov", "freq"],
         2,
         &["--aov freq", "frequency method"],
     );

@@ -56,7 +56,7 @@ pub const PARAMS: &[Param] = &[
     Param {
         name: "method",
         flag: "method",
-        help: "Integrator [default: scene's [render] method, else ppm]",
+        help: "Integrator [default: scene's [render] method, else freq-sppm]",
         kind: ParamKind::Value {
             value_name: "METHOD",
             choices: &[
@@ -241,9 +241,63 @@ pub const PARAMS: &[Param] = &[
         },
     },
     Param {
+        name: "freq_grow",
+        flag: "freq-grow",
+        help: "Largest kernel of a frequency method, as a multiple of the initial radius, in [1, 64] [default: 1, measured in docs/integrators.md; 1 never grows a kernel beyond R₀]",
+        kind: ParamKind::Value {
+            value_name: "G",
+            choices: &[],
+        },
+        get: |p| p.freq_grow.to_string(),
+        set: |p, v| {
+            p.freq_grow = parse_number(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "freq_hold_alpha",
+        flag: "freq-hold-alpha",
+        help: "α of a hitpoint held by its frequency radius, in (0, 1] [default: 0.9; 1 keeps the radius for ever, the poster's rule, which does not converge]",
+        kind: ParamKind::Value {
+            value_name: "A",
+            choices: &[],
+        },
+        get: |p| p.freq_hold_alpha.to_string(),
+        set: |p, v| {
+            p.freq_hold_alpha = parse_number(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "freq_pilot",
+        flag: "freq-pilot",
+        help: "Passes of the frequency pilot before the kernels are sized and the statistics restart [default: 4; 0 never grows kernels; only with --freq-grow above 1]",
+        kind: ParamKind::Value {
+            value_name: "N",
+            choices: &[],
+        },
+        get: |p| p.freq_pilot.to_string(),
+        set: |p, v| {
+            let n: i64 = v.parse().map_err(|_| "is not a whole number".to_owned())?;
+            p.freq_pilot = u32::try_from(n).map_err(|_| "is outside [0, 1000000]".to_owned())?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "freq_clear_cap",
+        flag: "freq-clear-cap",
+        help: "Cap every slot's radius of a frequency method at the clear radius of its gather disc (probed at every visible point), not only the held ones",
+        kind: ParamKind::Switch { sets: true },
+        get: |p| on_off(p.freq_clear_cap),
+        set: |p, v| {
+            p.freq_clear_cap = parse_switch(v)?;
+            Ok(())
+        },
+    },
+    Param {
         name: "max_depth",
         flag: "max-depth",
-        help: "Maximum number of scattering events on a light path, in [1, 1024] [default: scene, else 8]",
+        help: "Maximum number of scattering events on a light path, in [1, 1024] [default: scene, else 1024: in effect unlimited, paths end by Russian roulette]",
         kind: ParamKind::Value {
             value_name: "N",
             choices: &[],
@@ -426,6 +480,10 @@ mod tests {
         params.freq_geometry = false;
         params.direct_lighting = true;
         params.alpha = 2.0 / 3.0;
+        params.freq_grow = 2.5;
+        params.freq_hold_alpha = 1.0;
+        params.freq_pilot = 0;
+        params.freq_clear_cap = true;
         for base in [RenderParams::preview(), params] {
             let mut copy = RenderParams::preview();
             copy.method = Method::Path;

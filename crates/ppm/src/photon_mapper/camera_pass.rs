@@ -52,6 +52,8 @@ struct VisiblePoint {
     material: u32,
     weight: Rgb,
     normal_distance: f32,
+    /// |cos θo| of the camera path's last segment at the visible point.
+    mu_o: f32,
     /// Specular bounces of the camera path before this point.
     bounces: u32,
 }
@@ -106,6 +108,7 @@ impl PhotonMapper<'_> {
                 material: 0,
                 weight: Vec3::ZERO,
                 normal_distance: 0.0,
+                mu_o: 1.0,
                 bounces: 0,
             });
             // Visible points have bounces < max_depth ≤ 1024 (`trace_camera_path`).
@@ -122,13 +125,13 @@ impl PhotonMapper<'_> {
                 material_idx: point.material,
                 weight: point.weight,
                 radius: initial_radius,
-                freq: SlotFrequency::new(point.normal_distance),
+                freq: SlotFrequency::new(point.normal_distance, point.mu_o),
             };
             if first {
                 self.slots.push(new);
             } else {
                 self.slots.replace_visible_point(slot, &new);
-                self.slots.columns_mut().freq[slot].move_to(point.normal_distance);
+                self.slots.columns_mut().freq[slot].move_to(point.normal_distance, point.mu_o);
             }
         }
         self.camera_passes += 1;
@@ -163,6 +166,7 @@ impl Setup<'_> {
                 material: hit.material,
                 weight: end.throughput * weight_scale,
                 normal_distance: hit.t * mu,
+                mu_o: mu,
                 bounces: end.bounces,
             }
         });

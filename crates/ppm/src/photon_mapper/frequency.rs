@@ -44,6 +44,14 @@ pub(crate) struct SlotFrequency {
     /// [`GEOMETRY_UNKNOWN`] until it is probed: when the slot first becomes a candidate for
     /// holding, again after every new visible point.
     clear_level: u8,
+    /// |cos θo| toward the camera (or the last specular vertex), in units of 1/65535: with
+    /// `normal_distance` it gives the camera distance of the camera-line radius.
+    mu_o: u16,
+}
+
+/// A cosine in [0, 1] in units of 1/65535.
+fn quantize_cosine(mu: f32) -> u16 {
+    (mu.abs().min(1.0) * f32::from(u16::MAX)).round() as u16
 }
 
 /// [`SlotFrequency::clear_level`] before the probes ran.
@@ -53,9 +61,15 @@ impl SlotFrequency {
     /// No frequency photon merged yet.
     const EMPTY: u8 = 0;
 
-    /// The state of a new visible point at `normal_distance`: nothing merged, not probed.
-    pub(crate) fn new(normal_distance: f32) -> Self {
-        Self::restored(FrequencyEstimate::EMPTY, normal_distance, GEOMETRY_UNKNOWN)
+    /// The state of a new visible point at `normal_distance`, seen at cosine `mu_o`: nothing
+    /// merged, not probed.
+    pub(crate) fn new(normal_distance: f32, mu_o: f32) -> Self {
+        Self::restored(
+            FrequencyEstimate::EMPTY,
+            normal_distance,
+            GEOMETRY_UNKNOWN,
+            mu_o,
+        )
     }
 
     /// The state holding `estimate` at `normal_distance`, with the disc probed to
@@ -64,12 +78,14 @@ impl SlotFrequency {
         estimate: FrequencyEstimate,
         normal_distance: f32,
         clear_level: u8,
+        mu_o: f32,
     ) -> Self {
         let mut freq = Self {
             coefficients: [0; 3],
             normal_distance,
             merged: Self::EMPTY,
             clear_level,
+            mu_o: quantize_cosine(mu_o),
         };
         freq.set_estimate(estimate);
         freq
@@ -77,8 +93,9 @@ impl SlotFrequency {
 
     /// Keeps the merged estimate for a new visible point at `normal_distance`, whose disc is
     /// not probed yet.
-    pub(super) fn move_to(&mut self, normal_distance: f32) {
+    pub(super) fn move_to(&mut self, normal_distance: f32, mu_o: f32) {
         self.normal_distance = normal_distance;
+        self.mu_o = quantize_cosine(mu_o);
         self.clear_level = GEOMETRY_UNKNOWN;
     }
 
@@ -120,20 +137,39 @@ impl SlotFrequency {
     }
 
     /// The frequency radius r_freq of the merged deposits with kernel constant `k` (`None`
-    /// before the first).
+    /// before the first): min(r_x, r_θ) of the poster, where each deposit's a already holds
+    /// the camera-line radius ([`Self::seen_from_camera`]).
     pub(super) fn frequency_radius(&self, k: f64) -> Option<f64> {
         self.estimate().radius(f64::from(self.normal_distance), k)
     }
 
+    /// A deposit's field as this slot reads it: for a glossy field, the camera-line radius
+    /// r_cam of design §8.2 folded into a ([`Spectrum::seen_along_camera_line`]), which sees
+    /// how a highlight narrows along the rays that reach the camera.
+    pub(super) fn seen_from_camera(&self, field: Spectrum, caps: &Caps) -> Spectrum {
+        if field.is_lambertian() {
+            return field;
+        }
+        let mu_o = f64::from(self.mu_o.max(1)) / f64::from(u16::MAX);
+        let camera_distance = f64::from(self.normal_distance) / mu_o;
+        field.seen_along_camera_line(camera_distance, mu_o, caps)
+    }
+
+    /// The clear radius of the slot's gather disc, once probed (levels of `r_top`).
+    pub(super) fn clear_radius(&self, r_top: f64) -> Option<f64> {
+        (self.clear_level != GEOMETRY_UNKNOWN)
+            .then(|| crate::disc::level_radius(self.clear_level, r_top))
+    }
+
     /// The radius below which the slot holds its kernel: the frequency radius r_freq of its
     /// merged deposits (`None` before the first), bounded by the clear radius of its disc
-    /// (levels of `r0`, the initial radius) once probed.
-    pub(super) fn hold_radius(&self, k: f64, r0: f64) -> Option<f64> {
+    /// (levels of `r_top`, the largest kernel, [`Setup::kernel_max`]) once probed.
+    pub(super) fn hold_radius(&self, k: f64, r_top: f64) -> Option<f64> {
         let r_freq = self.frequency_radius(k)?;
         Some(if self.clear_level == GEOMETRY_UNKNOWN {
             r_freq
         } else {
-            r_freq.min(crate::disc::level_radius(self.clear_level, r0))
+            r_freq.min(crate::disc::level_radius(self.clear_level, r_top))
         })
     }
 }
@@ -145,10 +181,10 @@ pub(super) fn hold(
     radius: f64,
     uses_frequency: bool,
     k: f64,
-    r0: f64,
+    r_top: f64,
 ) -> (FrequencyRadius, bool) {
     let r_freq = if uses_frequency {
-        freq.hold_radius(k, r0)
+        freq.hold_radius(k, r_top)
             .map_or(FrequencyRadius::None, FrequencyRadius::Predicted)
     } else {
         FrequencyRadius::None
@@ -171,7 +207,7 @@ pub(super) struct FrequencyPhoton {
     field: Spectrum,
     field_lobe: MaterialLobe,
     curvature: f32,
-    /// |cos θi| of the photon's arrival, for the tangential projection of the deposit.
+    /// |cos θi| of the photon's arrival, for the tangential axis of the deposit.
     mu_i: f32,
     /// Index of its photon in the chunk's `photons`.
     photon: u32,
@@ -209,8 +245,8 @@ impl FrequencyPhoton {
 
 /// The field a hitpoint's radius reads (design §8.1): the photon's spectrum reflected by the
 /// hitpoint's lobe, with μo = 1 so that a stays in surface units (b does not depend on μo),
-/// under the conservative 3D collapse of §8.5 (the per-coefficient minimum of the tangential
-/// and sagittal reflections at the arrival cosine μi).
+/// under the conservative 3D collapse of §8.5 (on the surface, the smaller a and b of the
+/// tangential and sagittal reflections at the arrival cosine μi).
 fn deposit_field(
     spectrum: Spectrum,
     curvature: f32,
@@ -225,6 +261,16 @@ fn deposit_field(
         spectrum_lobe(lobe),
         caps,
     )
+}
+
+/// A frequency photon's field on its way: the spectra of the two tangent axes (design §8.5),
+/// which no single Gaussian bounds after travel. Both are carried along a segment; at a hit
+/// the sharper stands for the photon ([`Spectrum::sharper`]).
+pub(super) type Axes = [Spectrum; 2];
+
+/// The field a photon carrying `axes` has where it lands.
+pub(super) fn arrived(axes: Axes) -> Spectrum {
+    axes[0].sharper(axes[1])
 }
 
 /// [`photon::Photon::tag`] of a photon without a frequency record.
@@ -359,6 +405,7 @@ impl FrequencyDeposits {
             TagLayout::Global => &concatenated[tag as usize],
         };
         let material_idx = slots.material_idx();
+        let slot_freq = slots.freq();
         tagged_gather.accumulate_again(
             &mut self.per_entry,
             |acc: &mut FrequencyEstimate, entry, (_, tag)| {
@@ -368,7 +415,7 @@ impl FrequencyDeposits {
                 let slot = grid_slots[entry as usize] as usize;
                 if let Some(material) = setup.scene.material(material_idx[slot]) {
                     let field = record(tag).field(material.kind.lobe(), &setup.caps);
-                    acc.deposit(field, policy);
+                    acc.deposit(slot_freq[slot].seen_from_camera(field, &setup.caps), policy);
                 }
             },
         );
@@ -408,20 +455,31 @@ impl Setup<'_> {
     /// The spectrum a photon path `index` starts with from `emitter`, if it is a frequency
     /// photon.
     #[inline]
-    pub(super) fn start_spectrum(&self, index: u64, emitter: EmitterShape) -> Option<Spectrum> {
-        self.is_frequency_photon(index)
-            .then(|| emitter_spectrum(emitter, &self.caps))
+    pub(super) fn start_spectrum(&self, index: u64, emitter: EmitterShape) -> Option<Axes> {
+        self.is_frequency_photon(index).then(|| {
+            let s = emitter_spectrum(emitter, &self.caps);
+            [s, s]
+        })
     }
 
-    /// Stores the frequency record of a photon with `spectrum` arriving along `ray` at `hit`
-    /// on a surface of lobe `lobe` (the photon is the next one `out` stores), and returns the
-    /// photon's tag: [`UNTAGGED`] for a classical photon.
+    /// The largest gather radius a slot can have: the initial radius, times `freq_grow` for a
+    /// frequency method that grows kernels.
+    pub(super) fn kernel_max(&self) -> f64 {
+        match self.params.growth_pass() {
+            Some(_) => self.kernel_scale * self.params.freq_grow,
+            None => self.kernel_scale,
+        }
+    }
+
+    /// Stores the frequency record of a photon with `spectrum` landing at `hit` on a surface
+    /// of lobe `lobe` (the photon is the next one `out` stores), and returns the photon's tag:
+    /// [`UNTAGGED`] for a classical photon.
     #[inline]
     pub(super) fn record_frequency_photon(
         &self,
-        spectrum: Option<Spectrum>,
-        ray: &Ray,
+        spectrum: Option<Axes>,
         hit: &Hit,
+        arrived_from: Vec3,
         lobe: MaterialLobe,
         tag_base: u32,
         out: &mut TracedPhotons,
@@ -429,14 +487,14 @@ impl Setup<'_> {
         match spectrum {
             // A chunk stores at most PHOTON_CHUNK × max_depth ≤ 2²¹ records, so the index
             // fits (see `TagLayout`).
-            Some(s) => {
+            Some(axes) => {
                 let tag = tag_base | out.frequency.len() as u32;
                 out.frequency.push(FrequencyPhoton::new(
                     out.photons.len() as u32,
                     hit.curvature,
-                    ray.direction.dot(hit.shading_normal).abs(),
+                    arrived_from.dot(hit.shading_normal).abs(),
                     lobe,
-                    s,
+                    arrived(axes),
                     &self.caps,
                 ));
                 tag
@@ -460,14 +518,29 @@ impl Setup<'_> {
     /// Cost: one shadow ray per segment of a frequency photon, a few more near shadow edges.
     pub(super) fn travel_spectrum(
         &self,
-        s: Spectrum,
+        axes: Axes,
         ray: &Ray,
         hit: &Hit,
         sampler: &mut Sampler,
-    ) -> Spectrum {
+    ) -> Axes {
+        let distance = f64::from(hit.t);
+        let caps = &self.caps;
+        match self.occlusion(ray, hit, sampler) {
+            None => axes.map(|s| s.travel(distance, caps)),
+            Some((t_b, o)) => axes.map(|s| {
+                s.travel(t_b, caps)
+                    .occlude(o, caps)
+                    .travel(distance - t_b, caps)
+            }),
+        }
+    }
+
+    /// The partial occlusion of the segment `ray` → `hit` (see [`Self::travel_spectrum`]): the
+    /// blocker's distance along the segment and the window's spectral variance o, or `None`.
+    fn occlusion(&self, ray: &Ray, hit: &Hit, sampler: &mut Sampler) -> Option<(f64, f64)> {
         let distance = f64::from(hit.t);
         if !self.params.freq_occlusion {
-            return s.travel(distance, &self.caps);
+            return None;
         }
         let u = sampler.next_2d();
         // Offsets in the receiver's tangent plane, so that the probe's target lies on the
@@ -481,9 +554,9 @@ impl Setup<'_> {
             let length = to_target.length();
             Ray::new(ray.origin, to_target, length * (1.0 - CONTACT_FRACTION))
         };
-        let w = (2.0 * self.kernel_scale) as f32;
+        let w = (2.0 * self.kernel_max()) as f32;
         if !self.scene.occluded(&probe(w)) {
-            return s.travel(distance, &self.caps);
+            return None;
         }
         // Bisect the offset of the shadow edge: unblocked at `lo`, blocked at `hi`. The probes
         // only ask whether they are blocked (`Scene::occluded`, any hit, no `Hit` built); the
@@ -501,16 +574,15 @@ impl Setup<'_> {
         }
         // `occluded` and `intersect` agree on whether a ray is blocked (tested in geometry);
         // `None` cannot happen, and would mean no occlusion.
-        let Some(t_blocker) = self.scene.intersect(&probe(hi)).map(|hit| hit.t) else {
-            return s.travel(distance, &self.caps);
-        };
+        let t_blocker = self.scene.intersect(&probe(hi)).map(|hit| hit.t)?;
         let t_b = f64::from(t_blocker).clamp(0.0, distance);
-        let delta = f64::from(lo.max(w / 64.0));
+        // The offset lies in the receiver's tangent plane; the gap that matters is across the
+        // photon's ray, shorter at grazing incidence by the sine between `side` and the ray.
+        let across = (side - ray.direction * side.dot(ray.direction)).length();
+        let delta = f64::from(lo.max(w / 64.0) * across);
         let gap = (delta * t_b / distance).max(1e-9);
         let o = 1.0 / (4.0 * std::f64::consts::PI.powi(2) * gap * gap);
-        s.travel(t_b, &self.caps)
-            .occlude(o, &self.caps)
-            .travel(distance - t_b, &self.caps)
+        Some((t_b, o))
     }
 }
 
@@ -532,7 +604,7 @@ fn emitter_spectrum(shape: EmitterShape, caps: &Caps) -> Spectrum {
             Spectrum::area_light(f64::from(size), f64::from(cos_theta), caps)
         }
         EmitterShape::Point => Spectrum::point_light(caps),
-        // The falloff's own variance: narrower than the hard cone's, so the conservative one.
+        // The falloff's own variance: narrower than the hard cone's, the conservative side.
         EmitterShape::Spot {
             cone_angle,
             falloff_start,
@@ -541,17 +613,18 @@ fn emitter_spectrum(shape: EmitterShape, caps: &Caps) -> Spectrum {
     }
 }
 
-/// The photon's spectrum after scattering at `hit` into `sample.incoming` (the new travel
-/// direction), under the conservative isotropic 3D collapse of design §8.5.
+/// The photon's field after scattering at `hit` into `sample.incoming` (the new travel
+/// direction): the two tangent axes of design §8.5 from the field it arrived with.
 pub(super) fn scatter_spectrum(
-    spectrum: Spectrum,
+    axes: Axes,
     hit: &Hit,
     arrived_from: Vec3,
     sample: &geometry::BsdfSample,
     bsdf: &Bsdf,
     material: &geometry::Material,
     caps: &Caps,
-) -> Spectrum {
+) -> Axes {
+    let spectrum = arrived(axes);
     let normal = hit.shading_normal;
     let mu_i = f64::from(arrived_from.dot(normal).abs());
     let mu_o = f64::from(sample.incoming.dot(normal).abs());
@@ -566,23 +639,24 @@ pub(super) fn scatter_spectrum(
         } else {
             (ior, 1.0)
         };
-        return spectrum.refract(eta_i, eta_t, mu_i, mu_o, curvature, caps);
+        return spectrum.refract_axes(eta_i, eta_t, mu_i, mu_o, curvature, caps);
     }
     let lobe = if sample.is_specular {
         Lobe::Mirror
     } else {
         spectrum_lobe(bsdf.lobe())
     };
-    spectrum.reflect_isotropic(mu_i, mu_o, curvature, lobe, caps)
+    spectrum.reflect_axes(mu_i, mu_o, curvature, lobe, caps)
 }
 
 impl PhotonMapper<'_> {
     /// Probes the clear radius ([`crate::disc::clear_level`]) of every valid slot that has
-    /// become a candidate for holding (R ≤ r_freq) and has not been probed at its visible
-    /// point, in parallel. Deterministic: the probes use no random numbers.
-    pub(super) fn probe_clear_radii(&mut self) {
+    /// become a candidate for holding (R ≤ r_freq; with `all`, every slot with a frequency
+    /// radius) and has not been probed at its visible point, in parallel. Deterministic: the
+    /// probes use no random numbers.
+    pub(super) fn probe_clear_radii(&mut self, all: bool) {
         let k = self.setup.params.kernel_k;
-        let r0 = self.setup.kernel_scale as f32;
+        let r_top = self.setup.kernel_max();
         let slots = &self.slots;
         let scene = self.setup.scene;
         let probed: Vec<(usize, u8)> = (0..slots.len())
@@ -594,15 +668,17 @@ impl PhotonMapper<'_> {
                     return None;
                 }
                 // Not probed yet, so this is the unbounded frequency radius.
-                let r_freq = freq.hold_radius(k, self.setup.kernel_scale)?;
-                if slots.radius()[slot] > r_freq {
-                    return None;
+                if !all {
+                    let r_freq = freq.hold_radius(k, r_top)?;
+                    if slots.radius()[slot] > r_freq {
+                        return None;
+                    }
                 }
                 let level = crate::disc::clear_level(
                     scene,
                     slots.position()[slot],
                     slots.geometric_normal()[slot],
-                    r0,
+                    r_top as f32,
                 );
                 Some((slot, level))
             })
@@ -611,5 +687,79 @@ impl PhotonMapper<'_> {
         for (slot, level) in probed {
             columns.freq[slot].clear_level = level;
         }
+    }
+
+    /// The end of the pilot (at the start of pass [`RenderParams::growth_pass`], once the
+    /// visible points of the pass are traced): every valid slot with a frequency radius takes
+    /// the radius min(r_freq, clear radius, [`Setup::kernel_max`]) if that is larger than its
+    /// own, and every slot's statistics restart (N = 0, τ = 0; the image then counts the
+    /// photons emitted from this pass on). Growing a radius after flux was gathered is not a
+    /// rescale (the flux outside the old disc was never counted), hence the restart.
+    ///
+    /// [`RenderParams::growth_pass`]: crate::RenderParams::growth_pass
+    pub(super) fn grow_kernels(&mut self) {
+        self.probe_clear_radii(true);
+        let k = self.setup.params.kernel_k;
+        let r_top = self.setup.kernel_max();
+        let valid: Vec<bool> = (0..self.slots.len()).map(|s| self.is_valid(s)).collect();
+        let columns = self.slots.columns_mut();
+        columns
+            .radius
+            .par_iter_mut()
+            .zip(columns.photon_count.par_iter_mut())
+            .zip(columns.flux.par_iter_mut())
+            .zip(columns.freq.par_iter())
+            .zip(valid.par_iter())
+            .for_each(|((((radius, count), flux), freq), &valid)| {
+                if valid && let Some(target) = freq.hold_radius(k, r_top) {
+                    *radius = radius.max(target.min(r_top));
+                }
+                *count = 0.0;
+                *flux = [0.0; 3];
+            });
+    }
+}
+
+#[cfg(test)]
+mod radius_tests {
+    use super::*;
+
+    #[test]
+    fn glossy_deposits_carry_the_camera_line_radius() {
+        // A point light 1 m from a sharp glossy surface, seen from 3 m (design §8.2's example
+        // of what the slices miss): the slices a and b are both wide, yet the highlight is
+        // narrow along the camera's rays. The slot must predict the camera-line radius, far
+        // below the poster's min(r_x, r_θ) of the same field.
+        let caps = Caps::for_scene_size(10.0);
+        let field = Spectrum::point_light(&caps).travel(1.0, &caps).reflect(
+            1.0,
+            1.0,
+            0.0,
+            Lobe::Ggx { roughness: 0.1 },
+            &caps,
+        );
+        let (z, mu_o, k) = (3.0f32, 1.0f32, spectrum::K_STRICT);
+        let slot = SlotFrequency::new(z, mu_o);
+        let mut estimate = FrequencyEstimate::EMPTY;
+        estimate.deposit(
+            slot.seen_from_camera(field, &caps),
+            spectrum::MergePolicy::MinRadius,
+        );
+        let slot = SlotFrequency::restored(estimate, z, GEOMETRY_UNKNOWN, mu_o);
+        let poster = field.radius(f64::from(z), k);
+        let r_cam = field.camera_line_radius(f64::from(z), 1.0, k);
+        let got = slot.frequency_radius(k).unwrap();
+        assert!(r_cam < 0.5 * poster, "{r_cam} vs {poster}");
+        // (A point light's field is perfectly correlated, a_cam = 0: the caps' finest detail
+        // a_min bounds it.)
+        let expected = r_cam.max(spectrum::spatial_radius(caps.a_min(), k));
+        assert!(
+            (got - expected).abs() <= 1e-9 * expected,
+            "{got} vs {expected}"
+        );
+        // A Lambertian field is read as it is.
+        let lambert = field.bandlimit(Lobe::Lambert, &caps);
+        assert!(lambert.is_lambertian());
+        assert_eq!(slot.seen_from_camera(lambert, &caps), lambert);
     }
 }

@@ -183,6 +183,17 @@ impl<'s> PhotonMapper<'s> {
         self.n_emitted
     }
 
+    /// Photons the statistics count: all that were emitted, less those of the pilot once the
+    /// kernels were sized and the statistics restarted (every pass emits `photons_per_pass`).
+    fn photons_counted(&self) -> u64 {
+        match self.setup.params.growth_pass() {
+            Some(p) if self.pass > p => {
+                self.n_emitted - u64::from(p) * u64::from(self.setup.params.photons_per_pass)
+            }
+            _ => self.n_emitted,
+        }
+    }
+
     /// Whether `slot` holds a visible point in the current pass.
     #[must_use]
     fn is_valid(&self, slot: usize) -> bool {
@@ -258,13 +269,17 @@ impl<'s> PhotonMapper<'s> {
         let stochastic = self.setup.params.method.is_stochastic();
         let retrace = self.slots.is_empty() || stochastic;
         self.camera_pass(retrace);
+        let grow = self.setup.params.growth_pass() == Some(self.pass);
+        if grow {
+            self.grow_kernels();
+        }
         stats.camera_paths = self.slots.len() as u64;
         let camera = clock.elapsed().as_secs_f64();
         let photon_bounces = &self.photon_bounces;
         self.index.update(
             &self.slots,
             |slot| photon_bounces[slot] != NO_VISIBLE_POINT,
-            !stochastic,
+            !stochastic && !grow,
         );
         let index = clock.elapsed().as_secs_f64() - camera;
         self.photon_pass(&mut stats);
@@ -292,7 +307,7 @@ impl<'s> PhotonMapper<'s> {
         let radius = self.slots.radius();
         let count = self.slots.photon_count();
         let flux = self.slots.flux();
-        let n_emitted = self.n_emitted as f64;
+        let n_emitted = self.photons_counted() as f64;
         let camera_passes = f64::from(self.camera_passes.max(1));
         image.par_iter_mut().enumerate().for_each(|(pixel, out)| {
             let mut sum = [0.0f64; 3];
@@ -341,7 +356,7 @@ impl<'s> PhotonMapper<'s> {
                         Aov::PhotonCount => Some(slots.photon_count()[slot]),
                         Aov::FreqRadius => freq.frequency_radius(k),
                         _ => Some(
-                            freq.hold_radius(k, self.setup.kernel_scale)
+                            freq.hold_radius(k, self.setup.kernel_max())
                                 .map_or(0.0, |r| f64::from(u8::from(slots.radius()[slot] <= r))),
                         ),
                     };

@@ -84,8 +84,8 @@ impl Setup<'_> {
             if !bsdf.is_specular() && !counted_by_light_sampling {
                 let tag = self.record_frequency_photon(
                     spectrum,
-                    &ray,
                     &hit,
+                    incoming,
                     material.kind.lobe(),
                     tag_base,
                     out,

@@ -1,5 +1,5 @@
 //! Phase 4 of a pass: the hitpoint update. Every slot folds the pass's M and Φ into its R, N
-//! and τ by [`GatherStats::update`], with the frequency radius `frequency::hold` gives it.
+//! and τ by [`GatherStats::update_with_hold`], with the frequency radius `frequency::hold` gives it.
 
 use std::time::Instant;
 
@@ -19,10 +19,15 @@ impl PhotonMapper<'_> {
         let uses_frequency = params.method.uses_frequency();
         let probe_clock = Instant::now();
         if uses_frequency && params.freq_geometry {
-            self.probe_clear_radii();
+            self.probe_clear_radii(params.freq_clear_cap);
         }
         let probe_seconds = probe_clock.elapsed().as_secs_f64();
-        let r0 = self.setup.kernel_scale;
+        let r_top = self.setup.kernel_max();
+        let hold_alpha = params.freq_hold_alpha;
+        let clear_cap = uses_frequency && params.freq_geometry && params.freq_clear_cap;
+        // The cap never goes below a quarter of the initial radius: a smaller disc collects
+        // too few photons per pass for its bias gain to pay (measured, docs/integrators.md).
+        let r_min = 0.25 * self.setup.kernel_scale;
         let photons = &self.photons;
         let n_slots = self.slots.len();
         let columns = self.slots.columns_mut();
@@ -34,13 +39,16 @@ impl PhotonMapper<'_> {
             .zip(columns.freq.par_iter())
             .zip((0..n_slots).into_par_iter().map(|s| photons.deposit_of(s)))
             .map(|((((radius, photon_count), tau), freq), (m, phi))| {
-                let (r_freq, held) = frequency::hold(freq, *radius, uses_frequency, k, r0);
+                let (r_freq, held) = frequency::hold(freq, *radius, uses_frequency, k, r_top);
                 let mut stats = GatherStats {
                     radius: *radius,
                     photon_count: *photon_count,
                     flux: *tau,
                 };
-                stats.update(m, phi, alpha, r_freq, floor);
+                stats.update_with_hold(m, phi, alpha, r_freq, floor, hold_alpha);
+                if clear_cap && let Some(clear) = freq.clear_radius(r_top) {
+                    stats.cap_radius(clear.max(r_min));
+                }
                 *radius = stats.radius;
                 *photon_count = stats.photon_count;
                 *tau = stats.flux;
