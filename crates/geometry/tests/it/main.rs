@@ -5,6 +5,7 @@
 mod bad_input;
 mod cylinder;
 mod gltf;
+mod mitsuba;
 mod obj;
 mod shared_scenes;
 mod toml_scene;
