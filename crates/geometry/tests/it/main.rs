@@ -7,6 +7,7 @@ mod cylinder;
 mod gltf;
 mod mitsuba;
 mod obj;
+mod pbrt;
 mod shared_scenes;
 mod toml_scene;
 

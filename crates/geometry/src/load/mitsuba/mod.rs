@@ -744,7 +744,11 @@ impl<'a> Importer<'a> {
                 ));
                 MaterialKind::Glossy {
                     reflectance: specular * f0,
-                    roughness: alpha.max(SMOOTH_COAT_ALPHA),
+                    roughness: if alpha > 0.0 {
+                        alpha
+                    } else {
+                        SMOOTH_COAT_ALPHA
+                    },
                     diffuse: diffuse * (1.0 - f0),
                 }
             }
