@@ -8,4 +8,5 @@
 )]
 
 mod architecture;
+mod mitsuba_roundtrip;
 mod shared_scenes;

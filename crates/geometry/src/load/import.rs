@@ -182,6 +182,28 @@ impl Builder {
     /// Adds a mesh transformed by `to_world`. A transform that mirrors (negative determinant)
     /// swaps the winding so that the front face follows the transformed normals.
     pub(crate) fn mesh(&mut self, mesh: &IndexedMesh, to_world: Mat4, material: u32) {
+        if to_world == Mat4::IDENTITY {
+            // Keep the file's numbers bit for bit (no renormalised normals).
+            for face in &mesh.indices {
+                let positions = face.map(|i| mesh.positions[i as usize]);
+                let n = mesh
+                    .normals
+                    .as_ref()
+                    .map(|ns| {
+                        face.map(|i| {
+                            let v = ns[i as usize];
+                            if v.is_normalized() {
+                                v
+                            } else {
+                                v.normalize_or_zero()
+                            }
+                        })
+                    })
+                    .filter(|n| n.iter().all(|v| *v != Vec3::ZERO));
+                self.triangle(positions, n, material);
+            }
+            return;
+        }
         let normal_matrix = Mat3::from_mat4(to_world).inverse().transpose();
         let flip = to_world.determinant() < 0.0;
         let world: Vec<Vec3> = mesh
@@ -354,9 +376,9 @@ pub(crate) fn cylinder(
     material: u32,
     emissive: bool,
 ) {
-    let axis = p1 - p0;
+    let axis = (p1 - p0).normalize_or(Vec3::Z);
     let u = axis.any_orthonormal_vector();
-    let v = axis.normalize_or_zero().cross(u);
+    let v = axis.cross(u);
     let w0 = to_world.transform_point3(p0);
     let w1 = to_world.transform_point3(p1);
     let wu = to_world.transform_vector3(u * radius);

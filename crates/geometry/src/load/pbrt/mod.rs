@@ -517,7 +517,9 @@ impl Parser {
                 let which = match tokens.get(*i).map(|t| &t.tok) {
                     Some(Tok::Word(w)) => w.clone(),
                     _ => {
-                        return Err(self.err(loc, "ActiveTransform needs StartTime, EndTime or All"));
+                        return Err(
+                            self.err(loc, "ActiveTransform needs StartTime, EndTime or All")
+                        );
                     }
                 };
                 *i += 1;
