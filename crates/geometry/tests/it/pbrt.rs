@@ -37,18 +37,19 @@ fn ply_faces(path: &Path) -> usize {
 /// (triangles, emissive triangles, emissive spheres, directional lights, materials) expected of
 /// each shared scene, and how they were derived.
 fn expected(rel: &str) -> (usize, usize, usize, usize, usize) {
-    // The killeroo's Loop control mesh (the importer's stand-in): indices / 3.
+    // The killeroo's Loop control mesh: indices / 3 (8,316) triangles, times 4 per level of
+    // subdivision (SOURCE.md: 33,264 after one level, 532,224 after three).
     let killeroo = index_count(&pbrt("killeroos/geometry/killeroo.pbrt")) / 3;
     match rel {
-        // Two killeroos, two 2-triangle quads (trianglemesh, 6 indices each), one sphere light.
-        // Materials: the light's, the floor/wall diffuse, two coateddiffuse.
+        // Two killeroos (levels 1), two 2-triangle quads (trianglemesh, 6 indices each), one
+        // sphere light. Materials: the light's, the floor/wall diffuse, two coateddiffuse.
         "killeroos/killeroo-simple.pbrt" | "killeroos/killeroo-moving.pbrt" => {
-            (2 * killeroo + 4, 0, 1, 0, 4)
+            (2 * 4 * killeroo + 4, 0, 1, 0, 4)
         }
-        // One killeroo (killeroo3.pbrt differs only in its levels), three textured quads, a
-        // 64-triangle disk light, the distant light. Materials: light, textured diffuse, gold.
+        // One killeroo (killeroo3.pbrt: levels 3), three textured quads, a 64-triangle disk
+        // light, the distant light. Materials: light, textured diffuse, gold.
         "killeroos/killeroo-gold.pbrt" | "killeroos/killeroo-coated-gold.pbrt" => {
-            (killeroo + 6 + 64, 64, 0, 1, 3)
+            (64 * killeroo + 6 + 64, 64, 0, 1, 3)
         }
         // Four plates and the floor from their PLY headers; five sphere lights; materials: five
         // lights (each its own L), four plates, the floor.

@@ -17,7 +17,9 @@
 //!   front only (`twosided` is warned).
 //! - `Integrator "maxdepth"` is fppm's `max_depth` (both count scattering events).
 //! - Motion blur (`ActiveTransform`) keeps the shutter-open transform, with a warning.
+//! - `loopsubdiv` is subdivided as pbrt does it (`loop_subdiv.rs`).
 
+mod loop_subdiv;
 mod tokenizer;
 
 use std::collections::HashMap;
@@ -1494,12 +1496,6 @@ impl Parser {
                 } else {
                     idx.chunks(3).map(|t| [t[0], t[1], t[2]]).collect()
                 };
-                if shape.kind == "loopsubdiv" {
-                    builder.warn(format!(
-                        "{label}: Loop subdivision is not supported; the control mesh stands in (levels {} ignored)",
-                        self.int(p, "levels")?.unwrap_or(3)
-                    ));
-                }
                 if shape.kind == "bilinearmesh" {
                     builder.warn(format!(
                         "{label}: each bilinear patch is split into two triangles"
@@ -1512,7 +1508,23 @@ impl Parser {
                 };
                 mesh.check_indices()
                     .map_err(|m| self.err(loc, format!("{label}: {m}")))?;
-                mesh
+                if shape.kind == "loopsubdiv" {
+                    let levels = self.int(p, "levels")?.unwrap_or(3);
+                    let levels = u32::try_from(levels)
+                        .ok()
+                        .filter(|&l| {
+                            l <= 12 && (mesh.indices.len() << (2 * l)) <= loop_subdiv::MAX_TRIANGLES
+                        })
+                        .ok_or_else(|| {
+                            self.err(
+                                loc,
+                                format!("{label}: {levels} levels would make too many triangles"),
+                            )
+                        })?;
+                    loop_subdiv::subdivide(&mesh.positions, &mesh.indices, levels)
+                } else {
+                    mesh
+                }
             }
             "plymesh" => {
                 let file = self
