@@ -9,4 +9,5 @@
 
 mod architecture;
 mod mitsuba_roundtrip;
+mod pbrt_by_hand;
 mod shared_scenes;
