@@ -222,4 +222,17 @@ mod tests {
         let err = parse_ply(Path::new("bad.ply"), bad.as_bytes()).unwrap_err();
         assert!(err.to_string().contains("refers to vertex 9"), "{err}");
     }
+
+    #[test]
+    fn gzipped_ply_is_read() {
+        use std::io::Write;
+        let dir = std::env::temp_dir().join(format!("fppm-ply-gz-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("quad.ply.gz");
+        let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+        gz.write_all(ASCII_QUAD.as_bytes()).unwrap();
+        std::fs::write(&path, gz.finish().unwrap()).unwrap();
+        let mesh = load_ply(&path).unwrap();
+        assert_eq!(mesh.indices.len(), 2);
+    }
 }

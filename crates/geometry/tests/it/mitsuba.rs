@@ -332,3 +332,62 @@ fn no_emitter_at_all_is_an_error() {
     assert!(matches!(err, LoadError::NoSupportedEmitter { .. }), "{err}");
     assert_message(&err, &path, &["<emitter type=\"constant\">"]);
 }
+
+#[test]
+fn missing_texture_file() {
+    let (err, path) = load_edited(
+        "mitsuba_missing_texture",
+        "<rgb name=\"reflectance\" value=\"0.8\"/>",
+        "<texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"wood.png\"/></texture>",
+    );
+    assert_message(
+        &err.unwrap_err(),
+        &path,
+        &[
+            "line 4",
+            "<texture type=\"bitmap\"",
+            "wood.png",
+            "cannot read file",
+        ],
+    );
+}
+
+#[test]
+fn serialized_shape_index_out_of_range() {
+    let path = mitsuba("common/meshes/matpreview.serialized");
+    let scene = BASE.replacen(
+        "<shape type=\"rectangle\">",
+        &format!(
+            "<shape type=\"serialized\"><string name=\"filename\" value=\"{}\"/><integer name=\"shape_index\" value=\"3\"/>",
+            path.display()
+        ),
+        1,
+    );
+    let file = fixture("mitsuba_serialized_index", &[("scene.xml", &scene)]);
+    let err = load(&file).unwrap_err();
+    assert_message(
+        &err,
+        &file,
+        &[
+            "line 6",
+            "shape_index 3 is out of range (the file holds 3 meshes)",
+        ],
+    );
+}
+
+/// Scenes of version 0.6 use camelCase names and `<lookAt>`; they are upgraded as Mitsuba does.
+#[test]
+fn version_0_6_names_are_upgraded() {
+    let old = BASE
+        .replace("version=\"3.0.0\"", "version=\"0.6.0\"")
+        .replace("<lookat ", "<lookAt ")
+        .replace("name=\"to_world\"", "name=\"toWorld\"")
+        .replace(
+            "<sensor type=\"perspective\">",
+            "<integrator type=\"path\"><integer name=\"maxDepth\" value=\"4\"/></integrator>\n    <sensor type=\"perspective\">",
+        );
+    let path = fixture("mitsuba_v06", &[("scene.xml", &old)]);
+    let scene = load(&path).unwrap();
+    assert_eq!(scene.render.max_depth, Some(3));
+    assert_eq!(scene.camera.position, glam::Vec3::new(0.0, 0.0, 4.0));
+}

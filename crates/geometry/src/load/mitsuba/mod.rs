@@ -900,6 +900,9 @@ impl<'a> Importer<'a> {
                     .unwrap_or(DVec3::ZERO)
                     .as_vec3();
                 let radius = self.float(node, "radius")?.unwrap_or(1.0) as f32;
+                if !(radius > 0.0 && radius.is_finite()) {
+                    return Err(self.err(node, format!("radius must be > 0, got {radius}")));
+                }
                 if flip {
                     self.builder
                         .warn(format!("{label}: flip_normals is ignored on a sphere"));
@@ -911,6 +914,9 @@ impl<'a> Importer<'a> {
                 let p0 = self.vector(node, "p0")?.unwrap_or(DVec3::ZERO).as_vec3();
                 let p1 = self.vector(node, "p1")?.unwrap_or(DVec3::Z).as_vec3();
                 let radius = self.float(node, "radius")?.unwrap_or(1.0) as f32;
+                if !(radius > 0.0 && radius.is_finite()) || (p1 - p0).length() <= 0.0 {
+                    return Err(self.err(node, "a cylinder needs radius > 0 and p0 != p1"));
+                }
                 if flip {
                     self.builder
                         .warn(format!("{label}: flip_normals is ignored on a cylinder"));

@@ -1576,6 +1576,11 @@ impl Parser {
                 let radius = self.float(p, "radius")?.unwrap_or(1.0) as f32;
                 let zmin = self.float(p, "zmin")?.unwrap_or(-1.0) as f32;
                 let zmax = self.float(p, "zmax")?.unwrap_or(1.0) as f32;
+                if !(radius > 0.0 && radius.is_finite() && zmax != zmin) {
+                    return Err(
+                        self.err(loc, format!("{label}: needs radius > 0 and zmin != zmax"))
+                    );
+                }
                 if self.float(p, "phimax")?.is_some_and(|x| x < 360.0) {
                     builder.warn(format!("{label}: phimax is ignored (a whole cylinder)"));
                 }
