@@ -4,12 +4,14 @@
 //! - `render-all`: golden-image checks of every method against path-traced references.
 //! - `converge`: error versus time of every method on one scene (CSV, SVG plots, masks, maps).
 //! - `docs-image`: renders the CLI's default scene for `docs/default-scene.png`.
+//! - `peers`: equal-time comparison with Mitsuba 3 against pixel-averaged references.
 
 #![allow(clippy::print_stdout, clippy::print_stderr, clippy::unwrap_used)]
 
 mod converge;
 mod docs_image;
 mod image_io;
+mod peers;
 mod render_all;
 mod suite;
 #[cfg(test)]
@@ -24,7 +26,8 @@ cargo xtask <command> [flags]
 commands:
   render-all   golden-image check of every scene of tests/scenes.toml (see `render-all --help`)
   converge     error-versus-time study of one scene (see `converge --help`)
-  docs-image   render docs/default-scene.png with the fppm binary";
+  docs-image   render docs/default-scene.png with the fppm binary
+  peers        equal-time comparison with Mitsuba 3 (see `peers --help`)";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -38,6 +41,7 @@ fn main() -> ExitCode {
             "render-all" => render_all::HELP,
             "converge" => converge::HELP,
             "docs-image" => docs_image::HELP,
+            "peers" => peers::HELP,
             _ => HELP,
         };
         println!("{help}");
@@ -52,6 +56,7 @@ fn main() -> ExitCode {
         "render-all" => render_all::run(&root, rest),
         "converge" => converge::run(&root, rest),
         "docs-image" => docs_image::run(&root, rest),
+        "peers" => peers::run(&root, rest),
         other => {
             eprintln!("xtask: unknown command `{other}`\n\n{HELP}");
             return ExitCode::from(2);

@@ -14,8 +14,8 @@
 //!   Emission leaves front faces only; a dielectric's outside is its front.
 //! - [`Hit::curvature`] is signed as in frequency-algebra §3: positive when the centre of curvature
 //!   lies on the side the ray came from (a sphere: −1/R from outside, +1/R from inside). It is
-//!   the mean curvature: a cylinder, curved by 1/R around its axis and not along it, gives
-//!   ∓1/(2R); frequency analysis of the focusing around the axis would want the 1/R itself.
+//!   the largest principal curvature from that side, the one that focuses most: a cylinder,
+//!   curved by 1/R around its axis and not along it, gives 0 from outside and +1/R from inside.
 //! - Secondary rays ([`Hit::spawn_ray`], [`Hit::spawn_ray_to`]) start off the surface by pbrt-v4's
 //!   floating-point error bound, so they neither re-hit their surface nor slip through corners.
 //! - Refraction scales radiance by 1/η′² on camera paths only ([`TransportMode`]).

@@ -79,12 +79,14 @@ pub struct Hit {
     pub front_face: bool,
     /// Index into [`crate::SceneDescription::materials`].
     pub material: u32,
-    /// Signed mean curvature seen from the side the ray came from, following frequency-algebra §3:
-    /// positive when the centre of curvature lies on the ray's side (concave, focusing).
-    /// A sphere is exactly −1/R from outside and +1/R from inside; a cylinder reports its mean
-    /// curvature, −1/(2R) from outside and +1/(2R) from inside (its curvature around the axis,
-    /// the one that focuses in a plane across the axis, is twice that); a mesh triangle gets the mean
-    /// over its edges of −Δn·Δp/|Δp|² from its vertex normals; flat or normal-less triangles give 0.
+    /// The most focusing curvature seen from the side the ray came from: the largest signed
+    /// principal curvature, following frequency-algebra §3 (positive when the centre of
+    /// curvature lies on the ray's side: concave, focusing). Under the isotropic collapse of
+    /// §8.5 it is the conservative choice (the smallest predicted kernels).
+    /// A sphere is exactly −1/R from outside and +1/R from inside; a cylinder 0 from outside
+    /// (flat along its axis) and +1/R from inside (focusing across its axis, at R/2); a mesh
+    /// triangle the largest over its edges of the normal curvature −Δn·Δp/|Δp|² from its vertex
+    /// normals (signed for the side); flat or normal-less triangles give 0.
     pub curvature: f32,
     /// The primitive that was hit.
     pub primitive: Primitive,

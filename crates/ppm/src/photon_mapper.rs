@@ -942,6 +942,7 @@ impl<'s> PhotonMapper<'s> {
                         out.frequency.push(FrequencyPhoton::new(
                             out.photons.len() as u32,
                             hit.curvature,
+                            ray.direction.dot(hit.shading_normal).abs(),
                             material.kind.lobe(),
                             s,
                             &self.caps,
@@ -1291,6 +1292,8 @@ struct FrequencyPhoton {
     field: Spectrum,
     field_lobe: MaterialLobe,
     curvature: f32,
+    /// |cos θi| of the photon's arrival, for the tangential projection of the deposit.
+    mu_i: f32,
     /// Index of its photon in the chunk's `photons`.
     photon: u32,
     spectrum: Spectrum,
@@ -1300,14 +1303,16 @@ impl FrequencyPhoton {
     fn new(
         photon: u32,
         curvature: f32,
+        mu_i: f32,
         lobe: MaterialLobe,
         spectrum: Spectrum,
         caps: &Caps,
     ) -> Self {
         Self {
-            field: deposit_field(spectrum, curvature, lobe, caps),
+            field: deposit_field(spectrum, curvature, mu_i, lobe, caps),
             field_lobe: lobe,
             curvature,
+            mu_i,
             photon,
             spectrum,
         }
@@ -1318,16 +1323,29 @@ impl FrequencyPhoton {
         if lobe == self.field_lobe {
             self.field
         } else {
-            deposit_field(self.spectrum, self.curvature, lobe, caps)
+            deposit_field(self.spectrum, self.curvature, self.mu_i, lobe, caps)
         }
     }
 }
 
 /// The field a hitpoint's radius reads (design §8.1): the photon's spectrum reflected by the
-/// hitpoint's lobe, with μo = 1 so that a stays in surface units (b does not depend on μo) and
-/// μi = 1 for the conservative 3D collapse (§8.5: the out-of-plane axis keeps its width).
-fn deposit_field(spectrum: Spectrum, curvature: f32, lobe: MaterialLobe, caps: &Caps) -> Spectrum {
-    spectrum.reflect_isotropic(1.0, f64::from(curvature), spectrum_lobe(lobe), caps)
+/// hitpoint's lobe, with μo = 1 so that a stays in surface units (b does not depend on μo),
+/// under the conservative 3D collapse of §8.5 (the per-coefficient minimum of the tangential
+/// and sagittal reflections at the arrival cosine μi).
+fn deposit_field(
+    spectrum: Spectrum,
+    curvature: f32,
+    mu_i: f32,
+    lobe: MaterialLobe,
+    caps: &Caps,
+) -> Spectrum {
+    spectrum.reflect_isotropic(
+        f64::from(mu_i),
+        1.0,
+        f64::from(curvature),
+        spectrum_lobe(lobe),
+        caps,
+    )
 }
 
 /// [`Photon::tag`] of a photon without a frequency record.
@@ -1491,8 +1509,11 @@ fn emitter_spectrum(shape: EmitterShape, caps: &Caps) -> Spectrum {
             Spectrum::area_light(f64::from(size), f64::from(cos_theta), caps)
         }
         EmitterShape::Point => Spectrum::point_light(caps),
-        // A smooth falloff only lowers the angular frequency: the hard cone is conservative.
-        EmitterShape::Spot { cone_angle, .. } => Spectrum::spot_light(f64::from(cone_angle), caps),
+        // The falloff's own variance: narrower than the hard cone's, so the conservative one.
+        EmitterShape::Spot {
+            cone_angle,
+            falloff_start,
+        } => Spectrum::spot_light_smoothstep(f64::from(falloff_start), f64::from(cone_angle), caps),
         EmitterShape::Directional => Spectrum::directional_light(caps),
     }
 }
@@ -1529,7 +1550,7 @@ fn scatter_spectrum(
     } else {
         spectrum_lobe(bsdf.lobe())
     };
-    spectrum.reflect_isotropic(mu_o, curvature, lobe, caps)
+    spectrum.reflect_isotropic(mu_i, mu_o, curvature, lobe, caps)
 }
 
 #[cfg(test)]

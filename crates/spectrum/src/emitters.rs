@@ -55,6 +55,42 @@ impl Spectrum {
         Spectrum::finish(0.0, b, 0.0, false, caps)
     }
 
+    /// A spot light whose intensity falls off smoothly between the half-angles θstart and
+    /// θcone \[rad\] (pbrt-v4's `smoothstep(cos θ; cos θcone, cos θstart)`, full inside
+    /// θstart, none outside θcone): the Gaussian of the profile's own angular variance,
+    ///
+    /// `a = a_min`, `b = 2π²·∫θ²I(θ)dθ / ∫I(θ)dθ`, `c = 0`.
+    ///
+    /// The falloff concentrates the light inside the cone, so its variance is below the
+    /// hard cone's θcone²/3 and its prediction the more conservative (smaller b, sharper);
+    /// θstart ≥ θcone is the hard cone, [`Spectrum::spot_light`]. The integral is a fixed
+    /// 256-point midpoint rule (exact to ~10⁻⁵ relative).
+    #[must_use]
+    pub fn spot_light_smoothstep(falloff_start: f64, cone: f64, caps: &Caps) -> Self {
+        const STEPS: u32 = 256;
+        let cone = if cone.is_finite() { cone.abs() } else { 0.0 };
+        let start = if falloff_start.is_finite() {
+            falloff_start.abs().min(cone)
+        } else {
+            cone
+        };
+        let (cos_cone, cos_start) = (cone.cos(), start.cos());
+        let (mut moment, mut mass) = (0.0, 0.0);
+        for i in 0..STEPS {
+            let theta = cone * (f64::from(i) + 0.5) / f64::from(STEPS);
+            let w = if cos_start > cos_cone {
+                let t = ((theta.cos() - cos_cone) / (cos_start - cos_cone)).clamp(0.0, 1.0);
+                t * t * (3.0 - 2.0 * t)
+            } else {
+                1.0
+            };
+            moment += w * theta * theta;
+            mass += w;
+        }
+        let variance = if mass > 0.0 { moment / mass } else { 0.0 };
+        Spectrum::finish(0.0, TWO_PI_SQ * variance, 0.0, false, caps)
+    }
+
     /// A directional light of infinite extent: `a = a_max`, `b = b_min`, `c = 0`.
     /// Travel leaves it unchanged (up to the caps).
     #[must_use]

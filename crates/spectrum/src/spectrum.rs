@@ -268,14 +268,72 @@ impl Spectrum {
         }
     }
 
-    /// [`Spectrum::reflect`] under the conservative 3D collapse of the isotropic model:
-    /// the projection in is skipped (μi = 1 in the formulas), so
-    /// `a' = μo²·a`, `c' = μo·(c − 2κ·a)`, `b' = b − 4κ·c + 4κ²·a + 2π²σρ²`.
+    /// The reflections of the two tangent axes (design §8.5), `[tangential, sagittal]`:
     ///
-    /// Pass |κ|max or the mean curvature, whichever gives the smaller result.
+    /// - in the plane of incidence (tangential), [`Spectrum::reflect`] itself: the
+    ///   footprint scales by m = μo/μi and the curvature kicks by g = 2κ/μi;
+    /// - across it (sagittal), nothing is foreshortened (m = 1) and the curvature kicks by
+    ///   g = 2κ·μi (a concave mirror focuses a collimated beam at R/(2μi) there, at R·μi/2
+    ///   in the plane); the lobe adds the same b_ρ.
+    ///
+    /// Neither axis alone is conservative, and no single Gaussian lies below both after
+    /// every travel distance, so a photon carries both to its next hit and keeps the sharper
+    /// there ([`Spectrum::sharper`]). Pass the curvature that focuses most from the arriving
+    /// side (the largest principal curvature, positive when concave).
     #[must_use]
-    pub fn reflect_isotropic(self, mu_o: f64, curvature: f64, lobe: Lobe, caps: &Caps) -> Self {
-        self.reflect(1.0, mu_o, curvature, lobe, caps)
+    pub fn reflect_axes(
+        self,
+        mu_i: f64,
+        mu_o: f64,
+        curvature: f64,
+        lobe: Lobe,
+        caps: &Caps,
+    ) -> [Self; 2] {
+        let mu_i = clamp_mu(mu_i);
+        let tangential = self.reflect(mu_i, mu_o, curvature, lobe, caps);
+        let g = 2.0 * curvature * mu_i;
+        let a = self.a;
+        let c = self.c - g * self.a;
+        let b = overflow_to_inf(self.b + g * (g * self.a - 2.0 * self.c));
+        let sagittal = match lobe.bandwidth() {
+            None => Self::finish(a, b, c, true, caps),
+            Some(b_rho) => Self::finish(a, b + b_rho, c, false, caps),
+        };
+        [tangential, sagittal]
+    }
+
+    /// The field on the surface under the conservative 3D collapse (design §8.5): of the two
+    /// axes of [`Spectrum::reflect_axes`], the smaller a and the smaller b, with c capped
+    /// into a semi-definite form. Right at the surface (no travel) this predicts no larger a
+    /// kernel than either axis: it is what a hitpoint reads from a photon.
+    #[must_use]
+    pub fn reflect_isotropic(
+        self,
+        mu_i: f64,
+        mu_o: f64,
+        curvature: f64,
+        lobe: Lobe,
+        caps: &Caps,
+    ) -> Self {
+        let [t, s] = self.reflect_axes(mu_i, mu_o, curvature, lobe, caps);
+        Self::finish(
+            t.a.min(s.a),
+            t.b.min(s.b),
+            t.c.min(s.c),
+            t.lambertian && s.lambertian,
+            caps,
+        )
+    }
+
+    /// Of two forms, the one that predicts the smaller kernel here: the smaller a (then the
+    /// smaller b). Used where a photon that carried both axes' spectra arrives at a surface.
+    #[must_use]
+    pub fn sharper(self, other: Self) -> Self {
+        if (other.a, other.b) < (self.a, self.b) {
+            other
+        } else {
+            self
+        }
     }
 
     /// Refraction through a smooth interface from index ηi to ηt, at incident and
@@ -307,6 +365,32 @@ impl Spectrum {
         let c = t * (s * self.c + h * self.a);
         let b = overflow_to_inf(s * s * self.b + h * (2.0 * s * self.c + h * self.a));
         Self::finish(a, b, c, false, caps)
+    }
+
+    /// The refractions of the two tangent axes (design §8.5), `[tangential, sagittal]`: the
+    /// tangential one is [`Spectrum::refract`]; across the plane of incidence nothing is
+    /// foreshortened (t = 1), angles scale by s = ηi/ηt and the curvature kicks by
+    /// h = (ηt·μt − ηi·μi)·κ/ηt (Coddington's oblique power, in reduced angles). As for
+    /// [`Spectrum::reflect_axes`], a photon carries both to its next hit.
+    #[must_use]
+    pub fn refract_axes(
+        self,
+        eta_i: f64,
+        eta_t: f64,
+        mu_i: f64,
+        mu_t: f64,
+        curvature: f64,
+        caps: &Caps,
+    ) -> [Self; 2] {
+        let tangential = self.refract(eta_i, eta_t, mu_i, mu_t, curvature, caps);
+        let (eta_i, eta_t) = (clamp_eta(eta_i), clamp_eta(eta_t));
+        let (mu_i, mu_t) = (clamp_mu(mu_i), clamp_mu(mu_t));
+        let s = eta_i / eta_t;
+        let h = (eta_t * mu_t - eta_i * mu_i) * curvature / eta_t;
+        let a = self.a;
+        let c = s * self.c + h * self.a;
+        let b = overflow_to_inf(s * s * self.b + h * (2.0 * s * self.c + h * self.a));
+        [tangential, Self::finish(a, b, c, false, caps)]
     }
 
     /// BRDF band-limit: the outgoing field is the incoming one convolved in angle with

@@ -246,7 +246,8 @@ fn normals_front_face_and_curvature() {
     assert!(h.front_face);
     assert!(h.geometric_normal.distance(Vec3::X) < 1e-6);
     assert_eq!(h.shading_normal, h.geometric_normal);
-    assert!((h.curvature + 0.5).abs() < 1e-6, "{}", h.curvature);
+    // Flat along the axis: the larger principal curvature from outside is 0.
+    assert!(h.curvature.abs() < 1e-6, "{}", h.curvature);
     assert!((h.uv.y - 0.5).abs() < 1e-6);
     // From inside: the back, concave.
     let h = scene
@@ -255,9 +256,10 @@ fn normals_front_face_and_curvature() {
     assert!((h.t - 1.0).abs() < 1e-6);
     assert!(!h.front_face);
     assert!(h.geometric_normal.distance(-Vec3::X) < 1e-6);
-    assert!((h.curvature - 0.5).abs() < 1e-6, "{}", h.curvature);
+    // Concave across the axis: 1/R, the curvature that focuses.
+    assert!((h.curvature - 1.0).abs() < 1e-6, "{}", h.curvature);
     assert!((h.uv.y - 0.75).abs() < 1e-6);
-    // The curvature is the mean, 1/(2R), for any radius.
+    // 1/R from inside and 0 from outside, for any radius.
     let scene = scene_of(
         vec![],
         vec![cylinder(Vec3::ZERO, Vec3::Y, 0.25, 1.0, 360.0, Vec3::Z)],
@@ -265,7 +267,11 @@ fn normals_front_face_and_curvature() {
     let h = scene
         .intersect(&Ray::infinite(Vec3::new(3.0, 0.5, 0.0), -Vec3::X))
         .unwrap();
-    assert!((h.curvature + 2.0).abs() < 1e-5, "{}", h.curvature);
+    assert!(h.curvature.abs() < 1e-6, "{}", h.curvature);
+    let h = scene
+        .intersect(&Ray::infinite(Vec3::new(0.0, 0.5, 0.0), Vec3::X))
+        .unwrap();
+    assert!((h.curvature - 4.0).abs() < 1e-5, "{}", h.curvature);
     // A ray along the axis never meets an open cylinder.
     let scene = scene_of(vec![], vec![upright(360.0, Vec3::Z)]);
     assert!(
@@ -548,9 +554,12 @@ fn mirror_focuses_a_collimated_beam_at_half_the_radius() {
         let ray = Ray::infinite(Vec3::new(-0.5, 0.5, offset), Vec3::X);
         let h = scene.intersect(&ray).unwrap();
         assert!(!h.front_face);
-        // Paraxial focal length f = 1/(2κ) with κ = 1/R the curvature around the axis, twice the
-        // reported mean curvature.
-        assert!((h.curvature - 0.5 / radius).abs() < 1e-6);
+        // The reported curvature focuses where the traced rays do: f = 1/(2κ) = R/2.
+        assert!(
+            (0.5 / h.curvature - radius / 2.0).abs() < 1e-5,
+            "{}",
+            h.curvature
+        );
         let n = h.shading_normal;
         let reflected = ray.direction - 2.0 * ray.direction.dot(n) * n;
         let s = -h.position.z / reflected.z;

@@ -76,8 +76,8 @@ struct TriangleExtra {
     lower: Vec3A,
     /// Per-axis maximum of the vertices.
     upper: Vec3A,
-    /// Curvature seen from the front side.
-    front_curvature: f32,
+    /// The focusing curvature (see [`Hit::curvature`]) seen from the front and from the back.
+    curvature: [f32; 2],
 }
 
 /// A scene ready for ray queries, camera rays, BSDFs and light sampling.
@@ -377,7 +377,7 @@ impl Scene {
             shading_normal: shading_normal.into(),
             front_face,
             material: tri.material,
-            curvature: sign * extra.front_curvature,
+            curvature: extra.curvature[usize::from(!front_face)],
             primitive: Primitive::Triangle(index),
             uv: Vec2::new(b1, b2),
         }
@@ -424,11 +424,12 @@ impl Scene {
         let position_error =
             gamma(16.0) * (position.abs() + c.center.abs() + Vec3::splat(c.radius + c.height));
         let front_face = outward.dot(ray.direction) < 0.0;
-        let mean_curvature = 0.5 / c.radius;
+        // Principal curvatures 1/R around the axis and 0 along it: from outside (convex) the
+        // larger is 0, from inside (concave) 1/R.
         let (normal, curvature) = if front_face {
-            (outward, -mean_curvature)
+            (outward, 0.0)
         } else {
-            (-outward, mean_curvature)
+            (-outward, 1.0 / c.radius)
         };
         let angle = outward
             .dot(c.axis.cross(c.facing))
@@ -492,31 +493,33 @@ fn valid_material(m: &Material) -> bool {
 fn triangle_extra(tri: &crate::Triangle) -> TriangleExtra {
     let [p0, p1, p2] = tri.positions;
     let front_normal = (p1 - p0).cross(p2 - p0).normalize_or_zero();
-    let front_curvature = match tri.normals {
+    // The normal curvature along each edge, −Δn·Δp/|Δp|² from the front side, lies between
+    // the principal curvatures; the largest from each side stands for the most focusing one.
+    let curvature = match tri.normals {
         Some(mut n) => {
             // Orient the vertex normals to the front side, as the shading normal is.
             if (n[0] + n[1] + n[2]).dot(front_normal) < 0.0 {
                 n = n.map(|v| -v);
             }
-            let mut sum = 0.0;
+            let (mut front, mut back) = (f32::NEG_INFINITY, f32::NEG_INFINITY);
             for (a, b) in [(0, 1), (1, 2), (2, 0)] {
                 let dp = tri.positions[b] - tri.positions[a];
                 let dn = n[b] - n[a];
                 let len2 = dp.length_squared();
-                if len2 > 0.0 {
-                    sum += dn.dot(dp) / len2;
-                }
+                let k = if len2 > 0.0 { -dn.dot(dp) / len2 } else { 0.0 };
+                let k = if k.is_finite() { k } else { 0.0 };
+                front = front.max(k);
+                back = back.max(-k);
             }
-            let k = -sum / 3.0;
-            if k.is_finite() { k } else { 0.0 }
+            [front, back]
         }
-        None => 0.0,
+        None => [0.0, 0.0],
     };
     // The centroid and the bounds are the same expressions `triangle_hit` evaluated per hit
     // before they were hoisted here, so hits are bit-identical.
     TriangleExtra {
         front_normal: front_normal.into(),
-        front_curvature,
+        curvature,
         centroid: ((p0 + p1 + p2) / 3.0).into(),
         lower: p0.min(p1).min(p2).into(),
         upper: p0.max(p1).max(p2).into(),

@@ -492,3 +492,45 @@ fn hits_closer_than_obvhs_epsilon() {
         }
     }
 }
+
+#[test]
+fn mesh_curvature_is_the_focusing_principal_curvature() {
+    // A tessellated open cylinder of radius 0.5 about y with exact vertex normals, CCW seen
+    // from outside: principal curvatures 1/R across the axis and 0 along it. From inside the
+    // reported curvature must be the focusing 1/R = 2 (not the mean 1/(2R)); from outside
+    // the larger of −1/R and 0, i.e. 0.
+    let r = 0.5;
+    let n_phi = 64;
+    let ring = |j: usize| {
+        let phi = std::f32::consts::TAU * j as f32 / n_phi as f32;
+        Vec3::new(phi.cos(), 0.0, -phi.sin())
+    };
+    let mut tris = Vec::new();
+    for j in 0..n_phi {
+        let (n0, n1) = (ring(j), ring(j + 1));
+        let (a, b) = (n0 * r, n1 * r);
+        let (c, d) = (b + Vec3::Y, a + Vec3::Y);
+        for ([p, q, s], normals) in [([a, b, c], [n0, n1, n1]), ([a, c, d], [n0, n1, n0])] {
+            tris.push(Triangle {
+                positions: [p, q, s],
+                normals: Some(normals),
+                material: 0,
+            });
+        }
+    }
+    let scene = Scene::new(description(tris, vec![], vec![point_light(Vec3::Y * 0.5)])).unwrap();
+    let outside = scene
+        .intersect(&Ray::infinite(Vec3::new(3.0, 0.5, 0.01), -Vec3::X))
+        .unwrap();
+    assert!(outside.front_face);
+    assert!(outside.curvature.abs() < 0.02, "{}", outside.curvature);
+    let inside = scene
+        .intersect(&Ray::infinite(Vec3::new(0.0, 0.5, 0.01), Vec3::X))
+        .unwrap();
+    assert!(!inside.front_face);
+    assert!(
+        (inside.curvature - 2.0).abs() < 0.02,
+        "{}",
+        inside.curvature
+    );
+}

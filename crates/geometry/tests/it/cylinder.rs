@@ -161,7 +161,7 @@ material = \"silver\"
     assert_eq!(h.primitive, Primitive::Cylinder(0));
     assert!(!h.front_face);
     assert!((h.position.z + 0.5).abs() < 1e-5);
-    assert!((h.curvature - 1.0).abs() < 1e-5); // +1/(2R), concave
+    assert!((h.curvature - 2.0).abs() < 1e-5); // +1/R, concave across the axis
 }
 
 #[track_caller]

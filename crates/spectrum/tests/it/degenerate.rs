@@ -117,7 +117,7 @@ proptest! {
             q.project_in(mu_i, &caps),
             q.project_out(mu_o, &caps),
             q.reflect(mu_i, mu_o, kappa, lobe, &caps),
-            q.reflect_isotropic(mu_o, kappa, lobe, &caps),
+            q.reflect_isotropic(mu_i, mu_o, kappa, lobe, &caps),
             q.refract(eta_i, eta_t, mu_i, mu_o, kappa, &caps),
             q.bandlimit(lobe, &caps),
             q.occlude(o, &caps),

@@ -108,7 +108,7 @@ proptest! {
             q.project_in(mu_i, &caps),
             q.project_out(mu_o, &caps),
             q.reflect(mu_i, mu_o, kappa, lobe, &caps),
-            q.reflect_isotropic(mu_o, kappa, lobe, &caps),
+            q.reflect_isotropic(mu_i, mu_o, kappa, lobe, &caps),
             q.refract(1.0, eta, mu_i, refracted_cosine(1.0, eta, mu_i).unwrap_or(0.0), kappa, &caps),
             q.bandlimit(lobe, &caps),
             q.occlude(o, &caps),

@@ -37,6 +37,9 @@ macro_rules! assert_abc {
 
 mod support;
 
+/// The conservative 3D collapse against explicit tangential and sagittal maps.
+mod collapse;
+
 /// Degenerate and wild inputs never give NaN or a non-PSD form.
 mod degenerate;
 /// The hitpoint accumulator and its merge policies.

@@ -1,0 +1,53 @@
+"""Render a Mitsuba 3 scene for a wall-clock budget (used by `cargo xtask peers`).
+
+usage: render_mitsuba.py SCENE.xml INTEGRATOR SECONDS OUT.exr THREADS SEED [VARIANT]
+
+Renders in chunks of samples with distinct seeds, each chunk sized to take about a second,
+and stops before the next chunk would pass the budget; the image is the sample-weighted mean
+of the chunks (the same estimator as one render with all the samples). Prints one JSON line:
+seconds, samples per pixel, chunks, variant.
+"""
+import json
+import sys
+import time
+
+import drjit as dr
+import mitsuba as mi
+import numpy as np
+
+
+def main() -> None:
+    scene_path, integrator, seconds, out, threads, seed = sys.argv[1:7]
+    variant = sys.argv[7] if len(sys.argv) > 7 else "llvm_ad_rgb"
+    seconds, threads, seed = float(seconds), int(threads), int(seed)
+    start = time.perf_counter()
+    mi.set_variant(variant)
+    dr.set_thread_count(threads)
+    scene = mi.load_file(scene_path, integrator=integrator)
+    total = None
+    spp_done = 0
+    chunks = 0
+    chunk = 1
+    while True:
+        t0 = time.perf_counter()
+        image = np.array(mi.render(scene, spp=chunk, seed=seed * 1_000_003 + chunks), dtype=np.float64)
+        took = time.perf_counter() - t0
+        total = image * chunk if total is None else total + image * chunk
+        spp_done += chunk
+        chunks += 1
+        elapsed = time.perf_counter() - start
+        rate = chunk / max(took, 1e-6)
+        remaining = seconds - elapsed
+        if remaining <= 0:
+            break
+        chunk = max(1, min(int(rate * min(1.0, remaining)), 4096))
+        if chunk / rate > remaining * 1.05 + 0.05:
+            break
+    result = (total / spp_done).astype(np.float32)
+    mi.Bitmap(result[:, :, :3]).write(out)
+    print(json.dumps({"seconds": time.perf_counter() - start, "spp": spp_done, "chunks": chunks,
+                      "variant": variant}))
+
+
+if __name__ == "__main__":
+    main()

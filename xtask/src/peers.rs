@@ -1,0 +1,603 @@
+//! `cargo xtask peers`: equal-time comparison of fppm's methods with Mitsuba 3 (`path`, and
+//! `ptracer`, a light tracer) on the scenes of `scenes/peers/`, scored against a pixel-averaged
+//! Mitsuba `path` reference whose own noise is measured from two independent halves.
+//!
+//! Mitsuba runs from a Python venv this command creates (`target/peers-venv`, `pip install
+//! mitsuba drjit numpy`); nothing in the normal test suite needs it. Each scene is exported to
+//! Mitsuba XML from fppm's own loaded description ([`write_mitsuba`]), so both renderers read
+//! the same geometry, materials and camera.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use glam::{Vec2, Vec3};
+
+use crate::converge::{noise_rel_mse, reference_from_halves};
+use crate::image_io::{self, Image};
+
+pub(crate) const HELP: &str = "\
+cargo xtask peers [--scenes a,b,...] [--seconds 60] [--film WxH] [--threads 2]
+                  [--methods freq-sppm,sppm,freq,ppm] [--peers path,ptracer]
+                  [--reference-seconds 1200] [--out DIR] [--fppm-args \"...\"]
+
+Renders every scene of scenes/peers/ (or those named) with each fppm method and each Mitsuba 3
+integrator for the same wall-clock time, one renderer at a time, all with --threads threads,
+and scores them against a Mitsuba `path` reference (max_depth unlimited) rendered as two
+independent halves of --reference-seconds / 2 each (kept in DIR/SCENE/ and reused; delete them
+to re-render). Reports relMSE (mean of (x - ref)^2 / (ref^2 + 0.01)) over all pixels and over
+the pixels whose first hit is diffuse, the reference's own noise in the same units, and the
+image mean over the reference's. Writes DIR/SCENE/*.exr and DIR/table.md; DIR defaults to
+target/peers. The Mitsuba venv is created in target/peers-venv on first use (pip install
+mitsuba drjit numpy; the llvm_ad_rgb variant needs Debian's libllvm19).";
+
+/// The scenes of the comparison, in `scenes/peers/`.
+const SCENES: [&str; 4] = [
+    "box-glass-mirror",
+    "ring-caustic",
+    "room-indirect",
+    "pool-caustic",
+];
+
+struct Flags {
+    scenes: Vec<String>,
+    seconds: f64,
+    film: Option<(u32, u32)>,
+    threads: u32,
+    methods: Vec<String>,
+    peers: Vec<String>,
+    reference_seconds: f64,
+    out: Option<PathBuf>,
+    fppm_args: Vec<String>,
+}
+
+impl Flags {
+    fn parse(args: &[String]) -> Result<Self> {
+        let mut flags = Flags {
+            scenes: SCENES.iter().map(|s| (*s).to_owned()).collect(),
+            seconds: 60.0,
+            film: None,
+            threads: 2,
+            methods: ["freq-sppm", "sppm", "freq", "ppm"]
+                .map(str::to_owned)
+                .to_vec(),
+            peers: ["path", "ptracer"].map(str::to_owned).to_vec(),
+            reference_seconds: 1200.0,
+            out: None,
+            fppm_args: Vec::new(),
+        };
+        let mut it = args.iter();
+        while let Some(flag) = it.next() {
+            let mut value = || {
+                it.next()
+                    .cloned()
+                    .with_context(|| format!("{flag} needs a value"))
+            };
+            let list = |v: String| v.split(',').map(str::to_owned).collect::<Vec<_>>();
+            match flag.as_str() {
+                "--scenes" => flags.scenes = list(value()?),
+                "--seconds" => flags.seconds = value()?.parse().context("--seconds")?,
+                "--film" => {
+                    let v = value()?;
+                    let (w, h) = v.split_once('x').context("--film WxH")?;
+                    flags.film = Some((w.parse()?, h.parse()?));
+                }
+                "--threads" => flags.threads = value()?.parse().context("--threads")?,
+                "--methods" => flags.methods = list(value()?),
+                "--peers" => {
+                    let v = value()?;
+                    flags.peers = if v.is_empty() { Vec::new() } else { list(v) };
+                }
+                "--reference-seconds" => {
+                    flags.reference_seconds = value()?.parse().context("--reference-seconds")?;
+                }
+                "--out" => flags.out = Some(PathBuf::from(value()?)),
+                "--fppm-args" => {
+                    flags.fppm_args = value()?.split_whitespace().map(str::to_owned).collect();
+                }
+                other => bail!("unknown flag {other} (see cargo xtask peers --help)"),
+            }
+        }
+        if !(flags.seconds > 0.0 && flags.reference_seconds > 0.0) {
+            bail!("--seconds and --reference-seconds must be positive");
+        }
+        Ok(flags)
+    }
+}
+
+/// One scored render.
+struct Row {
+    scene: String,
+    renderer: String,
+    seconds: f64,
+    rel_mse: f64,
+    rel_mse_diffuse: f64,
+    mean_ratio: f64,
+    note: String,
+}
+
+pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
+    let flags = Flags::parse(args)?;
+    let out = flags
+        .out
+        .clone()
+        .unwrap_or_else(|| root.join("target/peers"));
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let python = ensure_venv(root)?;
+    let script = root.join("xtask/peers/render_mitsuba.py");
+    let fppm = build_fppm(root)?;
+
+    let mut rows = Vec::new();
+    let mut noise_lines = Vec::new();
+    for name in &flags.scenes {
+        let scene_path = root.join("scenes/peers").join(format!("{name}.toml"));
+        let mut description = geometry::load(&scene_path)
+            .with_context(|| format!("loading {}", scene_path.display()))?;
+        if let Some((w, h)) = flags.film {
+            description.film.width = w;
+            description.film.height = h;
+        }
+        let (width, height) = (description.film.width, description.film.height);
+        let dir = out.join(name);
+        let xml = write_mitsuba(&description, &dir.join("mitsuba"))?;
+        let scene = geometry::Scene::new(description)?;
+        let diffuse = diffuse_first_hit_mask(&scene, width as usize, height as usize);
+
+        // The reference: two independent halves.
+        let halves = ["ref-a", "ref-b"].map(|h| dir.join(format!("{h}.exr")));
+        for (seed, half) in halves.iter().enumerate() {
+            if !half.exists() {
+                eprintln!(
+                    "{name}: Mitsuba path reference half {} ({} s)",
+                    seed + 1,
+                    flags.reference_seconds / 2.0
+                );
+                run_mitsuba(
+                    &python,
+                    &script,
+                    &xml,
+                    "path",
+                    flags.reference_seconds / 2.0,
+                    half,
+                    flags.threads,
+                    1000 + seed as u32,
+                )?;
+            }
+        }
+        let (a, b) = (
+            image_io::read_exr(&halves[0])?,
+            image_io::read_exr(&halves[1])?,
+        );
+        let (pixels, variance) = reference_from_halves(&a.pixels, &b.pixels);
+        let reference = Image::new(a.width, a.height, pixels);
+        let all = vec![true; diffuse.len()];
+        noise_lines.push(format!(
+            "| {name} | {:.6} | {:.6} | {:.4} |",
+            noise_rel_mse(&variance, &reference, &all),
+            noise_rel_mse(&variance, &reference, &diffuse),
+            reference.mean()
+        ));
+
+        for method in &flags.methods {
+            let file = dir.join(format!("fppm-{method}.exr"));
+            eprintln!("{name}: fppm {method} for {} s", flags.seconds);
+            let clock = Instant::now();
+            let status = Command::new(&fppm)
+                .arg("render")
+                .arg(&scene_path)
+                .args(["--method", method])
+                .args(["--time", &format!("{}ms", (flags.seconds * 1000.0) as u64)])
+                .args(["--threads", &flags.threads.to_string()])
+                .args([
+                    "--width",
+                    &width.to_string(),
+                    "--height",
+                    &height.to_string(),
+                ])
+                .args(&flags.fppm_args)
+                .arg("--quiet")
+                .arg("-o")
+                .arg(&file)
+                .status()
+                .context("running fppm")?;
+            if !status.success() {
+                bail!("fppm render of {name} with {method} failed");
+            }
+            let seconds = clock.elapsed().as_secs_f64();
+            rows.push(score(
+                name,
+                &format!("fppm {method}"),
+                seconds,
+                &file,
+                &reference,
+                &diffuse,
+                "",
+            )?);
+        }
+        for integrator in &flags.peers {
+            let file = dir.join(format!("mitsuba-{integrator}.exr"));
+            eprintln!("{name}: Mitsuba {integrator} for {} s", flags.seconds);
+            let clock = Instant::now();
+            let report = run_mitsuba(
+                &python,
+                &script,
+                &xml,
+                integrator,
+                flags.seconds,
+                &file,
+                flags.threads,
+                7,
+            )?;
+            let seconds = clock.elapsed().as_secs_f64();
+            rows.push(score(
+                name,
+                &format!("Mitsuba {integrator}"),
+                seconds,
+                &file,
+                &reference,
+                &diffuse,
+                &report,
+            )?);
+        }
+    }
+
+    let mut table = String::new();
+    writeln!(
+        table,
+        "| scene | renderer | wall s | relMSE | relMSE diffuse-seen | mean / ref | notes |"
+    )?;
+    writeln!(table, "|---|---|---|---|---|---|---|")?;
+    for r in &rows {
+        writeln!(
+            table,
+            "| {} | {} | {:.1} | {:.6} | {:.6} | {:.4} | {} |",
+            r.scene, r.renderer, r.seconds, r.rel_mse, r.rel_mse_diffuse, r.mean_ratio, r.note
+        )?;
+    }
+    writeln!(table)?;
+    writeln!(
+        table,
+        "Reference noise (relMSE units; subtract from the figures above for the net error):"
+    )?;
+    writeln!(table)?;
+    writeln!(
+        table,
+        "| scene | all pixels | diffuse-seen | reference mean |"
+    )?;
+    writeln!(table, "|---|---|---|---|")?;
+    for line in &noise_lines {
+        writeln!(table, "{line}")?;
+    }
+    std::fs::write(out.join("table.md"), &table)?;
+    println!("{table}");
+    Ok(true)
+}
+
+fn score(
+    scene: &str,
+    renderer: &str,
+    seconds: f64,
+    file: &Path,
+    reference: &Image,
+    diffuse: &[bool],
+    note: &str,
+) -> Result<Row> {
+    let image = image_io::read_exr(file)?;
+    let all = image_io::errors(&image, reference, None)?;
+    let on_diffuse = image_io::errors(&image, reference, Some(diffuse))?;
+    Ok(Row {
+        scene: scene.to_owned(),
+        renderer: renderer.to_owned(),
+        seconds,
+        rel_mse: all.rel_mse,
+        rel_mse_diffuse: on_diffuse.rel_mse,
+        mean_ratio: all.mean_ratio,
+        note: note.to_owned(),
+    })
+}
+
+/// Pixels whose camera ray through the pixel centre first hits a diffuse, non-emitting surface.
+fn diffuse_first_hit_mask(scene: &geometry::Scene, width: usize, height: usize) -> Vec<bool> {
+    let mut mask = vec![false; width * height];
+    for y in 0..height {
+        for x in 0..width {
+            let ray = scene
+                .camera()
+                .generate_ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), Vec2::splat(0.5));
+            let diffuse = scene
+                .intersect(&ray)
+                .and_then(|hit| scene.material(hit.material))
+                .is_some_and(|m| {
+                    m.emission.max_element() == 0.0
+                        && matches!(m.kind, geometry::MaterialKind::Diffuse { .. })
+                });
+            mask[y * width + x] = diffuse;
+        }
+    }
+    mask
+}
+
+/// The venv's Python with Mitsuba 3, created on first use.
+fn ensure_venv(root: &Path) -> Result<PathBuf> {
+    let venv = root.join("target/peers-venv");
+    let python = venv.join("bin/python");
+    let has_mitsuba = |python: &Path| {
+        Command::new(python)
+            .args(["-c", "import mitsuba, drjit, numpy"])
+            .status()
+            .is_ok_and(|s| s.success())
+    };
+    if python.exists() && has_mitsuba(&python) {
+        return Ok(python);
+    }
+    eprintln!(
+        "creating {} (pip install mitsuba drjit numpy)",
+        venv.display()
+    );
+    let status = Command::new("python3")
+        .args(["-m", "venv"])
+        .arg(&venv)
+        .status()
+        .context("running python3 -m venv")?;
+    if !status.success() {
+        bail!("python3 -m venv {} failed", venv.display());
+    }
+    let status = Command::new(&python)
+        .args([
+            "-m", "pip", "install", "--quiet", "mitsuba", "drjit", "numpy",
+        ])
+        .status()
+        .context("running pip")?;
+    if !status.success() || !has_mitsuba(&python) {
+        bail!("installing mitsuba into {} failed", venv.display());
+    }
+    Ok(python)
+}
+
+/// Builds the release `fppm` binary and returns its path.
+fn build_fppm(root: &Path) -> Result<PathBuf> {
+    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned()))
+        .args(["build", "--release", "-p", "cli", "--quiet"])
+        .current_dir(root)
+        .status()
+        .context("running cargo build")?;
+    if !status.success() {
+        bail!("cargo build --release -p cli failed");
+    }
+    Ok(root.join("target/release/fppm"))
+}
+
+/// Runs the Mitsuba driver script; returns its report line.
+#[allow(clippy::too_many_arguments)]
+fn run_mitsuba(
+    python: &Path,
+    script: &Path,
+    xml: &Path,
+    integrator: &str,
+    seconds: f64,
+    out: &Path,
+    threads: u32,
+    seed: u32,
+) -> Result<String> {
+    let output = Command::new(python)
+        .arg(script)
+        .arg(xml)
+        .arg(integrator)
+        .arg(seconds.to_string())
+        .arg(out)
+        .arg(threads.to_string())
+        .arg(seed.to_string())
+        .output()
+        .context("running Mitsuba")?;
+    if !output.status.success() {
+        bail!(
+            "Mitsuba {integrator} on {} failed: {}",
+            xml.display(),
+            String::from_utf8_lossy(&output.stderr)
+                .lines()
+                .last()
+                .unwrap_or("")
+        );
+    }
+    Ok(String::from_utf8_lossy(&output.stdout).trim().to_owned())
+}
+
+/// Writes `description` as a Mitsuba 3 scene (`scene.xml` and one PLY per material group) in
+/// `dir` and returns the XML's path.
+///
+/// Conventions: fppm's diffuse and mirror materials scatter on both sides, so they are wrapped
+/// in `twosided`; a mirror is a `conductor` of material `none` (a perfect reflector) scaled by
+/// its reflectance; a dielectric is `dielectric` with `int_ior` = ior against vacuum; emission
+/// is an `area` emitter (one-sided, front = counter-clockwise side, as in fppm); cylinders are
+/// tessellated (512 segments around the kept arc) with exact vertex normals; the camera is a
+/// `perspective` sensor with `fov_axis = y` and a box-filtered `hdrfilm`; the integrator is
+/// `$integrator` with unlimited depth. Glossy materials and lights other than emissive surfaces
+/// and point lights are refused: the peer scenes do not use them.
+pub(crate) fn write_mitsuba(
+    description: &geometry::SceneDescription,
+    dir: &Path,
+) -> Result<PathBuf> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let mut xml = String::new();
+    writeln!(xml, "<scene version=\"3.0.0\">")?;
+    writeln!(xml, "  <default name=\"integrator\" value=\"path\"/>")?;
+    writeln!(xml, "  <default name=\"spp\" value=\"16\"/>")?;
+    writeln!(
+        xml,
+        "  <integrator type=\"$integrator\"><integer name=\"max_depth\" value=\"-1\"/></integrator>"
+    )?;
+    let c = &description.camera;
+    if c.aperture_radius > 0.0 {
+        bail!("thin-lens cameras are not exported");
+    }
+    let v = |p: Vec3| format!("{}, {}, {}", p.x, p.y, p.z);
+    writeln!(xml, "  <sensor type=\"perspective\">")?;
+    writeln!(xml, "    <string name=\"fov_axis\" value=\"y\"/>")?;
+    writeln!(
+        xml,
+        "    <float name=\"fov\" value=\"{}\"/>",
+        c.fov_y.to_degrees()
+    )?;
+    writeln!(
+        xml,
+        "    <transform name=\"to_world\"><lookat origin=\"{}\" target=\"{}\" up=\"{}\"/></transform>",
+        v(c.position),
+        v(c.look_at),
+        v(c.up)
+    )?;
+    writeln!(
+        xml,
+        "    <sampler type=\"independent\"><integer name=\"sample_count\" value=\"$spp\"/></sampler>"
+    )?;
+    writeln!(
+        xml,
+        "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"{}\"/><integer name=\"height\" value=\"{}\"/><rfilter type=\"box\"/><string name=\"pixel_format\" value=\"rgb\"/></film>",
+        description.film.width, description.film.height
+    )?;
+    writeln!(xml, "  </sensor>")?;
+
+    let rgb = |c: [f32; 3]| format!("{}, {}, {}", c[0], c[1], c[2]);
+    let mut bsdfs = Vec::new();
+    for m in &description.materials {
+        let bsdf = match m.kind {
+            geometry::MaterialKind::Diffuse { albedo } => format!(
+                "<bsdf type=\"twosided\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"{}\"/></bsdf></bsdf>",
+                rgb(albedo.to_array())
+            ),
+            geometry::MaterialKind::Mirror { reflectance } => format!(
+                "<bsdf type=\"twosided\"><bsdf type=\"conductor\"><string name=\"material\" value=\"none\"/><rgb name=\"specular_reflectance\" value=\"{}\"/></bsdf></bsdf>",
+                rgb(reflectance.to_array())
+            ),
+            geometry::MaterialKind::Dielectric { ior } => format!(
+                "<bsdf type=\"dielectric\"><float name=\"int_ior\" value=\"{ior}\"/><float name=\"ext_ior\" value=\"1.0\"/></bsdf>"
+            ),
+            other => bail!("material {} ({other:?}) is not exported", m.name),
+        };
+        let emission = m.emission.to_array();
+        let emitter = (emission.iter().any(|&e| e > 0.0)).then(|| {
+            format!(
+                "<emitter type=\"area\"><rgb name=\"radiance\" value=\"{}\"/></emitter>",
+                rgb(emission)
+            )
+        });
+        bsdfs.push((bsdf, emitter));
+    }
+
+    // Triangles, one PLY per material.
+    for (index, (bsdf, emitter)) in bsdfs.iter().enumerate() {
+        let triangles: Vec<_> = description
+            .triangles
+            .iter()
+            .filter(|t| t.material as usize == index)
+            .collect();
+        if triangles.is_empty() {
+            continue;
+        }
+        let file = format!("material-{index}.ply");
+        let mut ply = String::new();
+        let normals = triangles.iter().all(|t| t.normals.is_some());
+        writeln!(ply, "ply\nformat ascii 1.0")?;
+        writeln!(ply, "element vertex {}", 3 * triangles.len())?;
+        writeln!(ply, "property float x\nproperty float y\nproperty float z")?;
+        if normals {
+            writeln!(
+                ply,
+                "property float nx\nproperty float ny\nproperty float nz"
+            )?;
+        }
+        writeln!(ply, "element face {}", triangles.len())?;
+        writeln!(ply, "property list uchar int vertex_indices\nend_header")?;
+        for t in &triangles {
+            for k in 0..3 {
+                let p = t.positions[k];
+                match t.normals {
+                    Some(n) if normals => {
+                        writeln!(
+                            ply,
+                            "{} {} {} {} {} {}",
+                            p.x, p.y, p.z, n[k].x, n[k].y, n[k].z
+                        )?;
+                    }
+                    _ => writeln!(ply, "{} {} {}", p.x, p.y, p.z)?,
+                }
+            }
+        }
+        for i in 0..triangles.len() {
+            writeln!(ply, "3 {} {} {}", 3 * i, 3 * i + 1, 3 * i + 2)?;
+        }
+        std::fs::write(dir.join(&file), ply)?;
+        writeln!(
+            xml,
+            "  <shape type=\"ply\"><string name=\"filename\" value=\"{file}\"/>{bsdf}{}</shape>",
+            emitter.as_deref().unwrap_or("")
+        )?;
+    }
+    for s in &description.spheres {
+        let (bsdf, emitter) = &bsdfs[s.material as usize];
+        writeln!(
+            xml,
+            "  <shape type=\"sphere\"><point name=\"center\" value=\"{}\"/><float name=\"radius\" value=\"{}\"/>{bsdf}{}</shape>",
+            v(s.center),
+            s.radius,
+            emitter.as_deref().unwrap_or("")
+        )?;
+    }
+    for (index, cylinder) in description.cylinders.iter().enumerate() {
+        let (bsdf, emitter) = &bsdfs[cylinder.material as usize];
+        let file = format!("cylinder-{index}.ply");
+        std::fs::write(dir.join(&file), cylinder_ply(cylinder, 512))?;
+        writeln!(
+            xml,
+            "  <shape type=\"ply\"><string name=\"filename\" value=\"{file}\"/>{bsdf}{}</shape>",
+            emitter.as_deref().unwrap_or("")
+        )?;
+    }
+    for light in &description.lights {
+        match *light {
+            geometry::Light::Point {
+                position,
+                intensity,
+            } => writeln!(
+                xml,
+                "  <emitter type=\"point\"><point name=\"position\" value=\"{}\"/><rgb name=\"intensity\" value=\"{}\"/></emitter>",
+                v(position),
+                rgb(intensity.to_array())
+            )?,
+            ref other => bail!("light {other:?} is not exported"),
+        }
+    }
+    writeln!(xml, "</scene>")?;
+    let path = dir.join("scene.xml");
+    std::fs::write(&path, xml)?;
+    Ok(path)
+}
+
+/// An open cylinder's kept arc as an ASCII PLY of `segments` quads with exact outward normals,
+/// counter-clockwise seen from outside (the front, as fppm's analytic cylinder).
+fn cylinder_ply(c: &geometry::Cylinder, segments: usize) -> String {
+    let side = c.axis.cross(c.facing);
+    let mut ply = String::new();
+    let n_vertices = 2 * (segments + 1);
+    let _ = writeln!(
+        ply,
+        "ply\nformat ascii 1.0\nelement vertex {n_vertices}\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nelement face {}\nproperty list uchar int vertex_indices\nend_header",
+        2 * segments
+    );
+    for i in 0..=segments {
+        let phi = c.arc.to_radians() * (i as f32 / segments as f32 - 0.5);
+        let n = phi.cos() * c.facing + phi.sin() * side;
+        for s in [0.0, c.height] {
+            let p = c.center + s * c.axis + c.radius * n;
+            let _ = writeln!(ply, "{} {} {} {} {} {}", p.x, p.y, p.z, n.x, n.y, n.z);
+        }
+    }
+    for i in 0..segments {
+        let (a, b, c2, d) = (2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1);
+        // Seen from outside, going around counter-clockwise about the axis, then up.
+        let _ = writeln!(ply, "3 {a} {b} {c2}");
+        let _ = writeln!(ply, "3 {a} {c2} {d}");
+    }
+    ply
+}
