@@ -357,7 +357,7 @@ fn srgb_to_linear(v: f64) -> f64 {
 }
 
 /// The stand-in for an environment light (Mitsuba `envmap`/`constant`, pbrt `infinite`):
-/// nothing, and a warning. Returns the warning text.
+/// nothing, and a warning; the element is remembered for the no-emitter error.
 pub(crate) fn environment_light_standin(builder: &mut Builder, element: &str) {
     builder.warn(format!(
         "{element}: environment lights are not supported yet; the scene is rendered without it"

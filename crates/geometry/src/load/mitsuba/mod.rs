@@ -7,7 +7,7 @@
 //!   so they apply in document order; `<matrix>` is row-major; `<lookat>` builds the frame
 //!   (left, up, forward) with the camera looking down its +z;
 //! - `<spectrum>` values become RGB as Mitsuba's RGB variants do ([`super::spectrum`]);
-//! - colours given by a texture stand in as a constant ([`texture_standin`]); environment
+//! - colours given by a texture stand in as a constant (`Importer::texture_standin`); environment
 //!   emitters are skipped with a warning ([`super::import::environment_light_standin`]);
 //! - the integrator's `max_depth` (longest path in segments, Mitsuba's convention) becomes
 //!   fppm's `max_depth` (scattering events) minus one.
@@ -106,14 +106,11 @@ pub(crate) fn load_mitsuba(
             }
             "integrator" => importer.integrator(node, &mut render)?,
             // Declarations used through <ref>, and elements with no bearing on the image.
-            "bsdf" | "texture" | "spectrum" | "medium" | "phase" | "volume" | "float"
-            | "integer" | "boolean" | "string" | "rgb" | "point" | "vector" | "alias"
-            | "transform" => {
-                if matches!(node.tag.as_str(), "medium" | "volume") {
-                    return Err(doc.error(node, "participating media are not supported"));
-                }
+            "medium" | "volume" => {
+                return Err(doc.error(node, "participating media are not supported"));
             }
-            "ref" => {}
+            "bsdf" | "texture" | "spectrum" | "phase" | "float" | "integer" | "boolean"
+            | "string" | "rgb" | "point" | "vector" | "alias" | "transform" | "ref" => {}
             other => {
                 importer.builder.warn(format!(
                     "<{other}> at the top level of the scene is ignored"
