@@ -462,10 +462,10 @@ impl<'a> Importer<'a> {
                         .trim()
                         .parse()
                         .map_err(|_| self.err(op, "angle is not a number"))?;
-                    let axis = axis
-                        .try_normalize()
-                        .ok_or_else(|| self.err(op, "rotation axis cannot be zero"))?;
-                    DMat4::from_axis_angle(axis, angle.to_radians())
+                    if axis == DVec3::ZERO {
+                        return Err(self.err(op, "rotation axis cannot be zero"));
+                    }
+                    mitsuba_rotation(axis, angle.to_radians())
                 }
                 "lookat" => {
                     let parse = |k: &str| -> Result<Option<DVec3>, LoadError> {
@@ -1155,6 +1155,36 @@ fn emission_of(builder: &Builder, index: u32) -> bool {
         .materials
         .get(index as usize)
         .is_some_and(|m| m.emission.max_element() > 0.0)
+}
+
+/// Mitsuba's rotation (Dr.Jit's `rotate`): c·I + (1 − c)·a aᵀ + s·[a]×, with the axis `a`
+/// used as written. Mitsuba does not normalise it, so neither does the importer: a scene with a
+/// non-unit axis renders as in Mitsuba.
+fn mitsuba_rotation(a: DVec3, theta: f64) -> DMat4 {
+    let (s, c) = theta.sin_cos();
+    let k = 1.0 - c;
+    // Rows of the 3 × 3 part.
+    let r0 = DVec3::new(
+        c + a.x * a.x * k,
+        a.x * a.y * k - a.z * s,
+        a.x * a.z * k + a.y * s,
+    );
+    let r1 = DVec3::new(
+        a.y * a.x * k + a.z * s,
+        c + a.y * a.y * k,
+        a.y * a.z * k - a.x * s,
+    );
+    let r2 = DVec3::new(
+        a.z * a.x * k - a.y * s,
+        a.z * a.y * k + a.x * s,
+        c + a.z * a.z * k,
+    );
+    DMat4::from_cols(
+        DVec3::new(r0.x, r1.x, r2.x).extend(0.0),
+        DVec3::new(r0.y, r1.y, r2.y).extend(0.0),
+        DVec3::new(r0.z, r1.z, r2.z).extend(0.0),
+        glam::DVec4::W,
+    )
 }
 
 /// Reads a `.spd` file: lines of `wavelength value`, `#` comments.
