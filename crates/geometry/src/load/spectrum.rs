@@ -4,9 +4,10 @@
 //! [`spectrum_to_rgb`] follows `spectrum_list_to_srgb` (Mitsuba 3, `src/core/spectrum.cpp`):
 //! the piecewise-linear spectrum is sampled at 1000 wavelengths evenly spread over
 //! [360, 830] nm (zero outside its own range), weighted by the CIE 1931 2° colour-matching
-//! functions (and by the D65 illuminant for reflectances), scaled by 1/106.75 (the integral
-//! of ȳ), and converted from XYZ to linear sRGB. Reflectances are clamped to [0, 1],
-//! emission and indices of refraction only to ≥ 0. The colour-matching functions are the CIE
+//! functions (and by the D65 illuminant for everything but emission), scaled by 1/106.75 (the
+//! integral of ȳ), and converted from XYZ to linear sRGB. Reflectances are clamped to [0, 1],
+//! emission and indices of refraction only to ≥ 0. (Mitsuba's *named* conductors are read
+//! from files without the D65 weighting; [`METALS`] holds what it loads for them.) The colour-matching functions are the CIE
 //! 1931 tables at 5 nm, as Mitsuba stores them (read back through `mi.cie1931_xyz`).
 
 use glam::DVec3;
@@ -337,7 +338,8 @@ pub(crate) enum SpectrumUse {
     Reflectance,
     /// Emitted radiance or intensity (not weighted, clamped to ≥ 0).
     Emission,
-    /// A real or imaginary index of refraction (not weighted, clamped to ≥ 0).
+    /// A real or imaginary index of refraction given as a spectrum. Mitsuba weights it by D65
+    /// like any non-emitter property, but does not clamp it to 1 (clamped to ≥ 0).
     Ior,
 }
 
@@ -394,7 +396,7 @@ pub(crate) fn spectrum_to_rgb(
             - 1;
         let (w0, w1, v0, v1) = (wavelengths[j], wavelengths[j + 1], values[j], values[j + 1]);
         let v = ((w - w1) * v0 + (w0 - w) * v1) / (w0 - w1);
-        let d65 = if usage == SpectrumUse::Reflectance {
+        let d65 = if usage != SpectrumUse::Emission {
             table(&D65, w) / D65_NORMALIZATION
         } else {
             1.0
@@ -427,6 +429,41 @@ pub(crate) fn conductor_reflectance(eta: Rgb, k: Rgb) -> Rgb {
     let num = (eta - 1.0) * (eta - 1.0) + k * k;
     let den = (eta + 1.0) * (eta + 1.0) + k * k;
     (num / den.max(Rgb::splat(1e-12))).clamp(Rgb::ZERO, Rgb::ONE)
+}
+
+/// Reflectance at normal incidence of a conductor whose η and k are spectra, computed per
+/// wavelength (on η's wavelengths, k interpolated linearly and held at its ends) and then
+/// converted to RGB as a reflectance: closer to a spectral renderer than converting η and k
+/// to RGB first. `None` if either spectrum is malformed.
+pub(crate) fn conductor_reflectance_spectral(
+    eta: (&[f64], &[f64]),
+    k: (&[f64], &[f64]),
+) -> Option<Rgb> {
+    let (we, ve) = eta;
+    let (wk, vk) = k;
+    if we.is_empty() || wk.is_empty() || we.len() != ve.len() || wk.len() != vk.len() {
+        return None;
+    }
+    let k_at = |w: f64| -> f64 {
+        let j = wk.partition_point(|&x| x <= w);
+        if j == 0 {
+            vk[0]
+        } else if j >= wk.len() {
+            vk[wk.len() - 1]
+        } else {
+            let t = (w - wk[j - 1]) / (wk[j] - wk[j - 1]);
+            (1.0 - t) * vk[j - 1] + t * vk[j]
+        }
+    };
+    let r: Vec<f64> = we
+        .iter()
+        .zip(ve)
+        .map(|(&w, &n)| {
+            let k = k_at(w);
+            ((n - 1.0) * (n - 1.0) + k * k) / ((n + 1.0) * (n + 1.0) + k * k)
+        })
+        .collect();
+    spectrum_to_rgb(we, &r, SpectrumUse::Reflectance)
 }
 
 /// Reflectance of a smooth dielectric interface at normal incidence: ((η − 1) / (η + 1))².

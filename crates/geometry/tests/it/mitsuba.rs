@@ -447,3 +447,60 @@ fn transforms_match_mitsuba() {
         }
     }
 }
+
+/// `fov_axis` against Mitsuba 3.9.1: on a 96 × 54 film with `fov` 40, the vertical field of
+/// view Mitsuba's sensor ends up with (from `mi.traverse(sensor)['x_fov']` and the aspect).
+#[test]
+fn fov_axis_matches_mitsuba() {
+    for (axis, mitsuba_fov_y) in [
+        ("x", 23.140917),
+        ("y", 40.0),
+        ("diagonal", 20.234804),
+        ("smaller", 40.0),
+        ("larger", 23.140917),
+    ] {
+        let xml = format!(
+            r#"<scene version="3.0.0"><sensor type="perspective"><float name="fov" value="40"/><string name="fov_axis" value="{axis}"/>
+<film type="hdrfilm"><integer name="width" value="96"/><integer name="height" value="54"/></film></sensor>
+<shape type="sphere"/></scene>"#
+        );
+        let path = fixture(&format!("mitsuba_fov_{axis}"), &[("scene.xml", &xml)]);
+        let scene = load_with(&path, &LoadOptions::allow_no_emitter()).unwrap();
+        let ours = scene.camera.fov_y.to_degrees();
+        assert!(
+            (ours - mitsuba_fov_y).abs() < 1e-3,
+            "{axis}: {ours} vs {mitsuba_fov_y}"
+        );
+    }
+}
+
+/// A conductor's η and k given as `<spectrum filename=".spd">` become RGB as Mitsuba 3.9.1
+/// loads them (`scalar_rgb`, `mi.traverse`: η (0.0798705, 0.404652, 1.55897), k (3.38675,
+/// 2.50071, 1.76891) for the shared gold files); the mirror's reflectance is the Fresnel
+/// reflectance at normal incidence of those.
+#[test]
+fn spectral_eta_k_match_mitsuba() {
+    let spds = shared_scenes().join("pbrt-v4/killeroos/spds");
+    let xml = BASE.replacen(
+        "<bsdf type=\"diffuse\" id=\"white\">\n        <rgb name=\"reflectance\" value=\"0.8\"/>",
+        &format!(
+            "<bsdf type=\"conductor\" id=\"white\"><spectrum name=\"eta\" filename=\"{}\"/><spectrum name=\"k\" filename=\"{}\"/>",
+            spds.join("Au.eta.spd").display(),
+            spds.join("Au.k.spd").display()
+        ),
+        1,
+    );
+    assert_ne!(xml, BASE);
+    let path = fixture("mitsuba_spectral_eta", &[("scene.xml", &xml)]);
+    let scene = load(&path).unwrap();
+    let eta = glam::Vec3::new(0.079_870_5, 0.404_652, 1.558_97);
+    let k = glam::Vec3::new(3.386_75, 2.500_71, 1.768_91);
+    let expected = ((eta - 1.0) * (eta - 1.0) + k * k) / ((eta + 1.0) * (eta + 1.0) + k * k);
+    let geometry::MaterialKind::Mirror { reflectance } = scene.materials[0].kind else {
+        panic!("{:?}", scene.materials[0]);
+    };
+    assert!(
+        (reflectance - expected).abs().max_element() < 1e-4,
+        "{reflectance} vs {expected}"
+    );
+}

@@ -107,6 +107,9 @@ enum Value {
 #[derive(Clone, Debug, Default)]
 struct Params(Vec<Param>);
 
+/// A sampled spectrum: wavelengths (nm) and values.
+type Samples = (Vec<f64>, Vec<f64>);
+
 /// Where something was written: file index, line, column.
 #[derive(Clone, Copy, Debug)]
 struct Loc {
@@ -982,6 +985,38 @@ impl Parser {
         Ok(Some(rgb))
     }
 
+    /// The samples of a `spectrum` parameter given as λ/value pairs or a `.spd` file; `None`
+    /// for anything else (named spectra, rgb, absent).
+    fn spectral(&self, params: &Params, name: &str) -> Result<Option<Samples>, LoadError> {
+        let Some(p) = params.get(name) else {
+            return Ok(None);
+        };
+        if p.ty != "spectrum" {
+            return Ok(None);
+        }
+        let loc = Self::loc_of_param(p);
+        match p.values.as_slice() {
+            [Value::Str(s)] if s.starts_with("metal-") || s.starts_with("glass-") => Ok(None),
+            [Value::Str(s)] if s.starts_with("stdillum-") => Ok(None),
+            [Value::Str(s)] => super::mitsuba::read_spd(&self.resolve(s))
+                .map(Some)
+                .map_err(|m| self.err(loc, m)),
+            _ => {
+                let v = self.nums(p)?;
+                if v.len() < 2 || v.len() % 2 != 0 {
+                    return Err(self.err(
+                        loc,
+                        format!("parameter \"spectrum {name}\" needs wavelength/value pairs"),
+                    ));
+                }
+                Ok(Some((
+                    v.iter().step_by(2).copied().collect(),
+                    v.iter().skip(1).step_by(2).copied().collect(),
+                )))
+            }
+        }
+    }
+
     /// A named pbrt spectrum (metals, glasses) or a `.spd` file.
     fn named_spectrum(&mut self, s: &str, loc: Loc, usage: SpectrumUse) -> Result<Rgb, LoadError> {
         if let Some(rest) = s.strip_prefix("metal-") {
@@ -1150,6 +1185,21 @@ impl Parser {
                 };
                 let r0 = match self.colour(&p, &format!("{prefix}reflectance"), refl)? {
                     Some(r) => r,
+                    None if self.spectral(&p, &format!("{prefix}eta"))?.is_some()
+                        && self.spectral(&p, &format!("{prefix}k"))?.is_some() =>
+                    {
+                        // Both measured spectra: the reflectance is computed per wavelength.
+                        let (Some(eta), Some(k)) = (
+                            self.spectral(&p, &format!("{prefix}eta"))?,
+                            self.spectral(&p, &format!("{prefix}k"))?,
+                        ) else {
+                            return Err(self.err(def.loc, "conductor spectra vanished"));
+                        };
+                        spectrum::conductor_reflectance_spectral((&eta.0, &eta.1), (&k.0, &k.1))
+                            .ok_or_else(|| {
+                                self.err(def.loc, format!("{label}: malformed eta or k spectrum"))
+                            })?
+                    }
                     None => {
                         let eta = self.colour(&p, &format!("{prefix}eta"), SpectrumUse::Ior)?;
                         let k = self.colour(&p, &format!("{prefix}k"), SpectrumUse::Ior)?;
