@@ -1157,7 +1157,7 @@ fn emission_of(builder: &Builder, index: u32) -> bool {
         .is_some_and(|m| m.emission.max_element() > 0.0)
 }
 
-/// Mitsuba's rotation (Dr.Jit's `rotate`): c·I + (1 − c)·a aᵀ + s·[a]×, with the axis `a`
+/// Mitsuba's rotation (Dr.Jit's `rotate`): c·I + (1 − c)·a aᵀ + s·\[a\]×, with the axis `a`
 /// used as written. Mitsuba does not normalise it, so neither does the importer: a scene with a
 /// non-unit axis renders as in Mitsuba.
 fn mitsuba_rotation(a: DVec3, theta: f64) -> DMat4 {
