@@ -67,7 +67,7 @@ fn one() -> u32 {
 }
 
 fn default_depth() -> u32 {
-    8
+    ppm::RenderParams::preview().max_depth
 }
 
 /// Reads `tests/scenes.toml`.

@@ -41,6 +41,8 @@ pub(crate) struct Cli {
 }
 
 /// The subcommands.
+// Parsed once per process: the size of the render variant does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Subcommand)]
 pub(crate) enum Command {
     /// Render a scene file (.toml, .obj with its .mtl, .gltf, .glb, Mitsuba 3 .xml, pbrt-v4 .pbrt).
@@ -142,7 +144,24 @@ pub(crate) struct ParamArgs {
     /// 95 %-of-peak radius; the poster's is 0.7115].
     #[arg(long, value_name = "K", allow_negative_numbers = true)]
     pub(crate) kernel_k: Option<f64>,
-    /// Maximum number of path segments, in [1, 1024] [default: scene, else 8].
+    /// Largest kernel of a frequency method, as a multiple of the initial radius, in [1, 64]
+    /// [default: 1, measured in docs/integrators.md; 1 never grows a kernel beyond R₀].
+    #[arg(long, value_name = "G", allow_negative_numbers = true)]
+    pub(crate) freq_grow: Option<f64>,
+    /// α of a hitpoint held by its frequency radius, in (0, 1] [default: 0.9; 1 keeps the
+    /// radius for ever, the poster's rule, which does not converge].
+    #[arg(long, value_name = "A", allow_negative_numbers = true)]
+    pub(crate) freq_hold_alpha: Option<f64>,
+    /// Passes of the frequency pilot before the kernels are sized and the statistics restart
+    /// [default: 4; 0 never grows kernels; only with --freq-grow above 1].
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    pub(crate) freq_pilot: Option<i64>,
+    /// Cap every slot's radius of a frequency method at the clear radius of its gather disc
+    /// (probed at every visible point), not only the held ones.
+    #[arg(long)]
+    pub(crate) freq_clear_cap: bool,
+    /// Maximum number of scattering events on a light path, in [1, 1024] [default: scene,
+    /// else 1024: in effect unlimited, paths end by Russian roulette].
     #[arg(long, value_name = "N", allow_negative_numbers = true)]
     pub(crate) max_depth: Option<i64>,
     /// Hitpoints per pixel (paths per pixel per pass for --method path), in [1, 1024]

@@ -242,6 +242,14 @@ fn write_images(job: &Job, renderer: &Renderer<'_>, elapsed: Duration) -> anyhow
             "freq_geometry".into(),
             if params.freq_geometry { "on" } else { "off" }.into(),
         ));
+        for (key, value) in [
+            ("freq_grow", params.freq_grow.to_string()),
+            ("freq_hold_alpha", params.freq_hold_alpha.to_string()),
+            ("freq_pilot", params.freq_pilot.to_string()),
+            ("freq_clear_cap", params.freq_clear_cap.to_string()),
+        ] {
+            frame.metadata.push((key.into(), value));
+        }
     }
     for aov_flag in &job.outputs.aovs {
         for &aov in aov_flag.aovs() {

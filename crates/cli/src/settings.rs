@@ -328,6 +328,21 @@ fn apply_flags(base: RenderParams, flags: &ParamArgs) -> anyhow::Result<RenderPa
     if let Some(d) = flags.max_depth {
         p.max_depth = small_count("--max-depth", d)?;
     }
+    if let Some(g) = flags.freq_grow {
+        p.freq_grow = g;
+    }
+    if let Some(a) = flags.freq_hold_alpha {
+        p.freq_hold_alpha = a;
+    }
+    if flags.freq_clear_cap {
+        p.freq_clear_cap = true;
+    }
+    if let Some(n) = flags.freq_pilot {
+        p.freq_pilot = match u32::try_from(n) {
+            Ok(n) => n,
+            Err(_) => usage!("--freq-pilot {n} is outside [0, 1000000]"),
+        };
+    }
     if let Some(s) = flags.spp {
         p.samples_per_pixel = small_count("--spp", s)?;
     }

@@ -29,8 +29,8 @@ use glam::Vec3;
 
 /// Probe directions in the tangent plane.
 pub(crate) const DIRECTIONS: usize = 8;
-/// Candidate radii R₀·2^−i, i < LEVELS.
-pub(crate) const LEVELS: u32 = 5;
+/// Candidate radii R·2^−i, i < LEVELS, from the largest kernel R down to R/128.
+pub(crate) const LEVELS: u32 = 8;
 /// A drop probe must land on a surface whose geometric normal is within this cosine of the
 /// hitpoint's (`photon::AcceptParams`' default normal agreement, 60°).
 const NORMAL_COS: f32 = 0.5;
@@ -168,9 +168,12 @@ intensity = [1.0, 1.0, 1.0]
 
     #[test]
     fn a_disc_over_the_edge_of_the_last_level_is_not_clear() {
-        // 0.01 from the wall: even r0/16 = 0.025 overhangs it.
-        let r = clear_radius(&scene(), Vec3::new(0.49, 0.0, 0.0), Vec3::Y, 0.4);
+        // 0.002 from the wall: even r0/128 = 0.003125 overhangs it.
+        let r = clear_radius(&scene(), Vec3::new(0.498, 0.0, 0.0), Vec3::Y, 0.4);
         assert_eq!(r, 0.0);
+        // 0.01 from it: r0/64 = 0.00625 does not.
+        let r = clear_radius(&scene(), Vec3::new(0.49, 0.0, 0.0), Vec3::Y, 0.4);
+        assert_eq!(r, f64::from(0.4f32) / 64.0);
     }
 
     #[test]

@@ -119,6 +119,25 @@ pub struct RenderParams {
     /// Add direct lighting by light sampling at hitpoints instead of gathering photons that
     /// arrive straight from an emitter.
     pub direct_lighting: bool,
+    /// The largest kernel a frequency method may give a hitpoint, as a multiple of the
+    /// initial radius R₀, in [1, 64]. After the pilot (`freq_pilot`) every hitpoint whose
+    /// frequency prediction and clear disc allow it starts over at min(r_freq, clear radius,
+    /// `freq_grow`·R₀); 1 never grows a kernel beyond R₀ (the poster's rule).
+    pub freq_grow: f64,
+    /// α while a frequency method holds a hitpoint (R ≤ its frequency radius), in (0, 1]:
+    /// 1 keeps the radius for ever (the poster's rule, biased in the limit); below 1 the held
+    /// radius keeps shrinking slowly, R² ∝ N^−(1−α_hold)/α_hold, so that the estimate converges
+    /// (for α_hold > 1/2, N·R² still grows).
+    pub freq_hold_alpha: f64,
+    /// Passes of a frequency method's pilot, in [0, 10⁶]: after them (and only if
+    /// `freq_grow` > 1) the kernels are sized from the frequency prediction and every
+    /// hitpoint's statistics restart; 0 skips the growth.
+    pub freq_pilot: u32,
+    /// Whether a frequency method caps *every* slot's radius at the clear radius of its
+    /// gather disc (probed at every visible point), not only the held ones: near corners and
+    /// edges the kernel then shrinks at once to the distance where the disc leaves the
+    /// surface, which removes most of photon mapping's corner bias.
+    pub freq_clear_cap: bool,
 }
 
 /// A parameter outside its domain.
@@ -157,17 +176,25 @@ pub enum ParamError {
 }
 
 impl RenderParams {
+    /// The pass (0-based) at whose start a frequency method sizes its kernels from the
+    /// frequency prediction and restarts the statistics, if it grows kernels at all.
+    #[must_use]
+    pub fn growth_pass(&self) -> Option<u32> {
+        (self.method.uses_frequency() && self.freq_grow > 1.0 && self.freq_pilot > 0)
+            .then_some(self.freq_pilot)
+    }
+
     /// A quick preview: classical PPM, 100 000 photons per pass, α = 0.7, one hitpoint per
     /// pixel; for the frequency methods 10 % frequency photons, K = K_STRICT, min-radius merge
     /// and occlusion probes (the defaults of `docs/convergence.md` and `docs/integrators.md`).
     #[must_use]
     pub fn preview() -> Self {
         Self {
-            method: Method::Ppm,
+            method: Method::FreqSppm,
             photons_per_pass: 100_000,
             alpha: 0.7,
             initial_radius: None,
-            max_depth: 8,
+            max_depth: 1024,
             samples_per_pixel: 1,
             seed: 0,
             freq_fraction: 0.1,
@@ -177,6 +204,10 @@ impl RenderParams {
             freq_occlusion: true,
             freq_geometry: true,
             direct_lighting: false,
+            freq_grow: 1.0,
+            freq_hold_alpha: 0.9,
+            freq_pilot: 4,
+            freq_clear_cap: false,
         }
     }
 
@@ -215,6 +246,15 @@ impl RenderParams {
         }
         if !(self.kernel_k > 0.0 && self.kernel_k.is_finite()) {
             return Err(out("kernel-k", self.kernel_k, "(0, inf)"));
+        }
+        if !(1.0..=64.0).contains(&self.freq_grow) {
+            return Err(out("freq-grow", self.freq_grow, "[1, 64]"));
+        }
+        if !(self.freq_hold_alpha > 0.0 && self.freq_hold_alpha <= 1.0) {
+            return Err(out("freq-hold-alpha", self.freq_hold_alpha, "(0, 1]"));
+        }
+        if self.freq_pilot > 1_000_000 {
+            return Err(out("freq-pilot", self.freq_pilot, "[0, 1000000]"));
         }
         Ok(())
     }

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use crate::params::{Method, ParamError, RenderParams};
 use crate::path::PathTracer;
-use crate::photon_mapper::{MemoryUse, PassStats, PassTimings, PhotonMapper};
+use crate::photon_mapper::{MemoryUse, PassStats, PhotonMapper};
 
 /// A progressive render in progress: create it, call [`Renderer::iterate`] as often as the
 /// budget allows, read [`Renderer::image`] (and [`Renderer::aov`]) at any time, and save or
@@ -134,24 +134,10 @@ impl<'s> Renderer<'s> {
                 let pass = p.passes;
                 let clock = std::time::Instant::now();
                 let paths = p.iterate();
-                PassStats {
-                    photons_stored: 0,
-                    timings: PassTimings {
-                        camera: clock.elapsed().as_secs_f64(),
-                        ..PassTimings::default()
-                    },
-                    pass,
-                    camera_paths: paths,
-                    photons_traced: 0,
-                    frequency_photons: 0,
-                    photons_deposited: 0,
-                    hitpoints_hit: 0,
-                    hitpoints_valid: 0,
-                    mean_radius: 0.0,
-                    min_radius: 0.0,
-                    max_radius: 0.0,
-                    frequency_held: 0.0,
-                }
+                let mut stats = PassStats::empty(pass);
+                stats.camera_paths = paths;
+                stats.timings.camera = clock.elapsed().as_secs_f64();
+                stats
             }
         }
     }
@@ -187,11 +173,7 @@ impl<'s> Renderer<'s> {
                 let Engine::Photons(mapper) = &self.engine else {
                     return None;
                 };
-                let frequency = matches!(aov, Aov::FreqRadius | Aov::FreqHeld);
-                if frequency && !mapper.params.method.uses_frequency() {
-                    return None;
-                }
-                Some(slot_aov(mapper, aov))
+                mapper.slot_aov(aov)
             }
         }
     }
@@ -238,45 +220,4 @@ fn albedo(kind: MaterialKind) -> Rgb {
             ..
         } => reflectance + diffuse,
     }
-}
-
-/// A per-slot quantity averaged over each pixel's slots.
-fn slot_aov(mapper: &PhotonMapper<'_>, aov: Aov) -> Vec<f32> {
-    let spp = mapper.params.samples_per_pixel as usize;
-    let n_pixels = mapper.width as usize * mapper.height as usize;
-    let slots = &mapper.slots;
-    if slots.is_empty() {
-        return vec![0.0; n_pixels];
-    }
-    let k = mapper.params.kernel_k;
-    (0..n_pixels)
-        .into_par_iter()
-        .map(|pixel| {
-            let (mut sum, mut n) = (0.0f64, 0u32);
-            for slot in pixel * spp..(pixel + 1) * spp {
-                if !mapper.is_valid(slot) {
-                    continue;
-                }
-                let freq = slots.freq()[slot];
-                let value = match aov {
-                    Aov::Radius => Some(slots.radius()[slot]),
-                    Aov::PhotonCount => Some(slots.photon_count()[slot]),
-                    Aov::FreqRadius => freq.estimate().radius(f64::from(freq.normal_distance), k),
-                    _ => Some(
-                        freq.hold_radius(k, mapper.kernel_scale)
-                            .map_or(0.0, |r| f64::from(u8::from(slots.radius()[slot] <= r))),
-                    ),
-                };
-                if let Some(v) = value {
-                    sum += v.min(f64::from(f32::MAX));
-                    n += 1;
-                }
-            }
-            if n == 0 {
-                0.0
-            } else {
-                (sum / f64::from(n)) as f32
-            }
-        })
-        .collect()
 }

@@ -13,14 +13,14 @@ use spectrum::{FrequencyEstimate, MergePolicy, Spectrum};
 
 use crate::params::{Method, ParamError, RenderParams};
 use crate::path::PathTracer;
-use crate::photon_mapper::{NO_VISIBLE_POINT, PhotonMapper, SlotFrequency};
+use crate::photon_mapper::{MAX_PHOTON_BUDGET, PhotonMapper, SavedState, SlotFrequency};
 use crate::renderer::{Engine, Renderer};
 use crate::update::FrequencyFloor;
 
 const MAGIC: &[u8; 8] = b"FPPMSTAT";
 /// Version of the checkpoint layout; bump it whenever the layout or the meaning of a field
 /// changes, so that old checkpoints are refused rather than misread.
-pub const STATE_VERSION: u32 = 3;
+pub const STATE_VERSION: u32 = 4;
 
 /// Why a checkpoint could not be restored.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -175,6 +175,10 @@ fn write_params(w: &mut Writer, p: &RenderParams) {
     w.u32(u32::from(p.direct_lighting));
     w.u32(u32::from(p.freq_occlusion));
     w.u32(u32::from(p.freq_geometry));
+    w.f64(p.freq_grow);
+    w.f64(p.freq_hold_alpha);
+    w.u32(p.freq_pilot);
+    w.u32(u32::from(p.freq_clear_cap));
 }
 
 fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
@@ -200,6 +204,10 @@ fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
     let direct_lighting = r.bool()?;
     let freq_occlusion = r.bool()?;
     let freq_geometry = r.bool()?;
+    let freq_grow = r.f64()?;
+    let freq_hold_alpha = r.f64()?;
+    let freq_pilot = r.u32()?;
+    let freq_clear_cap = r.bool()?;
     Ok(RenderParams {
         method,
         photons_per_pass,
@@ -215,14 +223,18 @@ fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
         freq_occlusion,
         freq_geometry,
         direct_lighting,
+        freq_grow,
+        freq_hold_alpha,
+        freq_pilot,
+        freq_clear_cap,
     })
 }
 
 fn write_photon_mapper(w: &mut Writer, p: &PhotonMapper<'_>) {
-    w.u64(p.n_emitted);
-    w.u32(p.camera_passes);
-    let s = &p.slots;
-    let spp = p.params.samples_per_pixel as usize;
+    w.u64(p.photons_emitted());
+    w.u32(p.camera_passes());
+    let s = p.slots();
+    let spp = p.params().samples_per_pixel as usize;
     w.u64(s.len() as u64);
     for i in 0..s.len() {
         for v in [
@@ -235,8 +247,7 @@ fn write_photon_mapper(w: &mut Writer, p: &PhotonMapper<'_>) {
             v.to_array().iter().for_each(|&c| w.f32(c));
         }
         w.u32(s.material_idx()[i]);
-        // Layout of version 2, which stored the pixel, the `has_freq` flag and the validity
-        // flag: they are now derived (slot / spp, the estimate, the bounce budget).
+        // The pixel is redundant (slot / spp) and checked on reading.
         w.u32((i / spp) as u32);
         w.f64(s.radius()[i]);
         w.f64(s.photon_count()[i]);
@@ -244,8 +255,8 @@ fn write_photon_mapper(w: &mut Writer, p: &PhotonMapper<'_>) {
         let freq = s.freq()[i];
         let estimate = freq.estimate();
         w.u32(u32::from(estimate.has_freq()));
-        w.f32(freq.normal_distance);
-        w.u32(u32::from(freq.clear_level));
+        w.f32(freq.normal_distance());
+        w.u32(u32::from(freq.clear_level()));
         match estimate.spectrum() {
             None => w.u32(0),
             Some(spectrum) => {
@@ -253,16 +264,11 @@ fn write_photon_mapper(w: &mut Writer, p: &PhotonMapper<'_>) {
                 spectrum.to_bits().iter().for_each(|&b| w.u64(b));
             }
         }
-        // An invalid slot stored the budget of a camera path without bounces.
-        let valid = p.is_valid(i);
-        let budget = if valid {
-            u32::from(p.photon_bounces[i])
-        } else {
-            p.params.max_depth - 1
-        };
-        w.u32(u32::from(valid));
-        w.u32(budget);
-        p.direct[i].iter().for_each(|&c| w.f64(c));
+        // An invalid slot stores the budget of a camera path without bounces.
+        let budget = p.photon_budget(i);
+        w.u32(u32::from(budget.is_some()));
+        w.u32(budget.map_or(p.params().max_depth - 1, u32::from));
+        p.direct(i).iter().for_each(|&c| w.f64(c));
     }
 }
 
@@ -271,19 +277,17 @@ fn read_photon_mapper(
     p: &mut PhotonMapper<'_>,
     passes: u32,
 ) -> Result<(), StateError> {
-    p.pass = passes;
-    p.n_emitted = r.u64()?;
-    p.camera_passes = r.u32()?;
+    let n_emitted = r.u64()?;
+    let camera_passes = r.u32()?;
     let n = usize::try_from(r.u64()?).map_err(|_| StateError::Corrupt)?;
-    let expected = p.width as usize * p.height as usize * p.params.samples_per_pixel as usize;
-    if n != expected && n != 0 {
+    if n != p.n_slots() && n != 0 {
         return Err(StateError::Corrupt);
     }
-    let spp = p.params.samples_per_pixel as usize;
+    let spp = p.params().samples_per_pixel as usize;
     let mut slots = HitPoints::with_capacity(n);
     let mut stats = Vec::with_capacity(n);
-    p.photon_bounces = Vec::with_capacity(n);
-    p.direct = Vec::with_capacity(n);
+    let mut photon_budget = Vec::with_capacity(n);
+    let mut direct = Vec::with_capacity(n);
     for i in 0..n {
         let mut v = [Vec3::ZERO; 5];
         for item in &mut v {
@@ -313,11 +317,10 @@ fn read_photon_mapper(
         let valid = r.bool()?;
         let budget = u16::try_from(r.u32()?)
             .ok()
-            .filter(|&b| b != NO_VISIBLE_POINT)
+            .filter(|&b| b <= MAX_PHOTON_BUDGET)
             .ok_or(StateError::Corrupt)?;
-        p.photon_bounces
-            .push(if valid { budget } else { NO_VISIBLE_POINT });
-        p.direct.push([r.f64()?, r.f64()?, r.f64()?]);
+        photon_budget.push(valid.then_some(budget));
+        direct.push([r.f64()?, r.f64()?, r.f64()?]);
         slots.push(NewHitPoint {
             position: v[0],
             shading_normal: v[1],
@@ -326,12 +329,12 @@ fn read_photon_mapper(
             weight: v[4],
             material_idx,
             radius,
-            freq: {
-                let mut freq =
-                    SlotFrequency::new(FrequencyEstimate::from_spectrum(spectrum), normal_distance);
-                freq.clear_level = clear_level;
-                freq
-            },
+            freq: SlotFrequency::restored(
+                FrequencyEstimate::from_spectrum(spectrum),
+                normal_distance,
+                clear_level,
+                v[3].dot(v[1]).abs(),
+            ),
         });
         stats.push((photon_count, flux));
     }
@@ -340,7 +343,16 @@ fn read_photon_mapper(
         columns.photon_count[i] = photon_count;
         columns.flux[i] = flux;
     }
-    p.slots = slots;
+    p.restore(
+        passes,
+        SavedState {
+            n_emitted,
+            camera_passes,
+            slots,
+            photon_budget,
+            direct,
+        },
+    );
     Ok(())
 }
 

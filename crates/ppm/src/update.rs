@@ -77,6 +77,24 @@ impl GatherStats {
         freq: FrequencyRadius,
         floor: FrequencyFloor,
     ) {
+        self.update_with_hold(n_new, flux_new, alpha, freq, floor, 1.0);
+    }
+
+    /// [`Self::update`] with a held slot shrinking by `hold_alpha` instead of keeping its
+    /// radius: where `keep` holds, N′ = N + α_hold·M, R′ = R·√((N + α_hold·M)/(N + M)),
+    /// τ′ = (τ + Φ)·R′²/R² (exactly the keep rule for α_hold = 1). With 1/2 < α ≤ α_hold < 1
+    /// every slot shrinks as a PPM slot with an α in [α, α_hold]: for a steady M per pass,
+    /// R² ∝ N^−(1−α)/α → 0 while N·R² → ∞ (Hachisuka et al. 2008; Knaus and Zwicker 2011), so
+    /// bias and variance both vanish and the estimate converges.
+    pub fn update_with_hold(
+        &mut self,
+        n_new: u32,
+        flux_new: [f64; 3],
+        alpha: f64,
+        freq: FrequencyRadius,
+        floor: FrequencyFloor,
+        hold_alpha: f64,
+    ) {
         debug_assert!(
             alpha > 0.0 && alpha <= 1.0,
             "α must be in (0, 1], got {alpha}"
@@ -94,9 +112,18 @@ impl GatherStats {
             FrequencyRadius::None => false,
             FrequencyRadius::Predicted(r_freq) => r <= r_freq,
         };
-        if keep {
+        if keep && hold_alpha >= 1.0 {
             self.photon_count = n + m;
             self.flux = add(self.flux, flux_new);
+            return;
+        }
+        if keep {
+            let n_next = n + hold_alpha * m;
+            let r_next = r * (n_next / (n + m)).sqrt();
+            let scale = (r_next * r_next) / (r * r);
+            self.photon_count = n_next;
+            self.radius = r_next;
+            self.flux = add(self.flux, flux_new).map(|c| c * scale);
             return;
         }
         let mut n_next = n + alpha * m;
@@ -111,6 +138,18 @@ impl GatherStats {
         self.photon_count = n_next;
         self.radius = r_next;
         self.flux = add(self.flux, flux_new).map(|c| c * scale);
+    }
+
+    /// Shrinks the radius to at most `radius` at once, keeping the photon density N/R² and
+    /// the flux density τ/R² (the rescaling of the PPM update with M = 0): the estimate is
+    /// unchanged for a locally constant density.
+    pub fn cap_radius(&mut self, radius: f64) {
+        if radius > 0.0 && radius < self.radius {
+            let scale = (radius * radius) / (self.radius * self.radius);
+            self.photon_count *= scale;
+            self.flux = self.flux.map(|c| c * scale);
+            self.radius = radius;
+        }
     }
 
     /// Radiance estimate L = τ / (π R² N_emitted), with N_emitted the number of photons emitted

@@ -497,6 +497,25 @@ impl Spectrum {
         spatial_radius(self.camera_line_bandwidth(camera_distance), k) / clamp_mu(mu_o)
     }
 
+    /// The field as a hitpoint seen at cosine μo from a camera at distance D reads it: a
+    /// lowered to `min(a, a_cam/μo²)` (see [`Spectrum::camera_line_radius`]), so that the
+    /// spatial radius of the result is min(r_x, r_cam). Computed per deposit, while the
+    /// deposit still has its space–angle correlation c (the min-radius merge drops it, and
+    /// without c the camera-line radius is never the smaller). Lambertian fields are returned
+    /// unchanged (their r_cam ≥ r_x).
+    #[must_use]
+    pub fn seen_along_camera_line(self, camera_distance: f64, mu_o: f64, caps: &Caps) -> Self {
+        if self.lambertian {
+            return self;
+        }
+        let mu = clamp_mu(mu_o);
+        let a_cam = self.camera_line_bandwidth(camera_distance) / (mu * mu);
+        if a_cam >= self.a {
+            return self;
+        }
+        Self::finish(a_cam, self.b, self.c, false, caps)
+    }
+
     // ----------------------------------------------------------------------------------
     // Internals.
 

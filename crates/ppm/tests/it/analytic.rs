@@ -10,7 +10,7 @@ use crate::support::{PHOTON_METHODS, mean, params, render, rmse, scene};
 /// Inside a closed diffuse sphere of albedo ρ and radius R with a point light of intensity I at
 /// its centre, every wall point has radiance L = ρ·I / (π·R²·(1 − ρ)) (direct E = I/R², and the
 /// uniform radiosity B = ρ(E + B)). With ρ = 0.5, R = 1 and I = π, L = 1 (pbrt's test).
-const FURNACE: &str = r#"
+pub(crate) const FURNACE: &str = r#"
 format = 1
 [camera]
 position = [0.0, 0.0, 0.3]
@@ -127,7 +127,7 @@ fn max_depth_bounds_the_bounces_of_the_whole_light_path() {
 
 /// A point light of intensity I at height h over a large diffuse floor of albedo ρ: the floor
 /// radiance at distance d and incidence cosine cos θ is L = ρ/π · I·cos θ/d² (no other surface).
-const PLANE: &str = r#"
+pub(crate) const PLANE: &str = r#"
 format = 1
 [camera]
 position = [0.0, 2.0, 2.0]

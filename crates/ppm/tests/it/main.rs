@@ -13,5 +13,6 @@ mod analytic;
 mod checkpoint;
 mod determinism;
 mod frequency;
+mod kernels;
 mod statistics;
 mod support;

@@ -1,0 +1,250 @@
+//! Phase 1 of a pass: the camera pass. Each hitpoint slot's camera path is followed through
+//! specular bounces to its first non-specular surface, where it leaves a visible point; the
+//! emission it sees on the way is summed per slot.
+
+use geometry::{Bsdf, Hit, Rgb, TransportMode};
+use glam::{Vec2, Vec3};
+use photon::{HitPoints, NewHitPoint};
+use rayon::prelude::*;
+
+use super::frequency::SlotFrequency;
+use super::{NO_VISIBLE_POINT, PhotonMapper, SLOT_CHUNK, Setup};
+use crate::rng::Sampler;
+
+/// Camera streams live in their own half of the sampler's index space.
+const CAMERA_STREAM: u64 = 1 << 63;
+
+/// A camera path up to its first non-specular hit ([`PhotonMapper::camera_chain`]).
+pub(crate) struct CameraChain {
+    /// Emission seen along the path (not divided by the slots per pixel).
+    pub(crate) direct: Rgb,
+    /// The first non-specular hit, if the path reached one within `max_depth`.
+    pub(crate) end: Option<ChainEnd>,
+}
+
+/// Where a camera path meets its first non-specular surface.
+pub(crate) struct ChainEnd {
+    pub(crate) hit: Hit,
+    /// Unit direction back toward the camera (or the last specular vertex).
+    pub(crate) outgoing: Vec3,
+    /// Product of the specular weights along the way.
+    pub(crate) throughput: Rgb,
+    /// Specular bounces before `hit`.
+    pub(crate) bounces: u32,
+    /// The path's sampler, positioned after the chain's draws.
+    pub(crate) sampler: Sampler,
+}
+
+/// What one camera path produced.
+#[derive(Clone, Copy, Debug)]
+struct CameraSample {
+    /// Emission seen along the path (and direct lighting), already weighted by 1/spp.
+    direct: Rgb,
+    visible: Option<VisiblePoint>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct VisiblePoint {
+    position: Vec3,
+    shading_normal: Vec3,
+    geometric_normal: Vec3,
+    outgoing: Vec3,
+    material: u32,
+    weight: Rgb,
+    normal_distance: f32,
+    /// |cos θo| of the camera path's last segment at the visible point.
+    mu_o: f32,
+    /// Specular bounces of the camera path before this point.
+    bounces: u32,
+}
+
+impl PhotonMapper<'_> {
+    /// Traces one camera path per slot with this pass's jitter. The emission they see
+    /// directly (and the direct lighting, if enabled) is always accumulated, so that emitters
+    /// seen through a pixel are antialiased progressively even by PPM; the visible points
+    /// replace the slots' only when `update_hitpoints` (the first pass, and every SPPM pass):
+    /// otherwise only the emission sums are updated, in place.
+    pub(super) fn camera_pass(&mut self, update_hitpoints: bool) {
+        let setup = &self.setup;
+        let spp = setup.params.samples_per_pixel;
+        let n_slots = setup.width as usize * setup.height as usize * spp as usize;
+        let initial_radius = setup.kernel_scale;
+        let first = self.slots.is_empty();
+        let pass = self.pass;
+        if !update_hitpoints && !first {
+            // Only the directly seen emission changes: accumulate it in place, in parallel.
+            self.direct
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(SLOT_CHUNK)
+                .for_each(|(slot, sum)| {
+                    let sample = setup.trace_camera_path(slot as u32, pass);
+                    for (c, sum) in sum.iter_mut().enumerate() {
+                        *sum += f64::from(sample.direct[c]);
+                    }
+                });
+            self.camera_passes += 1;
+            return;
+        }
+        let traced: Vec<CameraSample> = (0..n_slots)
+            .into_par_iter()
+            .with_min_len(SLOT_CHUNK)
+            .map(|slot| setup.trace_camera_path(slot as u32, pass))
+            .collect();
+        if first {
+            self.slots = HitPoints::with_capacity(n_slots);
+            self.direct = vec![[0.0; 3]; n_slots];
+            self.photon_bounces = vec![NO_VISIBLE_POINT; n_slots];
+        }
+        for (slot, sample) in traced.into_iter().enumerate() {
+            for c in 0..3 {
+                self.direct[slot][c] += f64::from(sample.direct[c]);
+            }
+            let point = sample.visible.unwrap_or(VisiblePoint {
+                position: Vec3::ZERO,
+                shading_normal: Vec3::Z,
+                geometric_normal: Vec3::Z,
+                outgoing: Vec3::Z,
+                material: 0,
+                weight: Vec3::ZERO,
+                normal_distance: 0.0,
+                mu_o: 1.0,
+                bounces: 0,
+            });
+            // Visible points have bounces < max_depth ≤ 1024 (`trace_camera_path`).
+            let budget = (setup.params.max_depth - 1).saturating_sub(point.bounces);
+            self.photon_bounces[slot] = match sample.visible {
+                Some(_) => u16::try_from(budget).unwrap_or(NO_VISIBLE_POINT - 1),
+                None => NO_VISIBLE_POINT,
+            };
+            let new = NewHitPoint {
+                position: point.position,
+                shading_normal: point.shading_normal,
+                geometric_normal: point.geometric_normal,
+                outgoing: point.outgoing,
+                material_idx: point.material,
+                weight: point.weight,
+                radius: initial_radius,
+                freq: SlotFrequency::new(point.normal_distance, point.mu_o),
+            };
+            if first {
+                self.slots.push(new);
+            } else {
+                self.slots.replace_visible_point(slot, &new);
+                self.slots.columns_mut().freq[slot].move_to(point.normal_distance, point.mu_o);
+            }
+        }
+        self.camera_passes += 1;
+    }
+
+    /// The camera path of `slot` in `pass` through specular bounces to its first non-specular
+    /// hit, with the emission it sees on the way (unweighted by 1/spp).
+    pub(crate) fn camera_chain(&self, slot: u32, pass: u32) -> CameraChain {
+        self.setup.camera_chain(slot, pass)
+    }
+}
+
+impl Setup<'_> {
+    fn trace_camera_path(&self, slot: u32, pass: u32) -> CameraSample {
+        let weight_scale = 1.0 / self.params.samples_per_pixel as f32;
+        let chain = self.camera_chain(slot, pass);
+        let mut direct = chain.direct;
+        let visible = chain.end.map(|mut end| {
+            let hit = &end.hit;
+            if self.params.direct_lighting
+                && let Some(bsdf) = self.scene.bsdf(hit)
+            {
+                direct += end.throughput
+                    * self.direct_lighting(hit, &bsdf, end.outgoing, &mut end.sampler);
+            }
+            let mu = end.outgoing.dot(hit.shading_normal).abs();
+            VisiblePoint {
+                position: hit.position,
+                shading_normal: hit.shading_normal,
+                geometric_normal: hit.geometric_normal,
+                outgoing: end.outgoing,
+                material: hit.material,
+                weight: end.throughput * weight_scale,
+                normal_distance: hit.t * mu,
+                mu_o: mu,
+                bounces: end.bounces,
+            }
+        });
+        CameraSample {
+            direct: direct * weight_scale,
+            visible,
+        }
+    }
+
+    fn camera_chain(&self, slot: u32, pass: u32) -> CameraChain {
+        let spp = self.params.samples_per_pixel;
+        let pixel = slot / spp;
+        let (x, y) = (pixel % self.width, pixel / self.width);
+        let mut sampler = Sampler::new(self.params.seed, pass, CAMERA_STREAM | u64::from(slot));
+        let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+        let mut ray = self.scene.camera().generate_ray(film, sampler.next_2d());
+        let mut throughput = Rgb::ONE;
+        let mut direct = Rgb::ZERO;
+        // `bounces`: scattering events of the camera path before this hit. Emission seen here
+        // ends a light path with that many; a hitpoint adds one (its own scattering) to the
+        // photon's, so it needs bounces < max_depth.
+        for bounces in 0..=self.params.max_depth {
+            let Some(hit) = self.scene.intersect(&ray) else {
+                break;
+            };
+            direct += throughput * self.scene.emitted(&hit);
+            if bounces == self.params.max_depth {
+                break;
+            }
+            let Some(material) = self.scene.material(hit.material) else {
+                break;
+            };
+            let bsdf = Bsdf::new(material, &hit);
+            let outgoing = -ray.direction;
+            if bsdf.is_specular() {
+                let u_lobe = sampler.next_f32();
+                let u = sampler.next_2d();
+                let Some(sample) = bsdf.sample(outgoing, u_lobe, u, TransportMode::Radiance) else {
+                    break;
+                };
+                throughput *= sample.weight;
+                if throughput == Rgb::ZERO {
+                    break;
+                }
+                ray = hit.spawn_ray(sample.incoming);
+                continue;
+            }
+            return CameraChain {
+                direct,
+                end: Some(ChainEnd {
+                    hit,
+                    outgoing,
+                    throughput,
+                    bounces,
+                    sampler,
+                }),
+            };
+        }
+        CameraChain { direct, end: None }
+    }
+
+    /// One light sample of next-event estimation at a non-specular camera hit.
+    fn direct_lighting(
+        &self,
+        hit: &Hit,
+        bsdf: &Bsdf,
+        outgoing: Vec3,
+        sampler: &mut Sampler,
+    ) -> Rgb {
+        let u_light = sampler.next_f32();
+        let u = sampler.next_2d();
+        let Some(sample) = self.scene.lights().sample_direct(hit.position, u_light, u) else {
+            return Rgb::ZERO;
+        };
+        if sample.pdf <= 0.0 || !self.scene.light_visible(hit, &sample) {
+            return Rgb::ZERO;
+        }
+        let cos = sample.incoming.dot(hit.shading_normal).abs();
+        bsdf.eval(outgoing, sample.incoming) * sample.radiance * (cos / sample.pdf)
+    }
+}

@@ -1,0 +1,203 @@
+//! Phase 3 of a pass: the photon pass. Photons are traced in parallel in fixed chunks, sorted
+//! in Morton order and gathered into the hitpoints with `photon::gather_with`, which sums every
+//! hitpoint's contributions in photon order whatever the thread count.
+
+use std::time::Instant;
+
+use geometry::{Bsdf, MaterialKind, Rgb};
+use photon::{AcceptParams, GatherScratch, MortonScratch, Photon};
+use rayon::prelude::*;
+
+use super::frequency::FrequencyPhoton;
+use super::trace::TracedPhotons;
+use super::{PHOTON_CHUNK, PassStats, PhotonMapper};
+
+/// `PhotonPass::slot_entry` of a slot the grid does not index.
+pub(super) const NOT_IN_GRID: u32 = u32::MAX;
+
+/// The photon pass's buffers and what it leaves for the update: M and Φ per grid entry.
+///
+/// The buffers are kept from one pass to the next: a pass of a million photons fills about a
+/// hundred megabytes of them, which freshly allocated would cost page faults and serial copies.
+/// None of it carries state between passes.
+#[derive(Default)]
+pub(super) struct PhotonPass {
+    /// Per chunk of [`PHOTON_CHUNK`] photon paths, what they stored.
+    pub(super) traced: Vec<TracedPhotons>,
+    /// Morton keys of the stored photons.
+    keys: MortonScratch,
+    /// The stored photons in Morton order.
+    sorted: Vec<Photon>,
+    gather: GatherScratch<Rgb>,
+    /// The flux gather of the frequency-guided methods: each pair with its photon's tag.
+    pub(super) tagged_gather: GatherScratch<(Rgb, u32)>,
+    /// Per grid entry: M and Φ of the pass.
+    per_entry: Vec<(u32, [f64; 3])>,
+    /// Per slot: its grid entry, or [`NOT_IN_GRID`].
+    pub(super) slot_entry: Vec<u32>,
+}
+
+impl PhotonPass {
+    /// M and Φ of `slot` in the last pass.
+    pub(super) fn deposit_of(&self, slot: usize) -> (u32, [f64; 3]) {
+        match self.slot_entry[slot] {
+            NOT_IN_GRID => (0, [0.0; 3]),
+            entry => self.per_entry[entry as usize],
+        }
+    }
+
+    /// Heap bytes of the buffers sized by the photons, and of those sized by the hitpoints.
+    pub(super) fn heap_bytes(&self) -> (usize, usize) {
+        use std::mem::size_of;
+        let traced: usize = self
+            .traced
+            .iter()
+            .map(|t| {
+                t.photons.capacity() * size_of::<Photon>()
+                    + t.frequency.capacity() * size_of::<FrequencyPhoton>()
+            })
+            .sum::<usize>()
+            + self.traced.capacity() * size_of::<TracedPhotons>();
+        (
+            traced
+                + self.sorted.capacity() * size_of::<Photon>()
+                + self.keys.heap_bytes()
+                + self.gather.heap_bytes()
+                + self.tagged_gather.heap_bytes(),
+            self.per_entry.capacity() * size_of::<(u32, [f64; 3])>()
+                + self.slot_entry.capacity() * size_of::<u32>(),
+        )
+    }
+}
+
+impl PhotonMapper<'_> {
+    /// Traces this pass's photons (in parallel, fixed chunks), then gathers them into the
+    /// hitpoints in Morton order, and the frequency photons' deposits with them; reports the
+    /// photon counts and the tracing and frequency times in `stats`.
+    pub(super) fn photon_pass(&mut self, stats: &mut PassStats) {
+        let setup = &self.setup;
+        let n = u64::from(setup.params.photons_per_pass);
+        let first_index = self.n_emitted;
+        let pass = self.pass;
+        let clock = Instant::now();
+        let buffers = &mut self.photons;
+        let n_chunks = usize::try_from(n.div_ceil(PHOTON_CHUNK)).unwrap_or(usize::MAX);
+        buffers.traced.resize_with(n_chunks, TracedPhotons::default);
+        let layout = self.frequency.layout(n_chunks, setup.params.max_depth);
+        buffers
+            .traced
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(chunk, out)| {
+                out.clear();
+                let start = chunk as u64 * PHOTON_CHUNK;
+                let end = (start + PHOTON_CHUNK).min(n);
+                let tag_base = layout.chunk_base(chunk);
+                for idx in start..end {
+                    setup.trace_photon(pass, first_index + idx, tag_base, out);
+                }
+            });
+        self.n_emitted += n;
+        let frequency_photons = buffers.traced.iter().map(|c| c.frequency_photons).sum();
+        let trace_seconds = clock.elapsed().as_secs_f64();
+        let uses_frequency = setup.params.method.uses_frequency();
+        let frequency_clock = Instant::now();
+        if uses_frequency {
+            self.frequency.tag(layout, &mut buffers.traced);
+        }
+        let frequency_seconds = frequency_clock.elapsed().as_secs_f64();
+        let n_slots = self.slots.len();
+        stats.photons_traced = n;
+        stats.frequency_photons = frequency_photons;
+        stats.timings.trace = trace_seconds;
+        stats.timings.frequency += frequency_seconds;
+        // Slot → grid entry (`NOT_IN_GRID` for slots the grid does not index).
+        let grid_slots = self.index.grid_slots();
+        buffers.per_entry.clear();
+        buffers.slot_entry.clear();
+        buffers.slot_entry.resize(n_slots, NOT_IN_GRID);
+        for (entry, &slot) in grid_slots.iter().enumerate() {
+            buffers.slot_entry[slot as usize] = entry as u32;
+        }
+        let Some(grid) = self.index.grid() else {
+            return;
+        };
+        // Morton order (of the photons' positions, ties in trace order).
+        photon::morton_sort(
+            &buffers.traced,
+            |p: &Photon| p.position,
+            &mut buffers.keys,
+            &mut buffers.sorted,
+        );
+
+        let slots = &self.slots;
+        let photon_bounces = &self.photon_bounces;
+        let flux = |photon: &Photon, entry: u32| {
+            let slot = grid_slots[entry as usize] as usize;
+            // Whether the photon, which the grid reported for `slot` (so it lies within the
+            // slot's radius: the grid's test is exactly that of `photon::accepts`), counts for
+            // it: the light path they make has at most `max_depth` bounces, and the photon is
+            // on the hitpoint's side, with agreeing normals (see `photon::faces`).
+            let accepts = photon.bounces <= u32::from(photon_bounces[slot])
+                && photon::faces(photon, slots.geometric_normal()[slot], AcceptParams::COS_60);
+            accepts.then(|| {
+                let material = setup.scene.material(slots.material_idx()[slot])?;
+                let (normal, outgoing) = (slots.shading_normal()[slot], slots.outgoing()[slot]);
+                let f = match material.kind {
+                    // `Bsdf::eval` of a Lambertian without building the shading frame: the
+                    // same hemisphere test on the same dot products (the frame's z is the
+                    // normal), the same value.
+                    MaterialKind::Diffuse { albedo } => {
+                        if outgoing.dot(normal) * photon.incoming.dot(normal) <= 0.0 {
+                            Rgb::ZERO
+                        } else {
+                            albedo * std::f32::consts::FRAC_1_PI
+                        }
+                    }
+                    kind => Bsdf::from_normal(kind, normal, true).eval(outgoing, photon.incoming),
+                };
+                Some(f * photon.power * slots.weight()[slot])
+            })?
+        };
+        let add = |acc: &mut (u32, [f64; 3]), flux: Rgb| {
+            acc.0 += 1;
+            acc.1[0] += f64::from(flux.x);
+            acc.1[1] += f64::from(flux.y);
+            acc.1[2] += f64::from(flux.z);
+        };
+        if uses_frequency {
+            // The flux pairs carry the photon's tag, for the frequency deposits below.
+            photon::gather_with(
+                &mut buffers.tagged_gather,
+                grid,
+                &buffers.sorted,
+                &mut buffers.per_entry,
+                grid_slots.len(),
+                |photon, entry| flux(photon, entry).map(|f| (f, photon.tag)),
+                |acc, (f, _)| add(acc, f),
+            );
+        } else {
+            photon::gather_with(
+                &mut buffers.gather,
+                grid,
+                &buffers.sorted,
+                &mut buffers.per_entry,
+                grid_slots.len(),
+                flux,
+                add,
+            );
+        }
+        stats.photons_stored = buffers.sorted.len() as u64;
+        for &(m, _) in &buffers.per_entry {
+            stats.photons_deposited += u64::from(m);
+            stats.hitpoints_hit += u64::from(m > 0);
+        }
+        if !uses_frequency {
+            return;
+        }
+        let frequency_clock = Instant::now();
+        self.frequency
+            .deposit(setup, layout, buffers, grid_slots, &mut self.slots);
+        stats.timings.frequency += frequency_clock.elapsed().as_secs_f64();
+    }
+}

@@ -1,0 +1,179 @@
+//! Tracing one photon path: emission, Russian roulette, scattering, and the photons it stores
+//! on non-specular surfaces (with the frequency steps of `frequency.rs` for frequency photons).
+
+use geometry::{Bsdf, Hit, MaterialKind, Rgb, TransportMode};
+use glam::Vec3;
+use photon::Photon;
+
+use super::Setup;
+use super::frequency::{FrequencyPhoton, scatter_spectrum};
+use crate::rng::Sampler;
+
+/// Path depth from which Russian roulette may end a photon path.
+const ROULETTE_DEPTH: u32 = 3;
+
+/// Photons of one chunk, in trace order.
+#[derive(Default)]
+pub(super) struct TracedPhotons {
+    pub(super) photons: Vec<Photon>,
+    /// The frequency records of the chunk's frequency photons, in trace order.
+    pub(super) frequency: Vec<FrequencyPhoton>,
+    pub(super) frequency_photons: u64,
+}
+
+impl TracedPhotons {
+    /// Empties the chunk for the next pass, keeping the allocations.
+    pub(super) fn clear(&mut self) {
+        self.photons.clear();
+        self.frequency.clear();
+        self.frequency_photons = 0;
+    }
+}
+
+impl AsRef<[Photon]> for TracedPhotons {
+    fn as_ref(&self) -> &[Photon] {
+        &self.photons
+    }
+}
+
+impl Setup<'_> {
+    /// Traces photon path `index` of pass `pass` and stores its non-specular hits in `out`.
+    ///
+    /// The hot loop of a pass: `Scene::intersect_inlined` compiles the BVH traversal and the
+    /// hit into it, so that the `Hit` is not returned through memory. Not inlined itself (one
+    /// call per path), so that it stays visible in profiles; docs/performance.md says where
+    /// its time goes.
+    #[inline(never)]
+    pub(super) fn trace_photon(
+        &self,
+        pass: u32,
+        index: u64,
+        tag_base: u32,
+        out: &mut TracedPhotons,
+    ) {
+        let mut sampler = Sampler::new(self.params.seed, pass, index);
+        let u_light = sampler.next_f32();
+        let u_pos = sampler.next_2d();
+        let u_dir = sampler.next_2d();
+        let Some(emission) = self.scene.lights().sample_emission(u_light, u_pos, u_dir) else {
+            return;
+        };
+        let mut power = emission.power;
+        let mut ray = emission.ray();
+        let mut spectrum = self.start_spectrum(index, emission.emitter);
+        if spectrum.is_some() {
+            out.frequency_photons += 1;
+        }
+        // `depth`: the photon's bounces before this hit. A hitpoint adds one more, so hits at
+        // depth max_depth − 1 are the last that can count.
+        for depth in 0..self.params.max_depth {
+            let Some(hit) = self.scene.intersect_inlined(&ray) else {
+                break;
+            };
+            let Some(material) = self.scene.material(hit.material) else {
+                break;
+            };
+            let incoming = -ray.direction;
+            if let Some(s) = spectrum.as_mut() {
+                *s = self.travel_spectrum(*s, &ray, &hit, &mut sampler);
+            }
+            let bsdf = Bsdf::new(material, &hit);
+            // With direct lighting by light sampling, photons straight from an emitter are
+            // already accounted for at the hitpoints.
+            let counted_by_light_sampling = self.params.direct_lighting && depth == 0;
+            if !bsdf.is_specular() && !counted_by_light_sampling {
+                let tag = self.record_frequency_photon(
+                    spectrum,
+                    &hit,
+                    incoming,
+                    material.kind.lobe(),
+                    tag_base,
+                    out,
+                );
+                out.photons.push(Photon {
+                    position: hit.position,
+                    incoming,
+                    power,
+                    normal: hit.geometric_normal,
+                    bounces: depth,
+                    tag,
+                });
+            }
+            // Scatter, unless no later hit could count.
+            if depth + 1 == self.params.max_depth {
+                break;
+            }
+            let u_lobe = sampler.next_f32();
+            let u = sampler.next_2d();
+            let u_roulette = sampler.next_f32();
+            // Russian roulette (pbrt-v4 SPPM): keep the photon's power roughly constant, killing
+            // it with probability q = 1 − lum(scattered power) / lum(power) and dividing the
+            // survivor by 1 − q. On a Lambertian surface the scattered power is power × albedo
+            // whatever the direction (up to the shading-normal correction, which the roulette
+            // leaves out there), so the roulette runs before the direction is drawn and a killed
+            // photon costs no BSDF sample; elsewhere it needs the sampled weight. Either way q
+            // is fixed before `u_roulette` is compared with it: unbiased.
+            let roulette = depth + 1 >= ROULETTE_DEPTH;
+            let kill_probability = |scattered: Rgb| {
+                let ratio = luminance(scattered) / luminance(power).max(f32::MIN_POSITIVE);
+                (1.0 - ratio).max(0.0)
+            };
+            // The survival probability, when the roulette is decided before sampling.
+            let decided = match material.kind {
+                MaterialKind::Diffuse { albedo } if roulette => {
+                    let q = kill_probability(power * albedo);
+                    if u_roulette < q {
+                        break;
+                    }
+                    Some(1.0 - q)
+                }
+                _ => None,
+            };
+            let Some(sample) = bsdf.sample(incoming, u_lobe, u, TransportMode::Importance) else {
+                break;
+            };
+            let new_power =
+                power * sample.weight * shading_normal_correction(&hit, incoming, sample.incoming);
+            let survive = match decided {
+                Some(survive) => survive,
+                None if roulette => {
+                    let q = kill_probability(new_power);
+                    if u_roulette < q {
+                        break;
+                    }
+                    1.0 - q
+                }
+                None => 1.0,
+            };
+            power = new_power / survive;
+            if power == Rgb::ZERO || !power.is_finite() {
+                break;
+            }
+            if let Some(s) = spectrum.as_mut() {
+                *s = scatter_spectrum(*s, &hit, incoming, &sample, &bsdf, material, &self.caps);
+            }
+            ray = hit.spawn_ray(sample.incoming);
+        }
+    }
+}
+
+/// Veach's correction for shading normals on light paths (thesis §5.3; pbrt's
+/// `CorrectShadingNormal`): the BSDF is not symmetric once the shading normal differs from the
+/// geometric one, and flux carried by photons must be multiplied by
+/// |ωo·n_s|·|ωi·n_g| / (|ωo·n_g|·|ωi·n_s|) at every bounce (ωo toward where the photon came
+/// from, ωi the new direction). Without it photons through smooth-shaded meshes (the water
+/// surface of the Cornell box) carry a few per cent too much or too little light.
+fn shading_normal_correction(hit: &Hit, from: Vec3, to: Vec3) -> f32 {
+    let (ns, ng) = (hit.shading_normal, hit.geometric_normal);
+    let numerator = from.dot(ns).abs() * to.dot(ng).abs();
+    let denominator = from.dot(ng).abs() * to.dot(ns).abs();
+    if denominator > 0.0 {
+        numerator / denominator
+    } else {
+        0.0
+    }
+}
+
+fn luminance(c: Rgb) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}

@@ -1,0 +1,80 @@
+//! Phase 4 of a pass: the hitpoint update. Every slot folds the pass's M and Φ into its R, N
+//! and τ by [`GatherStats::update_with_hold`], with the frequency radius `frequency::hold` gives it.
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use super::{PassStats, PhotonMapper, frequency};
+use crate::update::GatherStats;
+
+impl PhotonMapper<'_> {
+    /// Folds the last photon pass into every slot, and reports the radii and the share of
+    /// slots that hold theirs in `stats`.
+    pub(super) fn update_hitpoints(&mut self, stats: &mut PassStats) {
+        let params = self.setup.params;
+        let alpha = params.alpha;
+        let k = params.kernel_k;
+        let floor = params.freq_floor;
+        let uses_frequency = params.method.uses_frequency();
+        let probe_clock = Instant::now();
+        if uses_frequency && params.freq_geometry {
+            self.probe_clear_radii(params.freq_clear_cap);
+        }
+        let probe_seconds = probe_clock.elapsed().as_secs_f64();
+        let r_top = self.setup.kernel_max();
+        let hold_alpha = params.freq_hold_alpha;
+        let clear_cap = uses_frequency && params.freq_geometry && params.freq_clear_cap;
+        // The cap never goes below a quarter of the initial radius: a smaller disc collects
+        // too few photons per pass for its bias gain to pay (measured, docs/integrators.md).
+        let r_min = 0.25 * self.setup.kernel_scale;
+        let photons = &self.photons;
+        let n_slots = self.slots.len();
+        let columns = self.slots.columns_mut();
+        let held: Vec<bool> = columns
+            .radius
+            .par_iter_mut()
+            .zip(columns.photon_count.par_iter_mut())
+            .zip(columns.flux.par_iter_mut())
+            .zip(columns.freq.par_iter())
+            .zip((0..n_slots).into_par_iter().map(|s| photons.deposit_of(s)))
+            .map(|((((radius, photon_count), tau), freq), (m, phi))| {
+                let (r_freq, held) = frequency::hold(freq, *radius, uses_frequency, k, r_top);
+                let mut stats = GatherStats {
+                    radius: *radius,
+                    photon_count: *photon_count,
+                    flux: *tau,
+                };
+                stats.update_with_hold(m, phi, alpha, r_freq, floor, hold_alpha);
+                if clear_cap && let Some(clear) = freq.clear_radius(r_top) {
+                    stats.cap_radius(clear.max(r_min));
+                }
+                *radius = stats.radius;
+                *photon_count = stats.photon_count;
+                *tau = stats.flux;
+                held
+            })
+            .collect();
+
+        stats.timings.frequency += probe_seconds;
+        stats.min_radius = f64::INFINITY;
+        let mut sum = 0.0;
+        let mut n_held = 0u64;
+        for (slot, &r) in self.slots.radius().iter().enumerate() {
+            if !self.is_valid(slot) {
+                continue;
+            }
+            stats.hitpoints_valid += 1;
+            sum += r;
+            stats.min_radius = stats.min_radius.min(r);
+            stats.max_radius = stats.max_radius.max(r);
+            n_held += u64::from(held[slot]);
+        }
+        if stats.hitpoints_valid > 0 {
+            stats.mean_radius = sum / stats.hitpoints_valid as f64;
+            stats.frequency_held = n_held as f64 / stats.hitpoints_valid as f64;
+        } else {
+            stats.min_radius = 0.0;
+        }
+    }
+}
