@@ -8,4 +8,6 @@
 )]
 
 mod architecture;
+mod mitsuba_roundtrip;
+mod pbrt_by_hand;
 mod shared_scenes;

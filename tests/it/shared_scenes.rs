@@ -25,6 +25,12 @@ const LIT_SCENES: &[&str] = &[
     "gltf/EmissiveStrengthTest/glTF/EmissiveStrengthTest.gltf",
     "gltf/EmissiveStrengthTest/glTF-Binary/EmissiveStrengthTest.glb",
     "gltf/LightsPunctualLamp/glTF/LightsPunctualLamp.gltf",
+    "mitsuba3/scenes/cbox/cbox.xml",
+    "mitsuba3/scenes/cbox/cbox-rgb.xml",
+    "mitsuba3/scenes/cbox/cbox-spectral.xml",
+    "pbrt-v4/killeroos/killeroo-simple.pbrt",
+    "pbrt-v4/killeroos/killeroo-gold.pbrt",
+    "pbrt-v4/veach-mis/veach-mis.pbrt",
 ];
 
 #[test]

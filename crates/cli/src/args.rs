@@ -45,7 +45,7 @@ pub(crate) struct Cli {
 #[allow(clippy::large_enum_variant)]
 #[derive(Debug, Subcommand)]
 pub(crate) enum Command {
-    /// Render a scene file (.toml, .obj with its .mtl, .gltf, .glb).
+    /// Render a scene file (.toml, .obj with its .mtl, .gltf, .glb, Mitsuba 3 .xml, pbrt-v4 .pbrt).
     Render {
         /// The scene file.
         #[arg(value_name = "SCENE")]

@@ -224,3 +224,24 @@ pub struct RenderDefaults {
     /// number or `true`/`false` as written by Rust), in the order of the keys' names.
     pub params: Vec<(String, String)>,
 }
+
+impl RenderDefaults {
+    /// The text of render parameter `name`, if the scene sets it.
+    #[must_use]
+    pub fn get(&self, name: &str) -> Option<&str> {
+        self.params
+            .iter()
+            .find(|(key, _)| key == name)
+            .map(|(_, value)| value.as_str())
+    }
+
+    /// Sets render parameter `name` (what an importer reads from another renderer's
+    /// settings), replacing an earlier value.
+    pub fn set(&mut self, name: &str, value: impl ToString) {
+        let value = value.to_string();
+        match self.params.iter_mut().find(|(key, _)| key == name) {
+            Some(entry) => entry.1 = value,
+            None => self.params.push((name.to_owned(), value)),
+        }
+    }
+}

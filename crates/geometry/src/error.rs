@@ -27,7 +27,7 @@ pub enum LoadError {
     },
     /// The file name has an extension no loader handles.
     #[error(
-        "{}: unsupported scene file extension {extension:?} (expected .toml, .obj, .gltf or .glb)",
+        "{}: unsupported scene file extension {extension:?} (expected .toml, .obj, .gltf, .glb, .xml or .pbrt)",
         path.display()
     )]
     UnsupportedExtension {
@@ -203,6 +203,54 @@ pub enum LoadError {
         /// The file.
         path: PathBuf,
     },
+    /// A Mitsuba XML scene is malformed, or uses something with no honest stand-in.
+    #[error("{}: {}{}{message}", path.display(), location(*line, *column), element_prefix(element))]
+    Xml {
+        /// The XML file (the scene or the included fragment).
+        path: PathBuf,
+        /// 1-based line, if known.
+        line: Option<u32>,
+        /// 1-based column, if known.
+        column: Option<u32>,
+        /// The element, e.g. `<shape type="ply">` (empty if none).
+        element: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A pbrt-v4 scene is malformed, or uses something with no honest stand-in.
+    #[error("{}: {}{message}", path.display(), location(*line, *column))]
+    Pbrt {
+        /// The pbrt file (the scene or an included file).
+        path: PathBuf,
+        /// 1-based line, if known.
+        line: Option<u32>,
+        /// 1-based column, if known.
+        column: Option<u32>,
+        /// What is wrong.
+        message: String,
+    },
+    /// A binary or ASCII mesh file (PLY, Mitsuba `.serialized`) is malformed.
+    #[error("{}: invalid {format} file: {message}", path.display())]
+    MeshFile {
+        /// The mesh file.
+        path: PathBuf,
+        /// `"ply"` or `"serialized"`.
+        format: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// Nothing fppm can render emits light, but the file has emitters it had to skip
+    /// (environment lights are not supported yet).
+    #[error(
+        "{}: scene has no emitter fppm can render (skipped: {skipped}; environment lights are not supported yet)",
+        path.display()
+    )]
+    NoSupportedEmitter {
+        /// The file.
+        path: PathBuf,
+        /// The skipped emitters, e.g. `<emitter type="envmap">`.
+        skipped: String,
+    },
     /// An emissive material is used only by degenerate (zero-area) triangles.
     #[error("{}: emissive material {material:?} has zero area (all its triangles are degenerate)", path.display())]
     ZeroAreaEmitter {
@@ -229,6 +277,15 @@ fn for_key(key: &str) -> String {
         String::new()
     } else {
         format!(" for {key:?}")
+    }
+}
+
+/// `"<shape type=\"ply\">: "`, or nothing.
+fn element_prefix(element: &str) -> String {
+    if element.is_empty() {
+        String::new()
+    } else {
+        format!("{element}: ")
     }
 }
 
@@ -263,7 +320,11 @@ impl LoadError {
             | Self::NonFiniteVertex { path, .. }
             | Self::EmptyScene { path }
             | Self::NoEmitter { path }
-            | Self::ZeroAreaEmitter { path, .. } => path,
+            | Self::ZeroAreaEmitter { path, .. }
+            | Self::Xml { path, .. }
+            | Self::Pbrt { path, .. }
+            | Self::MeshFile { path, .. }
+            | Self::NoSupportedEmitter { path, .. } => path,
         }
     }
 }

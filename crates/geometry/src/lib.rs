@@ -25,7 +25,8 @@
 //!
 //! The loaders turn a scene file into a plain [`SceneDescription`]:
 //! [`load()`] picks the loader by extension (`.toml` scene files of format version 1, lone
-//! `.obj` files with their `.mtl`, `.gltf`/`.glb` files), [`load_toml_str`] reads a TOML scene
+//! `.obj` files with their `.mtl`, `.gltf`/`.glb` files, Mitsuba 3 `.xml` and pbrt-v4 `.pbrt`
+//! scenes, whose mapping is in `docs/scene-import.md`), [`load_toml_str`] reads a TOML scene
 //! held in memory, and [`load_with`] takes [`LoadOptions`] (e.g. to accept a scene without
 //! emitters for `fppm info`). Every failure is a [`LoadError`] naming the file.
 //! [`SceneDescription::summary`] gives a [`SceneSummary`] for reports and snapshots.

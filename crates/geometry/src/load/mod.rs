@@ -16,8 +16,14 @@
 
 mod frame;
 mod gltf;
+mod import;
+mod mitsuba;
 mod obj;
+mod pbrt;
+mod ply;
 mod polygon;
+mod serialized;
+mod spectrum;
 mod toml;
 
 use std::collections::HashSet;
@@ -70,8 +76,8 @@ impl LoadOptions {
     }
 }
 
-/// Loads a scene file, choosing the loader by extension: `.toml`, `.obj`, `.gltf` or `.glb`
-/// (case-insensitive). The scene must contain an emitter.
+/// Loads a scene file, choosing the loader by extension: `.toml`, `.obj`, `.gltf`, `.glb`,
+/// `.xml` (Mitsuba 3) or `.pbrt` (pbrt-v4) (case-insensitive). The scene must contain an emitter.
 ///
 /// # Errors
 /// Any [`LoadError`]: unreadable file, unknown extension, malformed or out-of-range content,
@@ -102,6 +108,8 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<SceneDescription,
             let mesh = gltf::load_gltf(path)?;
             mesh.into_scene(path, options)
         }
+        "xml" => mitsuba::load_mitsuba(path, options),
+        "pbrt" => pbrt::load_pbrt(path, options),
         _ => Err(LoadError::UnsupportedExtension {
             path: path.to_path_buf(),
             extension,

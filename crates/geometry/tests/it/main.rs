@@ -5,7 +5,9 @@
 mod bad_input;
 mod cylinder;
 mod gltf;
+mod mitsuba;
 mod obj;
+mod pbrt;
 mod shared_scenes;
 mod toml_scene;
 
