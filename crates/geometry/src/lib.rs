@@ -61,6 +61,7 @@ mod scene;
 mod summary;
 #[cfg(test)]
 mod test_util;
+mod validate;
 
 pub use aabb::Aabb;
 pub use bsdf::{Bsdf, BsdfSample, Lobe, TransportMode, fresnel_dielectric};

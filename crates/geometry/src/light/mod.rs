@@ -158,25 +158,19 @@ pub struct LightSampler {
 }
 
 impl LightSampler {
-    /// Collects the emitters; `Err(None)` if none has positive power, `Err(Some(what))` for an
-    /// invalid light.
-    pub(crate) fn new(desc: &SceneDescription, bounds: Aabb) -> Result<Self, Option<String>> {
+    /// Collects the emitters of a valid description (see `crate::validate`); `None` if none
+    /// has positive power.
+    pub(crate) fn new(desc: &SceneDescription, bounds: Aabb) -> Option<Self> {
         let mut emitters = Vec::new();
-        let rgb_ok = |c: Rgb| c.is_finite() && c.cmpge(Rgb::ZERO).all();
-        for (i, light) in desc.lights.iter().enumerate() {
+        for light in &desc.lights {
             match *light {
                 Light::Point {
                     position,
                     intensity,
-                } => {
-                    if !(position.is_finite() && rgb_ok(intensity)) {
-                        return Err(Some(format!("point light {i}")));
-                    }
-                    emitters.push(Emitter::Point {
-                        position,
-                        intensity,
-                    });
-                }
+                } => emitters.push(Emitter::Point {
+                    position,
+                    intensity,
+                }),
                 Light::Spot {
                     position,
                     direction,
@@ -184,19 +178,10 @@ impl LightSampler {
                     cone_angle,
                     falloff_start,
                 } => {
-                    let axis = direction.try_normalize();
-                    let ok = position.is_finite()
-                        && rgb_ok(intensity)
-                        && cone_angle > 0.0
-                        && cone_angle <= PI
-                        && falloff_start.is_finite();
-                    let (Some(axis), true) = (axis, ok) else {
-                        return Err(Some(format!("spot light {i}")));
-                    };
                     let falloff_start = falloff_start.clamp(0.0, cone_angle);
                     emitters.push(Emitter::Spot {
                         position,
-                        frame: Frame::from_normal(axis),
+                        frame: Frame::from_normal(direction.normalize()),
                         intensity,
                         cos_cone: cone_angle.cos(),
                         cos_start: falloff_start.cos(),
@@ -207,24 +192,19 @@ impl LightSampler {
                 Light::Directional {
                     direction,
                     irradiance,
-                } => {
-                    let (Some(axis), true) = (direction.try_normalize(), rgb_ok(irradiance)) else {
-                        return Err(Some(format!("directional light {i}")));
-                    };
-                    emitters.push(Emitter::Directional {
-                        frame: Frame::from_normal(axis),
-                        irradiance,
-                        center: bounds.center(),
-                        radius: bounds.bounding_radius().max(1e-3),
-                    });
-                }
+                } => emitters.push(Emitter::Directional {
+                    frame: Frame::from_normal(direction.normalize()),
+                    irradiance,
+                    center: bounds.center(),
+                    radius: bounds.bounding_radius().max(1e-3),
+                }),
             }
         }
         let emission = |m: u32| {
             desc.materials
                 .get(m as usize)
                 .map(|m| m.emission)
-                .filter(|e| e.cmpgt(Rgb::ZERO).any() && rgb_ok(*e))
+                .filter(|e| e.cmpgt(Rgb::ZERO).any())
         };
         let mut triangle_emitter = Vec::new();
         for (i, tri) in desc.triangles.iter().enumerate() {
@@ -274,8 +254,8 @@ impl LightSampler {
         }
         let powers: Vec<Rgb> = emitters.iter().map(Emitter::power).collect();
         let weights: Vec<f64> = powers.iter().map(|&p| f64::from(luminance(p))).collect();
-        let distribution = Distribution1D::new(&weights).ok_or(None)?;
-        Ok(Self {
+        let distribution = Distribution1D::new(&weights)?;
+        Some(Self {
             emitters,
             powers,
             distribution,

@@ -36,6 +36,8 @@ use crate::description::{
     Triangle,
 };
 use crate::error::LoadError;
+use crate::validate;
+pub(crate) use crate::validate::fmt_vec;
 
 pub use frame::FRAMED_FOV_Y_DEGREES;
 pub(crate) use frame::{bounds, frame_camera};
@@ -290,12 +292,7 @@ pub(crate) fn finish(
         mut notes,
         degenerate_materials,
     } = parts;
-    for material in &materials {
-        check_material(path, material)?;
-    }
-    for light in &lights {
-        check_light(path, light)?;
-    }
+    validate::materials_and_lights(&materials, &lights).map_err(|e| e.in_file(path))?;
     if triangles.is_empty() && spheres.is_empty() && cylinders.is_empty() {
         return Err(LoadError::EmptyScene {
             path: path.to_path_buf(),
@@ -330,7 +327,9 @@ pub(crate) fn finish(
         .iter()
         .zip(&used)
         .any(|(m, &u)| u && is_emissive(m));
-    let has_delta_emitter = lights.iter().any(|l| light_power(l).max_element() > 0.0);
+    let has_delta_emitter = lights
+        .iter()
+        .any(|l| validate::light_power(l).max_element() > 0.0);
     if options.require_emitter && !has_area_emitter && !has_delta_emitter {
         return Err(LoadError::NoEmitter {
             path: path.to_path_buf(),
@@ -344,7 +343,7 @@ pub(crate) fn finish(
             frame_camera(&triangles, &spheres, &cylinders, aspect)
         }
     };
-    Ok(SceneDescription {
+    let description = SceneDescription {
         source: PathBuf::from(path),
         camera,
         film,
@@ -355,86 +354,7 @@ pub(crate) fn finish(
         lights,
         render,
         notes,
-    })
-}
-
-/// The colour that says how strong a light is (intensity or irradiance).
-pub(crate) fn light_power(light: &Light) -> Vec3 {
-    match *light {
-        Light::Point { intensity, .. } | Light::Spot { intensity, .. } => intensity,
-        Light::Directional { irradiance, .. } => irradiance,
-    }
-}
-
-/// Checks a colour: finite and non-negative.
-pub(crate) fn check_colour(path: &Path, key: &str, c: Vec3) -> Result<(), LoadError> {
-    if !c.is_finite() {
-        return Err(LoadError::InvalidValue {
-            path: path.to_path_buf(),
-            key: key.to_owned(),
-            message: format!("must be finite, got {}", fmt_vec(c)),
-        });
-    }
-    if c.min_element() < 0.0 {
-        return Err(LoadError::InvalidValue {
-            path: path.to_path_buf(),
-            key: key.to_owned(),
-            message: format!("must not be negative, got {}", fmt_vec(c)),
-        });
-    }
-    Ok(())
-}
-
-/// Formats a vector as `[x, y, z]`.
-pub(crate) fn fmt_vec(v: Vec3) -> String {
-    format!("[{}, {}, {}]", v.x, v.y, v.z)
-}
-
-fn check_material(path: &Path, m: &Material) -> Result<(), LoadError> {
-    use crate::description::MaterialKind;
-    let key = |what: &str| format!("material {:?} {what}", m.name);
-    check_colour(path, &key("emission"), m.emission)?;
-    match m.kind {
-        MaterialKind::Diffuse { albedo } => check_colour(path, &key("albedo"), albedo),
-        MaterialKind::Mirror { reflectance } => {
-            check_colour(path, &key("reflectance"), reflectance)
-        }
-        MaterialKind::Dielectric { ior } => {
-            if ior.is_finite() && ior > 0.0 {
-                Ok(())
-            } else {
-                Err(LoadError::InvalidValue {
-                    path: path.to_path_buf(),
-                    key: key("ior"),
-                    message: format!("must be finite and > 0, got {ior}"),
-                })
-            }
-        }
-        MaterialKind::Glossy {
-            reflectance,
-            roughness,
-            diffuse,
-        } => {
-            check_colour(path, &key("reflectance"), reflectance)?;
-            check_colour(path, &key("diffuse"), diffuse)?;
-            if roughness.is_finite() && roughness > 0.0 {
-                Ok(())
-            } else {
-                Err(LoadError::InvalidValue {
-                    path: path.to_path_buf(),
-                    key: key("roughness"),
-                    message: format!("must be finite and > 0, got {roughness}"),
-                })
-            }
-        }
-    }
-}
-
-fn check_light(path: &Path, light: &Light) -> Result<(), LoadError> {
-    let name = match light {
-        Light::Point { .. } => "point light intensity",
-        Light::Spot { .. } => "spot light intensity",
-        Light::Directional { .. } => "directional light irradiance",
     };
-    check_colour(path, name, light_power(light))
+    validate::primitives(&description).map_err(|e| e.in_file(path))?;
+    Ok(description)
 }

@@ -20,7 +20,7 @@ use std::path::Path;
 use glam::{Mat3, Mat4, Vec3};
 use serde::Deserialize;
 
-use super::{LoadOptions, MAX_FILM_SIDE, MeshData, SceneParts, check_colour, fmt_vec};
+use super::{LoadOptions, MAX_FILM_SIDE, MeshData, SceneParts, fmt_vec};
 use crate::description::{
     Camera, Cylinder, Film, Light, LoadNotes, Material, MaterialKind, RenderDefaults,
     SceneDescription, Sphere, Triangle,
@@ -226,7 +226,7 @@ impl Converter<'_> {
 
     fn colour(&self, key: &str, v: [f32; 3]) -> Result<Vec3, LoadError> {
         let c = Vec3::from(v);
-        check_colour(self.path, key, c)?;
+        crate::validate::colour(key, c).map_err(|e| e.in_file(self.path))?;
         Ok(c)
     }
 

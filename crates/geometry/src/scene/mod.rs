@@ -56,7 +56,7 @@ pub enum SceneError {
         count: usize,
     },
     /// A value is NaN, infinite or out of its range.
-    #[error("scene `{}`: {what} is invalid", path.display())]
+    #[error("scene `{}`: {what}", path.display())]
     Invalid {
         /// The scene file.
         path: PathBuf,
@@ -111,69 +111,23 @@ impl Scene {
         }
         let camera = CameraModel::new(&description.camera, &description.film)
             .ok_or_else(|| SceneError::Camera { path: source() })?;
-        let count = description.materials.len();
+        crate::validate::description(&description).map_err(|e| e.in_scene(&description.source))?;
         let invalid = |what: String| SceneError::Invalid {
             path: source(),
             what,
         };
-        for (i, m) in description.materials.iter().enumerate() {
-            if !valid_material(m) {
-                return Err(invalid(format!("material {i} (`{}`)", m.name)));
-            }
-        }
         let mut bounds = Aabb::EMPTY;
-        for (i, t) in description.triangles.iter().enumerate() {
-            if t.material as usize >= count {
-                return Err(SceneError::MaterialIndex {
-                    path: source(),
-                    what: format!("triangle {i}"),
-                    index: t.material,
-                    count,
-                });
-            }
-            if !t.positions.iter().all(|p| p.is_finite())
-                || !t.normals.is_none_or(|n| n.iter().all(|v| v.is_finite()))
-            {
-                return Err(invalid(format!("triangle {i} (non-finite vertex)")));
-            }
+        for t in &description.triangles {
             for p in t.positions {
                 bounds = bounds.include(p);
             }
         }
-        for (i, s) in description.spheres.iter().enumerate() {
-            if s.material as usize >= count {
-                return Err(SceneError::MaterialIndex {
-                    path: source(),
-                    what: format!("sphere {i}"),
-                    index: s.material,
-                    count,
-                });
-            }
-            if !(s.center.is_finite() && s.radius.is_finite() && s.radius > 0.0) {
-                return Err(invalid(format!("sphere {i} (radius {})", s.radius)));
-            }
+        for s in &description.spheres {
             bounds = bounds
                 .include(s.center - Vec3::splat(s.radius))
                 .include(s.center + Vec3::splat(s.radius));
         }
-        for (i, c) in description.cylinders.iter().enumerate() {
-            let Some(material) = description.materials.get(c.material as usize) else {
-                return Err(SceneError::MaterialIndex {
-                    path: source(),
-                    what: format!("cylinder {i}"),
-                    index: c.material,
-                    count,
-                });
-            };
-            if let Some(what) = invalid_cylinder(c) {
-                return Err(invalid(format!("cylinder {i} ({what})")));
-            }
-            if material.emission.max_element() > 0.0 {
-                return Err(invalid(format!(
-                    "cylinder {i} (material `{}` emits, but cylinders cannot)",
-                    material.name
-                )));
-            }
+        for c in &description.cylinders {
             bounds = bounds.union(c.bounds());
         }
         if bounds.is_empty() {
@@ -191,10 +145,8 @@ impl Scene {
             }
         }
         let extra = description.triangles.iter().map(triangle_extra).collect();
-        let lights = LightSampler::new(&description, bounds).map_err(|what| match what {
-            None => SceneError::NoLight { path: source() },
-            Some(what) => invalid(what),
-        })?;
+        let lights = LightSampler::new(&description, bounds)
+            .ok_or_else(|| SceneError::NoLight { path: source() })?;
         let primitives =
             description.triangles.len() + description.spheres.len() + description.cylinders.len();
         if primitives >= crate::bvh::MAX_PRIMITIVES {
@@ -442,44 +394,6 @@ impl Scene {
 }
 
 /// What is wrong with a cylinder's numbers, if anything.
-fn invalid_cylinder(c: &crate::Cylinder) -> Option<String> {
-    const TOLERANCE: f32 = 1e-4;
-    if !(c.center.is_finite() && c.axis.is_finite() && c.facing.is_finite()) {
-        return Some("non-finite center, axis or facing".to_owned());
-    }
-    if !(c.radius.is_finite() && c.radius > 0.0) {
-        return Some(format!("radius {}", c.radius));
-    }
-    if !(c.height.is_finite() && c.height > 0.0) {
-        return Some(format!("height {}", c.height));
-    }
-    if !(c.arc > 0.0 && c.arc <= std::f32::consts::TAU * (1.0 + TOLERANCE)) {
-        return Some(format!("arc {} outside (0, 2π]", c.arc));
-    }
-    if (c.axis.length() - 1.0).abs() > TOLERANCE
-        || (c.facing.length() - 1.0).abs() > TOLERANCE
-        || c.axis.dot(c.facing).abs() > TOLERANCE
-    {
-        return Some("axis and facing must be perpendicular unit vectors".to_owned());
-    }
-    None
-}
-
-fn valid_material(m: &Material) -> bool {
-    let rgb_ok = |c: Rgb| c.is_finite() && c.cmpge(Rgb::ZERO).all();
-    let kind_ok = match m.kind {
-        crate::MaterialKind::Diffuse { albedo } => rgb_ok(albedo),
-        crate::MaterialKind::Mirror { reflectance } => rgb_ok(reflectance),
-        crate::MaterialKind::Dielectric { ior } => ior.is_finite() && ior > 0.0,
-        crate::MaterialKind::Glossy {
-            reflectance,
-            roughness,
-            diffuse,
-        } => rgb_ok(reflectance) && rgb_ok(diffuse) && roughness.is_finite() && roughness > 0.0,
-    };
-    kind_ok && rgb_ok(m.emission)
-}
-
 /// Front normal and front-side curvature of a triangle (see [`Hit::curvature`]).
 fn triangle_extra(tri: &crate::Triangle) -> TriangleExtra {
     let [p0, p1, p2] = tri.positions;

@@ -1,0 +1,364 @@
+//! What makes a scene description valid, checked in one place: by every loader when it
+//! finishes (`load::finish`, which reports a [`LoadError`] naming the file) and by
+//! `Scene::new` for descriptions built in code (a [`SceneError`]). What follows from these
+//! checks (finite positions, unit directions, non-negative colours, material indices in range)
+//! is what the rest of the crate relies on: `LightSampler::new` and the BVH build cannot fail.
+
+use std::f32::consts::PI;
+use std::fmt;
+use std::path::Path;
+
+use glam::Vec3;
+
+use crate::description::{Cylinder, Light, Material, MaterialKind, SceneDescription};
+use crate::{LoadError, SceneError};
+
+/// One problem of a scene description.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum Invalid {
+    /// A value outside its domain: `key` names it as the scene does (`material "lamp"
+    /// emission`), `message` says what is wrong (`must be finite, got [inf, 0, 0]`).
+    Value { key: String, message: String },
+    /// A primitive refers to a material that does not exist.
+    MaterialIndex {
+        what: String,
+        index: u32,
+        count: usize,
+    },
+}
+
+impl fmt::Display for Invalid {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Value { key, message } => write!(f, "{key} {message}"),
+            Self::MaterialIndex { what, index, count } => write!(
+                f,
+                "{what} refers to material {index} but there are {count} materials"
+            ),
+        }
+    }
+}
+
+impl Invalid {
+    fn value(key: impl Into<String>, message: impl Into<String>) -> Self {
+        Self::Value {
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    /// The loader's error for this problem in the file `path`.
+    pub(crate) fn in_file(self, path: &Path) -> LoadError {
+        let message = self.to_string();
+        let (key, message) = match self {
+            Self::Value { key, message } => (key, message),
+            Self::MaterialIndex { what, .. } => (what, message),
+        };
+        LoadError::InvalidValue {
+            path: path.to_path_buf(),
+            key,
+            message,
+        }
+    }
+
+    /// `Scene::new`'s error for this problem in the scene from `path`.
+    pub(crate) fn in_scene(self, path: &Path) -> SceneError {
+        let path = path.to_path_buf();
+        match self {
+            Self::Value { .. } => SceneError::Invalid {
+                path,
+                what: self.to_string(),
+            },
+            Self::MaterialIndex { what, index, count } => SceneError::MaterialIndex {
+                path,
+                what,
+                index,
+                count,
+            },
+        }
+    }
+}
+
+/// Formats a vector as `[x, y, z]`.
+pub(crate) fn fmt_vec(v: Vec3) -> String {
+    format!("[{}, {}, {}]", v.x, v.y, v.z)
+}
+
+/// A colour (radiance, albedo, intensity): finite and non-negative.
+pub(crate) fn colour(key: &str, c: Vec3) -> Result<(), Invalid> {
+    if !c.is_finite() {
+        return Err(Invalid::value(
+            key,
+            format!("must be finite, got {}", fmt_vec(c)),
+        ));
+    }
+    if c.min_element() < 0.0 {
+        return Err(Invalid::value(
+            key,
+            format!("must not be negative, got {}", fmt_vec(c)),
+        ));
+    }
+    Ok(())
+}
+
+fn positive(key: String, x: f32) -> Result<(), Invalid> {
+    if x.is_finite() && x > 0.0 {
+        Ok(())
+    } else {
+        Err(Invalid::value(
+            key,
+            format!("must be finite and > 0, got {x}"),
+        ))
+    }
+}
+
+fn finite(key: String, v: Vec3) -> Result<(), Invalid> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(Invalid::value(
+            key,
+            format!("must be finite, got {}", fmt_vec(v)),
+        ))
+    }
+}
+
+fn direction(key: String, v: Vec3) -> Result<(), Invalid> {
+    if v.try_normalize().is_some() {
+        Ok(())
+    } else {
+        Err(Invalid::value(
+            key,
+            format!("must be a finite non-zero vector, got {}", fmt_vec(v)),
+        ))
+    }
+}
+
+/// A material: colours finite and non-negative, index of refraction and roughness finite and
+/// positive.
+pub(crate) fn material(m: &Material) -> Result<(), Invalid> {
+    let key = |what: &str| format!("material {:?} {what}", m.name);
+    colour(&key("emission"), m.emission)?;
+    match m.kind {
+        MaterialKind::Diffuse { albedo } => colour(&key("albedo"), albedo),
+        MaterialKind::Mirror { reflectance } => colour(&key("reflectance"), reflectance),
+        MaterialKind::Dielectric { ior } => positive(key("ior"), ior),
+        MaterialKind::Glossy {
+            reflectance,
+            roughness,
+            diffuse,
+        } => {
+            colour(&key("reflectance"), reflectance)?;
+            colour(&key("diffuse"), diffuse)?;
+            positive(key("roughness"), roughness)
+        }
+    }
+}
+
+/// The colour that says how strong a light is (intensity or irradiance).
+pub(crate) fn light_power(light: &Light) -> Vec3 {
+    match *light {
+        Light::Point { intensity, .. } | Light::Spot { intensity, .. } => intensity,
+        Light::Directional { irradiance, .. } => irradiance,
+    }
+}
+
+/// Light `i`: its power a colour, its position finite, its direction non-zero, a spot's cone
+/// in (0, π] and its falloff start finite.
+pub(crate) fn light(i: usize, light: &Light) -> Result<(), Invalid> {
+    let key = |kind: &str, what: &str| format!("{kind} light {i} {what}");
+    match *light {
+        Light::Point {
+            position,
+            intensity,
+        } => {
+            colour(&key("point", "intensity"), intensity)?;
+            finite(key("point", "position"), position)
+        }
+        Light::Spot {
+            position,
+            direction: axis,
+            intensity,
+            cone_angle,
+            falloff_start,
+        } => {
+            colour(&key("spot", "intensity"), intensity)?;
+            finite(key("spot", "position"), position)?;
+            direction(key("spot", "direction"), axis)?;
+            if !(cone_angle > 0.0 && cone_angle <= PI) {
+                return Err(Invalid::value(
+                    key("spot", "cone angle"),
+                    format!("must be in (0, π] radians, got {cone_angle}"),
+                ));
+            }
+            if falloff_start.is_finite() {
+                Ok(())
+            } else {
+                Err(Invalid::value(
+                    key("spot", "falloff start"),
+                    format!("must be finite, got {falloff_start}"),
+                ))
+            }
+        }
+        Light::Directional {
+            direction: axis,
+            irradiance,
+        } => {
+            colour(&key("directional", "irradiance"), irradiance)?;
+            direction(key("directional", "direction"), axis)
+        }
+    }
+}
+
+/// Cylinder `i`: finite, positive sizes, an arc in (0, 2π], perpendicular unit axis and facing,
+/// and a material that does not emit (cylinders are not emitters).
+fn cylinder(i: usize, c: &Cylinder, materials: &[Material]) -> Result<(), Invalid> {
+    const TOLERANCE: f32 = 1e-4;
+    let key = |what: &str| format!("cylinder {i} {what}");
+    let Some(m) = materials.get(c.material as usize) else {
+        return Err(Invalid::MaterialIndex {
+            what: format!("cylinder {i}"),
+            index: c.material,
+            count: materials.len(),
+        });
+    };
+    if !(c.center.is_finite() && c.axis.is_finite() && c.facing.is_finite()) {
+        return Err(Invalid::value(
+            key("center, axis and facing"),
+            "must be finite",
+        ));
+    }
+    positive(key("radius"), c.radius)?;
+    positive(key("height"), c.height)?;
+    if !(c.arc > 0.0 && c.arc <= std::f32::consts::TAU * (1.0 + TOLERANCE)) {
+        return Err(Invalid::value(
+            key("arc"),
+            format!("must be in (0, 2π], got {}", c.arc),
+        ));
+    }
+    if (c.axis.length() - 1.0).abs() > TOLERANCE
+        || (c.facing.length() - 1.0).abs() > TOLERANCE
+        || c.axis.dot(c.facing).abs() > TOLERANCE
+    {
+        return Err(Invalid::value(
+            key("axis and facing"),
+            "must be perpendicular unit vectors",
+        ));
+    }
+    if m.emission.max_element() > 0.0 {
+        return Err(Invalid::value(
+            key("material"),
+            format!("`{}` emits, but cylinders cannot", m.name),
+        ));
+    }
+    Ok(())
+}
+
+/// Every check of a description: [`materials_and_lights`], then [`primitives`].
+pub(crate) fn description(d: &SceneDescription) -> Result<(), Invalid> {
+    materials_and_lights(&d.materials, &d.lights)?;
+    primitives(d)
+}
+
+/// Every material and light.
+pub(crate) fn materials_and_lights(
+    materials: &[Material],
+    lights: &[Light],
+) -> Result<(), Invalid> {
+    for m in materials {
+        material(m)?;
+    }
+    for (i, l) in lights.iter().enumerate() {
+        light(i, l)?;
+    }
+    Ok(())
+}
+
+/// Each primitive's material index and geometry.
+pub(crate) fn primitives(d: &SceneDescription) -> Result<(), Invalid> {
+    let count = d.materials.len();
+    let index = |what: String, index: u32| {
+        if (index as usize) < count {
+            Ok(())
+        } else {
+            Err(Invalid::MaterialIndex { what, index, count })
+        }
+    };
+    for (i, t) in d.triangles.iter().enumerate() {
+        index(format!("triangle {i}"), t.material)?;
+        if !t.positions.iter().all(|p| p.is_finite())
+            || !t.normals.is_none_or(|n| n.iter().all(|v| v.is_finite()))
+        {
+            return Err(Invalid::value(
+                format!("triangle {i}"),
+                "has a non-finite vertex or normal",
+            ));
+        }
+    }
+    for (i, s) in d.spheres.iter().enumerate() {
+        index(format!("sphere {i}"), s.material)?;
+        finite(format!("sphere {i} center"), s.center)?;
+        positive(format!("sphere {i} radius"), s.radius)?;
+    }
+    for (i, c) in d.cylinders.iter().enumerate() {
+        cylinder(i, c, &d.materials)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_util::{description, point_light, tri};
+
+    #[track_caller]
+    fn check(d: &SceneDescription, expect: &str) {
+        let got = super::description(d).err().map(|e| e.to_string());
+        assert_eq!(got.as_deref(), Some(expect));
+        // Scene::new reports the same problem.
+        let scene = crate::Scene::new(d.clone()).err().map(|e| e.to_string());
+        assert!(scene.is_some_and(|e| e.ends_with(expect)), "{expect}");
+    }
+
+    #[test]
+    fn one_check_for_every_path() {
+        let floor = tri(Vec3::ZERO, Vec3::X, Vec3::Y, 0);
+        let ok = description(vec![floor], Vec::new(), vec![point_light(Vec3::Z)]);
+        assert_eq!(super::description(&ok), Ok(()));
+
+        let mut d = ok.clone();
+        d.lights = vec![Light::Spot {
+            position: Vec3::Z,
+            direction: -Vec3::Z,
+            intensity: Vec3::ONE,
+            cone_angle: 0.0,
+            falloff_start: 0.0,
+        }];
+        check(
+            &d,
+            "spot light 0 cone angle must be in (0, π] radians, got 0",
+        );
+        d.lights = vec![Light::Directional {
+            direction: Vec3::ZERO,
+            irradiance: Vec3::ONE,
+        }];
+        check(
+            &d,
+            "directional light 0 direction must be a finite non-zero vector, got [0, 0, 0]",
+        );
+
+        let mut d = ok.clone();
+        d.materials[0].emission = Vec3::new(-1.0, 0.0, 0.0);
+        check(
+            &d,
+            "material \"m\" emission must not be negative, got [-1, 0, 0]",
+        );
+
+        let mut d = ok;
+        d.triangles[0].material = 7;
+        check(
+            &d,
+            "triangle 0 refers to material 7 but there are 2 materials",
+        );
+    }
+}
