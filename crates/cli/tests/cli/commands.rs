@@ -23,7 +23,7 @@ fn without_a_subcommand_fppm_renders_the_default_scene_here() {
     let exr = read_exr(&dir.join("fppm.exr"));
     assert_eq!(exr.metadata["fppm.scene"], "<built-in default scene>");
     // The scene's [render] table picks the method and the seed.
-    assert_eq!(exr.metadata["fppm.method"], "freq");
+    assert_eq!(exr.metadata["fppm.method"], "freq-sppm");
     assert_eq!(exr.metadata["fppm.seed"], "1");
     assert!(exr.mean() > 0.0);
 }

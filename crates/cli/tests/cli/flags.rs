@@ -57,7 +57,7 @@ fn outputs_go_where_asked_and_metadata_is_written() {
     let exr = read_exr(&dir.join("a.exr"));
     let m = &exr.metadata;
     assert_eq!(m["fppm.passes"], "2");
-    assert_eq!(m["fppm.method"], "ppm");
+    assert_eq!(m["fppm.method"], "freq-sppm");
     assert_eq!(m["fppm.seed"], "7");
     assert_eq!(m["fppm.photons"], "8000");
     assert_eq!(m["fppm.photons_per_pass"], "4000");
