@@ -583,7 +583,7 @@ fn cylinder_ply(c: &geometry::Cylinder, segments: usize) -> String {
         2 * segments
     );
     for i in 0..=segments {
-        let phi = c.arc.to_radians() * (i as f32 / segments as f32 - 0.5);
+        let phi = c.arc * (i as f32 / segments as f32 - 0.5);
         let n = phi.cos() * c.facing + phi.sin() * side;
         for s in [0.0, c.height] {
             let p = c.center + s * c.axis + c.radius * n;

@@ -226,6 +226,24 @@ fn other_flag_ranges() {
         &["--aov freq", "frequency method"],
     );
     check(
+        "freq_grow_below_one",
+        &["render", CORNELL, "--freq-grow", "0.5"],
+        2,
+        &["freq-grow", "[1, 64]"],
+    );
+    check(
+        "freq_hold_alpha_zero",
+        &["render", CORNELL, "--freq-hold-alpha", "0"],
+        2,
+        &["freq-hold-alpha", "(0, 1]"],
+    );
+    check(
+        "freq_pilot_negative",
+        &["render", CORNELL, "--freq-pilot", "-1"],
+        2,
+        &["--freq-pilot -1"],
+    );
+    check(
         "aov_path",
         &["render", CORNELL, "--method", "path", "--aov", "radius"],
         2,

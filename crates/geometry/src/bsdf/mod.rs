@@ -7,12 +7,16 @@
 //! All materials scatter on both sides: a reflection needs `outgoing` and `incoming` on the same
 //! side of the shading normal, whichever side that is.
 //!
-//! The glossy model is additive, like the MTL `Kd` + `Ks` it comes from:
-//! f = diffuse/π + D·G₂·F/(4 cos θₒ cos θᵢ), with GGX D, height-correlated Smith G₂ and Schlick's
-//! F = F₀ + (1 − F₀)(1 − cos θ_d)⁵ with F₀ = `reflectance`. It conserves energy when
-//! `reflectance` = 1 and `diffuse` = 0, but `diffuse + reflectance` close to 1 reflects up to ≈ 15 %
-//! more than it receives near grazing angles (Schlick grows there). Single-scattering GGX
-//! loses energy at high roughness (≈ 0.69 albedo at α = 0.5, 0.31 at α = 1, normal incidence).
+//! The glossy model is a GGX conductor over a Lambertian base, coupled so that it never reflects
+//! more than it receives (the MTL `Kd` + `Ks` it comes from is additive, and reflected up to 1.3
+//! of the incident light with Kd = 0.6, Ks = 0.7):
+//! f = f_d + D·G₂·F/(4 cos θₒ cos θᵢ), with GGX D, height-correlated Smith G₂ and Schlick's
+//! F = F₀ + (1 − F₀)(1 − cos θ_d)⁵ with F₀ = `reflectance`, and the base of Ashikhmin and Shirley
+//! (2000), f_d = 28/(23π)·diffuse·(1 − F₀)·(1 − (1 − cos θᵢ/2)⁵)·(1 − (1 − cos θₒ/2)⁵): reciprocal,
+//! weighted by what the specular layer leaves (1 − F₀), and fading at grazing angles where
+//! Schlick's F → 1. Its directional albedo stays ≤ 1 for every roughness, `reflectance` and
+//! `diffuse` in [0, 1] (tested on a grid). Single-scattering GGX loses energy at high roughness
+//! (≈ 0.69 albedo at α = 0.5, 0.31 at α = 1, normal incidence).
 
 use std::f32::consts::{FRAC_1_PI, PI};
 
@@ -155,7 +159,7 @@ impl Bsdf {
                 reflectance,
                 roughness,
                 diffuse,
-            } => diffuse * FRAC_1_PI + ggx_eval(wo, wi, roughness, reflectance),
+            } => coupled_diffuse(wo, wi, reflectance, diffuse) + ggx_eval(wo, wi, roughness, reflectance),
         }
     }
 
@@ -174,7 +178,7 @@ impl Bsdf {
                 roughness,
                 diffuse,
             } => {
-                let p_spec = specular_probability(reflectance, diffuse);
+                let p_spec = specular_probability(reflectance, diffuse, wo.z);
                 p_spec * ggx_pdf(wo, wi, roughness) + (1.0 - p_spec) * wi.z * FRAC_1_PI
             }
         }
@@ -235,7 +239,7 @@ impl Bsdf {
                 }
                 let flip = wo.z < 0.0;
                 let wo_up = if flip { -wo } else { wo };
-                let p_spec = specular_probability(reflectance, diffuse);
+                let p_spec = specular_probability(reflectance, diffuse, wo_up.z);
                 let wi_up = if u_lobe < p_spec {
                     let wm = ggx_sample_visible_normal(wo_up, roughness, u);
                     reflect(wo_up, wm)
@@ -245,7 +249,8 @@ impl Bsdf {
                 if wi_up.z <= 0.0 {
                     return None;
                 }
-                let f = diffuse * FRAC_1_PI + ggx_eval(wo_up, wi_up, roughness, reflectance);
+                let f = coupled_diffuse(wo_up, wi_up, reflectance, diffuse)
+                    + ggx_eval(wo_up, wi_up, roughness, reflectance);
                 let pdf = p_spec * ggx_pdf(wo_up, wi_up, roughness)
                     + (1.0 - p_spec) * wi_up.z * FRAC_1_PI;
                 if pdf.is_nan() || pdf <= 0.0 {
@@ -291,11 +296,24 @@ impl Bsdf {
     }
 }
 
-/// Probability of sampling the GGX lobe of a glossy material: proportional to the lobes' albedos
-/// (luminance of the specular reflectance vs the diffuse albedo).
-fn specular_probability(reflectance: Rgb, diffuse: Rgb) -> f32 {
-    let s = luminance(reflectance);
-    let d = luminance(diffuse);
+/// The Lambertian base of a glossy material under its specular layer (Ashikhmin and Shirley
+/// 2000, eq. 5): 28/(23π)·diffuse·(1 − F₀)·(1 − (1 − cos θᵢ/2)⁵)·(1 − (1 − cos θₒ/2)⁵), with
+/// both directions in the upper hemisphere.
+fn coupled_diffuse(wo: Vec3, wi: Vec3, reflectance: Rgb, diffuse: Rgb) -> Rgb {
+    if diffuse == Rgb::ZERO {
+        return Rgb::ZERO;
+    }
+    let fade = |cos: f32| 1.0 - (1.0 - 0.5 * cos.abs()).powi(5);
+    diffuse * (Rgb::ONE - reflectance) * (28.0 / (23.0 * PI) * fade(wo.z) * fade(wi.z))
+}
+
+/// Probability of sampling the GGX lobe of a glossy material seen at cosine `cos_o`: proportional
+/// to the lobes' albedos there (luminance of Schlick's Fresnel at that angle, which grows toward
+/// grazing even for a black `reflectance`, vs the diffuse base under the specular layer).
+fn specular_probability(reflectance: Rgb, diffuse: Rgb, cos_o: f32) -> f32 {
+    let c = (1.0 - cos_o.abs().min(1.0)).powi(5);
+    let s = luminance(reflectance + (Rgb::ONE - reflectance) * c);
+    let d = luminance(diffuse * (Rgb::ONE - reflectance));
     if s + d > 0.0 { s / (s + d) } else { 0.5 }
 }
 

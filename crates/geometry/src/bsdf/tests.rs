@@ -49,8 +49,12 @@ fn albedo_by_eval(b: &Bsdf, wo: Vec3) -> f32 {
 
 /// Mean sample weight (estimates ∫ f cos dω).
 fn albedo_by_sampling(b: &Bsdf, wo: Vec3, mode: TransportMode) -> f32 {
+    albedo_by_samples(b, wo, mode, 100_000)
+}
+
+/// Mean weight of `n` samples.
+fn albedo_by_samples(b: &Bsdf, wo: Vec3, mode: TransportMode, n: u32) -> f32 {
     let mut rng = Rng::new(1);
-    let n = 100_000;
     let mut sum = 0.0f64;
     for _ in 0..n {
         if let Some(s) = b.sample(wo, rng.f32(), rng.vec2(), mode) {
@@ -103,18 +107,36 @@ fn white_furnace() {
                     "α {alpha} θ {theta}: {by_eval} vs {by_sampling}"
                 );
             }
-            // With a diffuse base the albedo is the two lobes' sum (Schlick's Fresnel grows toward
-            // grazing, so reflectance + diffuse = 1 may exceed 1 by a few per cent; keep a margin).
+            // With a diffuse base the albedo stays below 1 and above the specular part.
             let gd = bsdf(glossy(alpha, 0.45, 0.5));
             let e = albedo_by_sampling(&gd, wo, TransportMode::Radiance);
-            // FIXME: the additive Kd + Ks model gains energy near grazing (Schlick's F → 1 while the
-            // diffuse lobe stays): up to ≈ 1.15 at 85°. An energy-conserving coupling would change
-            // the meaning of the MTL mapping, so it is documented instead.
-            let ceiling = if theta > 80.0 { 1.2 } else { 1.0 + 5e-3 };
-            assert!(
-                e <= ceiling && e > 0.5 + 0.45 * floor - 0.02,
-                "α {alpha} θ {theta}: {e}"
-            );
+            assert!(e <= 1.0 + 5e-3 && e > 0.45 * floor, "α {alpha} θ {theta}: {e}");
+        }
+    }
+}
+
+/// The glossy furnace: the directional albedo of glossy-over-diffuse is at most 1 at 32 angles for
+/// a grid of roughness, specular reflectance and diffuse albedo (the additive model reached 1.3 with
+/// CornellBox-Glossy's Kd ≈ 0.6, Ks = 0.7). Estimated by importance sampling (20 000 samples of
+/// weights that vary little, a relative standard error well below the 1 % margin) and, for the rougher lobes, by quadrature of
+/// `eval` as an independent check.
+#[test]
+fn glossy_over_diffuse_never_reflects_more_than_it_receives() {
+    for alpha in [0.02, 0.1, 0.3, 0.6, 1.0] {
+        for ks in [0.0, 0.3, 0.7, 1.0] {
+            for kd in [0.0, 0.6, 1.0] {
+                let b = bsdf(glossy(alpha, ks, kd));
+                for k in 0..32 {
+                    let theta = 89.0 * (k as f32 + 0.5) / 32.0;
+                    let wo = outgoing(&b, theta);
+                    let e = albedo_by_samples(&b, wo, TransportMode::Radiance, 20_000);
+                    assert!(e <= 1.01, "α {alpha}, Ks {ks}, Kd {kd}, θ {theta}: albedo {e}");
+                    if alpha >= 0.3 && k % 8 == 0 {
+                        let q = albedo_by_eval(&b, wo);
+                        assert!(q <= 1.01, "α {alpha}, Ks {ks}, Kd {kd}, θ {theta}: quadrature {q}");
+                    }
+                }
+            }
         }
     }
 }
