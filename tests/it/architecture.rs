@@ -4,7 +4,19 @@
 use std::collections::BTreeMap;
 use std::process::Command;
 
-/// Workspace crates each product crate may depend on (normal dependencies).
+/// The workspace crates each workspace crate depends on (normal dependencies), exactly: a new
+/// edge, or a missing one, is a change of ARCHITECTURE.md's map first.
+const EDGES: &[(&str, &[&str])] = &[
+    ("spectrum", &[]),
+    ("geometry", &[]),
+    ("photon", &[]),
+    ("ppm", &["spectrum", "geometry", "photon"]),
+    ("film", &[]),
+    ("cli", &["geometry", "ppm", "film"]),
+    ("xtask", &["geometry", "ppm", "film"]),
+];
+
+/// The direction of ARCHITECTURE.md: the crates each crate may depend on.
 const ALLOWED: &[(&str, &[&str])] = &[
     ("spectrum", &[]),
     ("geometry", &["spectrum"]),
@@ -67,6 +79,37 @@ fn workspace_crates_depend_only_in_the_allowed_direction() {
                 );
             }
         }
+    }
+}
+
+#[test]
+fn workspace_edges_are_exactly_those_of_the_map() {
+    let deps = dependencies();
+    let workspace: Vec<&str> = EDGES.iter().map(|(name, _)| *name).collect();
+    for (name, expected) in EDGES {
+        let mut actual: Vec<&str> = deps[*name]
+            .iter()
+            .map(String::as_str)
+            .filter(|d| workspace.contains(d))
+            .collect();
+        actual.sort_unstable();
+        let mut expected = expected.to_vec();
+        expected.sort_unstable();
+        assert_eq!(actual, expected, "workspace dependencies of {name}");
+        let allowed = ALLOWED.iter().find(|(n, _)| n == name).map(|(_, a)| *a);
+        assert!(
+            expected
+                .iter()
+                .all(|e| allowed.is_some_and(|a| a.contains(e))),
+            "{name}: an edge against the direction of ARCHITECTURE.md"
+        );
+    }
+    // Every workspace package is in the map.
+    for name in deps.keys() {
+        assert!(
+            workspace.contains(&name.as_str()) || name == "tests",
+            "{name} is missing from EDGES"
+        );
     }
 }
 
