@@ -10,8 +10,9 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("geometry", &["spectrum"]),
     ("photon", &["spectrum", "geometry"]),
     ("ppm", &["spectrum", "geometry", "photon"]),
-    ("cli", &["spectrum", "geometry", "photon", "ppm"]),
-    ("xtask", &["spectrum", "geometry", "photon", "ppm"]),
+    ("film", &[]),
+    ("cli", &["spectrum", "geometry", "photon", "ppm", "film"]),
+    ("xtask", &["spectrum", "geometry", "photon", "ppm", "film"]),
 ];
 
 /// Normal (non-dev, non-build) dependencies of every workspace package.

@@ -28,7 +28,8 @@ fn c3(v: Vec3) -> String {
 fn write_mitsuba(scene: &SceneDescription, dir: &Path) -> PathBuf {
     std::fs::create_dir_all(dir).unwrap();
     let mut x = String::from("<scene version=\"3.0.0\">\n");
-    if let Some(depth) = scene.render.max_depth {
+    if let Some(depth) = scene.render.get("max_depth") {
+        let depth: u32 = depth.parse().unwrap();
         // Mitsuba counts path segments: one more than scattering events.
         writeln!(
             x,
@@ -303,7 +304,11 @@ fn assert_same(a: &SceneDescription, b: &SceneDescription, name: &str) {
         &format!("{name} aperture"),
     );
     assert_eq!(a.film, b.film, "{name} film");
-    assert_eq!(a.render.max_depth, b.render.max_depth, "{name} max depth");
+    assert_eq!(
+        a.render.get("max_depth"),
+        b.render.get("max_depth"),
+        "{name} max depth"
+    );
     assert_eq!(a.triangles.len(), b.triangles.len(), "{name} triangles");
     for (i, (t, u)) in a.triangles.iter().zip(&b.triangles).enumerate() {
         for k in 0..3 {

@@ -10,8 +10,8 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use glam::Vec2;
 
-use crate::image_io::{self, Errors, Image};
 use crate::suite::{self, SuiteScene};
+use film::{Errors, Image};
 
 pub(crate) const HELP: &str = "\
 cargo xtask converge --scene NAME [--budgets 2,4,8,16,32] [--methods ppm,sppm,freq,freq-sppm,path]
@@ -139,67 +139,67 @@ fn process_cpu_seconds() -> f64 {
     (ticks(11) + ticks(12)) / 100.0
 }
 
-/// Parameter values given on the command line.
-#[derive(Clone, Copy, Debug, Default)]
-struct Overrides {
-    alpha: Option<f64>,
-    freq_fraction: Option<f64>,
-    kernel_k: Option<f64>,
-    freq_merge: Option<ppm::MergePolicy>,
-    freq_geometry: Option<bool>,
-}
+/// Render parameters given on the command line or varied by the sweep: `(name, text)` pairs
+/// that `ppm::RenderParams::set` reads (names, parsing and ranges are defined there).
+#[derive(Clone, Debug, Default)]
+struct Overrides(Vec<(&'static str, String)>);
 
 impl Overrides {
-    fn apply(&self, params: &mut ppm::RenderParams) {
-        if let Some(a) = self.alpha {
-            params.alpha = a;
-        }
-        if let Some(f) = self.freq_fraction {
-            params.freq_fraction = f;
-        }
-        if let Some(k) = self.kernel_k {
-            params.kernel_k = k;
-        }
-        if let Some(m) = self.freq_merge {
-            params.freq_merge = m;
-        }
-        if let Some(g) = self.freq_geometry {
-            params.freq_geometry = g;
-        }
+    /// One parameter.
+    fn one(name: &str, value: impl ToString) -> Self {
+        let mut o = Self::default();
+        o.push(name, value.to_string())
+            .expect("a parameter of ppm::PARAMS");
+        o
     }
 
-    fn label(&self, defaults: &ppm::RenderParams) -> String {
+    /// Adds (or replaces) the parameter called `name` (with `-` or `_`).
+    fn push(&mut self, name: &str, value: String) -> Result<()> {
+        let param = ppm::param(name).with_context(|| format!("unknown parameter `{name}`"))?;
+        self.0.retain(|(n, _)| *n != param.name);
+        self.0.push((param.name, value));
+        Ok(())
+    }
+
+    fn apply(&self, params: &mut ppm::RenderParams) -> Result<()> {
+        for (name, value) in &self.0 {
+            params.set(name, value)?;
+        }
+        Ok(())
+    }
+
+    /// Whether every parameter given is one of `names`.
+    fn only(&self, names: &[&str]) -> bool {
+        self.0.iter().all(|(n, _)| names.contains(n))
+    }
+
+    fn label(&self, defaults: &ppm::RenderParams) -> Result<String> {
         let mut p = *defaults;
-        self.apply(&mut p);
-        format!(
+        self.apply(&mut p)?;
+        Ok(format!(
             "alpha={:.3} ff={} k={} merge={} geometry={}",
             p.alpha,
             p.freq_fraction,
             k_name(p.kernel_k),
-            merge_name(p.freq_merge),
-            if p.freq_geometry { "on" } else { "off" }
-        )
+            value_of("freq_merge", &p),
+            value_of("freq_geometry", &p),
+        ))
     }
 }
 
+/// The text of the parameter called `name` in `params`.
+fn value_of(name: &str, params: &ppm::RenderParams) -> String {
+    ppm::param(name).map_or_else(String::new, |p| p.get(params))
+}
+
+/// K by the name of its constant where it has one.
 fn k_name(k: f64) -> String {
-    if (k - spectrum::K_POSTER).abs() < 1e-12 {
+    if (k - ppm::K_POSTER).abs() < 1e-12 {
         "poster".to_string()
-    } else if (k - spectrum_k_strict()).abs() < 1e-12 {
+    } else if (k - ppm::K_STRICT).abs() < 1e-12 {
         "strict".to_string()
     } else {
         format!("{k}")
-    }
-}
-
-fn spectrum_k_strict() -> f64 {
-    spectrum::K_STRICT
-}
-
-fn merge_name(m: ppm::MergePolicy) -> &'static str {
-    match m {
-        ppm::MergePolicy::MinRadius => "min",
-        ppm::MergePolicy::PosterMax => "poster-max",
     }
 }
 
@@ -267,29 +267,10 @@ impl Flags {
                         other => bail!("--clock takes wall or cpu, not `{other}`"),
                     };
                 }
-                "--alpha" => flags.overrides.alpha = Some(value()?.parse()?),
-                "--freq-fraction" => flags.overrides.freq_fraction = Some(value()?.parse()?),
-                "--kernel-k" => {
-                    let v = value()?;
-                    flags.overrides.kernel_k = Some(match v.as_str() {
-                        "poster" => spectrum::K_POSTER,
-                        "strict" => spectrum_k_strict(),
-                        other => other.parse()?,
-                    });
-                }
-                "--freq-merge" => {
-                    flags.overrides.freq_merge = Some(match value()?.as_str() {
-                        "min" => ppm::MergePolicy::MinRadius,
-                        "poster-max" => ppm::MergePolicy::PosterMax,
-                        other => bail!("unknown merge policy `{other}` (min, poster-max)"),
-                    });
-                }
-                "--freq-geometry" => {
-                    flags.overrides.freq_geometry = Some(match value()?.as_str() {
-                        "on" => true,
-                        "off" => false,
-                        other => bail!("--freq-geometry takes on or off, not `{other}`"),
-                    });
+                // Any render parameter by its name, e.g. --alpha 0.5, --kernel-k poster,
+                // --freq-geometry off.
+                other if other.starts_with("--") && ppm::param(&other[2..]).is_some() => {
+                    flags.overrides.push(&other[2..], value()?.clone())?;
                 }
                 other => bail!("converge: unknown flag `{other}`"),
             }
@@ -361,7 +342,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
     let golden = root
         .join("tests/golden")
         .join(format!("{}.exr", entry.name));
-    let reference = image_io::read_exr(&golden)
+    let reference = film::read_exr(&golden)
         .with_context(|| format!("run `cargo xtask render-all --bless {}` first", entry.name))?;
     let out = flags.out.clone().map_or_else(
         || {
@@ -394,8 +375,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
     let (reference, reference_variance) = match flags.pointwise {
         None => (reference, None),
         Some(paths) => {
-            let mut params = base_params(entry, ppm::Method::Ppm, &flags);
-            flags.overrides.apply(&mut params);
+            let params = base_params(entry, &scene, ppm::Method::Ppm, &flags)?;
             let start = Instant::now();
             // Two independent halves: their mean is the reference, their difference measures
             // its noise.
@@ -443,13 +423,12 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
 
     let mut rows = Vec::new();
     for &method in &flags.methods {
-        let mut params = base_params(entry, method, &flags);
-        flags.overrides.apply(&mut params);
+        let params = base_params(entry, &scene, method, &flags)?;
         println!(
             "converge: {} {} ({})",
             entry.name,
             method,
-            flags.overrides.label(&params)
+            flags.overrides.label(&params)?
         );
         let mut renderer = ppm::Renderer::new(&scene, params).context("render parameters")?;
         let mut elapsed = Duration::ZERO;
@@ -460,9 +439,9 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
                 elapsed += flags.clock.since(start);
             }
             let image = Image::new(reference.width, reference.height, renderer.image());
-            let all = image_io::errors(&image, &reference, Some(&transport))?;
+            let all = film::errors(&image, &reference, Some(&transport))?;
             let masked = [0, 1, 2].map(|i| {
-                image_io::errors(&image, &reference, Some(&masks.masks[i])).expect("sizes match")
+                film::errors(&image, &reference, Some(&masks.masks[i])).expect("sizes match")
             });
             println!(
                 "  {:>6.1} s ({:>5} passes): relMSE {:.5}  RMSE {:.5}  mean ratio {:.4}  [low {:.5} caustic {:.5} glossy {:.5}] [mean ratio low {:.4} caustic {:.4} glossy {:.4}]",
@@ -501,18 +480,18 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         }
         let stem = format!("{}-{}", entry.name, method.name());
         let image = Image::new(reference.width, reference.height, renderer.image());
-        image_io::write_png(
+        film::write_preview(
             &out.join(format!("{stem}.png")),
             &image,
-            image_io::auto_exposure(&reference),
+            film::Tonemap::linear(film::auto_exposure(&reference)),
             3,
         )?;
         write_maps(&renderer, &out, &stem, reference.width)?;
     }
-    image_io::write_png(
+    film::write_preview(
         &out.join(format!("{}-reference.png", entry.name)),
         &reference,
-        image_io::auto_exposure(&reference),
+        film::Tonemap::linear(film::auto_exposure(&reference)),
         3,
     )?;
     write_csv(
@@ -546,10 +525,16 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
     Ok(true)
 }
 
-fn base_params(entry: &SuiteScene, method: ppm::Method, flags: &Flags) -> ppm::RenderParams {
-    let mut params = suite::params(entry, method, flags.seed);
+fn base_params(
+    entry: &SuiteScene,
+    scene: &geometry::Scene,
+    method: ppm::Method,
+    flags: &Flags,
+) -> Result<ppm::RenderParams> {
+    let mut params = suite::params(entry, scene, method, flags.seed)?;
     params.photons_per_pass = flags.photons;
-    params
+    flags.overrides.apply(&mut params)?;
+    Ok(params)
 }
 
 /// The reference of two independent halves A and B (pixels of linear RGB): their mean, and
@@ -573,7 +558,7 @@ pub(crate) fn reference_from_halves(
 
 /// The expected contribution of the reference's noise to a relMSE over `mask`: E[(x − ref)²] =
 /// (x − L)² + Var(ref) for an image x independent of the reference, so this is the mean of
-/// Var(ref) / (ref² + ε) with the relMSE's own normalisation (`image_io::errors`).
+/// Var(ref) / (ref² + ε) with the relMSE's own normalisation (`film::errors`).
 pub(crate) fn noise_rel_mse(variance: &[[f64; 3]], reference: &Image, mask: &[bool]) -> f64 {
     let (mut sum, mut n) = (0.0f64, 0usize);
     for ((v, r), &inside) in variance.iter().zip(&reference.pixels).zip(mask) {
@@ -582,7 +567,7 @@ pub(crate) fn noise_rel_mse(variance: &[[f64; 3]], reference: &Image, mask: &[bo
         }
         for c in 0..3 {
             let y = f64::from(r[c]);
-            sum += v[c] / (y * y + image_io::REL_MSE_EPSILON);
+            sum += v[c] / (y * y + film::REL_MSE_EPSILON);
             n += 1;
         }
     }
@@ -677,14 +662,20 @@ fn write_masks(path: &Path, masks: &Masks, width: usize) -> Result<()> {
             [f(1), 0.6 * f(0), f(2)]
         })
         .collect();
-    image_io::write_png(path, &Image::new(width, n / width, pixels), 1.0, 3)
+    film::write_preview(
+        path,
+        &Image::new(width, n / width, pixels),
+        film::Tonemap::linear(1.0),
+        3,
+    )?;
+    Ok(())
 }
 
 /// Radius map (all photon mappers), frequency radius and held-by-floor maps (frequency methods).
 fn write_maps(renderer: &ppm::Renderer<'_>, out: &Path, stem: &str, width: usize) -> Result<()> {
     if let Some(radius) = renderer.aov(ppm::Aov::Radius) {
         let max = percentile(&radius, 0.99);
-        image_io::write_false_colour(
+        film::write_false_colour(
             &out.join(format!("{stem}-radius.png")),
             width,
             &radius,
@@ -694,7 +685,7 @@ fn write_maps(renderer: &ppm::Renderer<'_>, out: &Path, stem: &str, width: usize
         println!("  radius map: 99th percentile {max:.5} (red)");
     }
     if let Some(held) = renderer.aov(ppm::Aov::FreqHeld) {
-        image_io::write_false_colour(&out.join(format!("{stem}-held.png")), width, &held, 1.0, 3)?;
+        film::write_false_colour(&out.join(format!("{stem}-held.png")), width, &held, 1.0, 3)?;
         let share = held.iter().map(|&v| f64::from(v)).sum::<f64>() / held.len().max(1) as f64;
         println!(
             "  held by the frequency floor: {:.1} % of hitpoints",
@@ -703,7 +694,7 @@ fn write_maps(renderer: &ppm::Renderer<'_>, out: &Path, stem: &str, width: usize
     }
     if let Some(freq) = renderer.aov(ppm::Aov::FreqRadius) {
         let max = percentile(&freq, 0.99);
-        image_io::write_false_colour(
+        film::write_false_colour(
             &out.join(format!("{stem}-freq-radius.png")),
             width,
             &freq,
@@ -957,51 +948,31 @@ fn sweep(
     let transport = suite::transport_mask(scene);
     let mut variants: Vec<Overrides> = vec![Overrides::default()];
     for alpha in [0.5, 2.0 / 3.0, 0.8] {
-        variants.push(Overrides {
-            alpha: Some(alpha),
-            ..Overrides::default()
-        });
+        variants.push(Overrides::one("alpha", alpha));
     }
     for ff in [0.05, 0.2] {
-        variants.push(Overrides {
-            freq_fraction: Some(ff),
-            ..Overrides::default()
-        });
+        variants.push(Overrides::one("freq_fraction", ff));
     }
     for k in [
-        spectrum::K_POSTER,
-        4.0 * spectrum_k_strict(),
-        2.0 * spectrum_k_strict(),
-        0.5 * spectrum_k_strict(),
+        ppm::K_POSTER,
+        4.0 * ppm::K_STRICT,
+        2.0 * ppm::K_STRICT,
+        0.5 * ppm::K_STRICT,
     ] {
-        variants.push(Overrides {
-            kernel_k: Some(k),
-            ..Overrides::default()
-        });
+        variants.push(Overrides::one("kernel_k", k));
     }
-    variants.push(Overrides {
-        freq_geometry: Some(false),
-        ..Overrides::default()
-    });
-    variants.push(Overrides {
-        freq_merge: Some(ppm::MergePolicy::PosterMax),
-        ..Overrides::default()
-    });
+    variants.push(Overrides::one("freq_geometry", "off"));
+    variants.push(Overrides::one("freq_merge", "poster-max"));
     let mut csv = String::from(
         "scene,method,budget_s,alpha,freq_fraction,kernel_k,freq_merge,freq_geometry,seconds,passes,rel_mse,rmse,mean_ratio,rel_mse_low,rel_mse_caustic,rel_mse_glossy\n",
     );
     for &method in &flags.methods {
         for v in &variants {
-            let only_alpha = v.freq_fraction.is_none()
-                && v.kernel_k.is_none()
-                && v.freq_merge.is_none()
-                && v.freq_geometry.is_none();
-            if !method.uses_frequency() && !only_alpha {
+            if !method.uses_frequency() && !v.only(&["alpha"]) {
                 continue;
             }
-            let mut params = base_params(entry, method, flags);
-            flags.overrides.apply(&mut params);
-            v.apply(&mut params);
+            let mut params = base_params(entry, scene, method, flags)?;
+            v.apply(&mut params)?;
             let mut renderer = ppm::Renderer::new(scene, params).context("render parameters")?;
             let mut elapsed = Duration::ZERO;
             while elapsed.as_secs_f64() < flags.budget {
@@ -1010,15 +981,15 @@ fn sweep(
                 elapsed += flags.clock.since(start);
             }
             let image = Image::new(reference.width, reference.height, renderer.image());
-            let e = image_io::errors(&image, reference, Some(&transport))?;
+            let e = film::errors(&image, reference, Some(&transport))?;
             let m = [0, 1, 2].map(|i| {
-                image_io::errors(&image, reference, Some(&masks.masks[i])).expect("sizes match")
+                film::errors(&image, reference, Some(&masks.masks[i])).expect("sizes match")
             });
             println!(
                 "sweep {} {:<9} {:<48} relMSE {:.5} [low {:.5} caustic {:.5} glossy {:.5}] mean {:.4} ({} passes)",
                 entry.name,
                 method.name(),
-                v.label(&params),
+                v.label(&params)?,
                 e.rel_mse,
                 m[0].rel_mse,
                 m[1].rel_mse,
@@ -1035,8 +1006,8 @@ fn sweep(
                 params.alpha,
                 params.freq_fraction,
                 k_name(params.kernel_k),
-                merge_name(params.freq_merge),
-                if params.freq_geometry { "on" } else { "off" },
+                value_of("freq_merge", &params),
+                value_of("freq_geometry", &params),
                 elapsed.as_secs_f64(),
                 renderer.passes(),
                 e.rel_mse,

@@ -10,7 +10,6 @@
 
 mod converge;
 mod docs_image;
-mod image_io;
 mod peers;
 mod render_all;
 mod suite;

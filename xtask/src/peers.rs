@@ -16,7 +16,7 @@ use anyhow::{Context, Result, bail};
 use glam::{Vec2, Vec3};
 
 use crate::converge::{noise_rel_mse, reference_from_halves};
-use crate::image_io::{self, Image};
+use film::Image;
 
 pub(crate) const HELP: &str = "\
 cargo xtask peers [--scenes a,b,...] [--seconds 60] [--film WxH] [--threads 2]
@@ -166,10 +166,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
                 )?;
             }
         }
-        let (a, b) = (
-            image_io::read_exr(&halves[0])?,
-            image_io::read_exr(&halves[1])?,
-        );
+        let (a, b) = (film::read_exr(&halves[0])?, film::read_exr(&halves[1])?);
         let (pixels, variance) = reference_from_halves(&a.pixels, &b.pixels);
         let reference = Image::new(a.width, a.height, pixels);
         let all = vec![true; diffuse.len()];
@@ -284,9 +281,9 @@ fn score(
     diffuse: &[bool],
     note: &str,
 ) -> Result<Row> {
-    let image = image_io::read_exr(file)?;
-    let all = image_io::errors(&image, reference, None)?;
-    let on_diffuse = image_io::errors(&image, reference, Some(diffuse))?;
+    let image = film::read_exr(file)?;
+    let all = film::errors(&image, reference, None)?;
+    let on_diffuse = film::errors(&image, reference, Some(diffuse))?;
     Ok(Row {
         scene: scene.to_owned(),
         renderer: renderer.to_owned(),

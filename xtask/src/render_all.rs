@@ -8,8 +8,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 
-use crate::image_io::{self, Errors, Image};
 use crate::suite::{self, SuiteScene, Tolerance};
+use film::{Errors, Image};
 
 /// Seed of the golden references; differs from every check and calibration seed so the
 /// reference's noise is independent of the images compared with it.
@@ -151,7 +151,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         .map(|r| r.sheet_row.clone())
         .filter(|r| !r.is_empty())
         .collect();
-    image_io::write_sheet(&out_dir.join("sheet.png"), &rows, 2)?;
+    film::write_sheet(&out_dir.join("sheet.png"), &rows, 2)?;
     println!(
         "render-all: {} scene(s) in {:.1} s; report: {}",
         reports.len(),
@@ -190,11 +190,11 @@ fn golden_path(root: &Path, name: &str) -> PathBuf {
 /// Renders the golden reference of `entry` with the path tracer (never a photon mapper).
 fn bless(root: &Path, entry: &SuiteScene, golden: &Path) -> Result<()> {
     let scene = suite::load_scene(root, entry)?;
-    let mut params = suite::params(entry, ppm::Method::Path, REFERENCE_SEED);
+    let mut params = suite::params(entry, &scene, ppm::Method::Path, REFERENCE_SEED)?;
     params.samples_per_pixel = entry.reference_spp;
     let rendered = suite::render(&scene, params, entry.reference_passes)?;
     std::fs::create_dir_all(golden.parent().context("golden path has a parent")?)?;
-    image_io::write_exr(golden, &rendered.image)?;
+    film::write_exr(golden, &film::Frame::new(rendered.image.clone()))?;
     println!(
         "render-all: blessed {} ({} paths/pixel, {:.1} s) -> {}",
         entry.name,
@@ -227,7 +227,7 @@ fn check_scene(
         ));
         return Ok(report);
     }
-    let reference = image_io::read_exr(golden)?;
+    let reference = film::read_exr(golden)?;
     if (reference.width, reference.height) != (entry.width as usize, entry.height as usize) {
         report.problem = Some(format!(
             "golden reference is {}x{} but the suite asks for {}x{}: run `cargo xtask render-all --bless {}` after checking the images",
@@ -236,11 +236,11 @@ fn check_scene(
         return Ok(report);
     }
     report.reference_mean = reference.mean();
-    let exposure = image_io::auto_exposure(&reference);
-    image_io::write_png(
+    let exposure = film::auto_exposure(&reference);
+    film::write_preview(
         &out_dir.join(format!("{}-reference.png", entry.name)),
         &reference,
-        exposure,
+        film::Tonemap::linear(exposure),
         ZOOM,
     )?;
     report.sheet_row.push(scale(&reference, exposure));
@@ -249,20 +249,24 @@ fn check_scene(
     let factor = if flags.full { FULL_FACTOR } else { 1 };
     for method in ppm::Method::ALL {
         let passes = suite::passes(entry, method) * factor;
-        let rendered = suite::render(&scene, suite::params(entry, method, CHECK_SEED), passes)?;
-        let errors = image_io::errors(&rendered.image, &reference, Some(&mask))?;
+        let rendered = suite::render(
+            &scene,
+            suite::params(entry, &scene, method, CHECK_SEED)?,
+            passes,
+        )?;
+        let errors = film::errors(&rendered.image, &reference, Some(&mask))?;
         let tolerance = entry.tolerance.get(method.name()).copied();
-        let perturbed = image_io::errors(&scale(&rendered.image, 1.1), &reference, Some(&mask))?;
+        let perturbed = film::errors(&scale(&rendered.image, 1.1), &reference, Some(&mask))?;
         let stem = format!("{}-{}", entry.name, method.name());
-        image_io::write_png(
+        film::write_preview(
             &out_dir.join(format!("{stem}.png")),
             &rendered.image,
-            exposure,
+            film::Tonemap::linear(exposure),
             ZOOM,
         )?;
         report.sheet_row.push(scale(&rendered.image, exposure));
-        let map = image_io::rel_error_map(&rendered.image, &reference);
-        image_io::write_false_colour(
+        let map = film::rel_mse_map(&rendered.image, &reference)?;
+        film::write_false_colour(
             &out_dir.join(format!("{stem}-error.png")),
             entry.width as usize,
             &map,
@@ -307,7 +311,7 @@ fn scale(image: &Image, factor: f32) -> Image {
 /// relMSE ≤ 1.5 × the largest seen, |mean ratio − 1| ≤ 1.5 × the largest seen + 0.005.
 fn calibrate(root: &Path, entry: &SuiteScene, seeds: &[u64]) -> Result<()> {
     let golden = golden_path(root, &entry.name);
-    let reference = image_io::read_exr(&golden)
+    let reference = film::read_exr(&golden)
         .with_context(|| format!("run `cargo xtask render-all --bless {}` first", entry.name))?;
     let scene = suite::load_scene(root, entry)?;
     let mask = suite::transport_mask(&scene);
@@ -319,10 +323,10 @@ fn calibrate(root: &Path, entry: &SuiteScene, seeds: &[u64]) -> Result<()> {
         for &seed in seeds {
             let rendered = suite::render(
                 &scene,
-                suite::params(entry, method, seed),
+                suite::params(entry, &scene, method, seed)?,
                 suite::passes(entry, method),
             )?;
-            let e = image_io::errors(&rendered.image, &reference, Some(&mask))?;
+            let e = film::errors(&rendered.image, &reference, Some(&mask))?;
             rel.push(e.rel_mse);
             dev.push(e.mean_ratio - 1.0);
         }
@@ -393,7 +397,7 @@ fn write_report(
          neighbours): they measure light transport, not the lamp's outline. A method passes when relMSE ≤ tol and |mean ratio − 1| ≤ mean tol. \
          “×1.1 trips” says whether the same image scaled by 1.1 would fail (the check catches a 10 % regression).</p>",
         reports.len(),
-        image_io::REL_MSE_EPSILON
+        film::REL_MSE_EPSILON
     );
     for report in reports {
         let name = &report.entry.name;

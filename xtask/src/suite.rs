@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use serde::Deserialize;
 
-use crate::image_io::Image;
+use film::Image;
 
 /// The whole suite file.
 #[derive(Debug, Deserialize)]
@@ -100,9 +100,17 @@ pub(crate) fn load_scene_sized(
     geometry::Scene::new(description).with_context(|| format!("building {}", path.display()))
 }
 
-/// The parameters of `method` on `entry` at the check budget.
-pub(crate) fn params(entry: &SuiteScene, method: ppm::Method, seed: u64) -> ppm::RenderParams {
-    let mut params = ppm::RenderParams::preview();
+/// The parameters of `method` on `entry` at the check budget: the scene's `[render]` table,
+/// then the suite's.
+pub(crate) fn params(
+    entry: &SuiteScene,
+    scene: &geometry::Scene,
+    method: ppm::Method,
+    seed: u64,
+) -> Result<ppm::RenderParams> {
+    let mut params = ppm::RenderParams::preview()
+        .with_scene_defaults(&scene.description().render)
+        .with_context(|| format!("[render] table of {}", entry.path.display()))?;
     params.method = method;
     params.seed = seed;
     params.max_depth = entry.max_depth;
@@ -112,7 +120,7 @@ pub(crate) fn params(entry: &SuiteScene, method: ppm::Method, seed: u64) -> ppm:
     } else {
         entry.spp
     };
-    params
+    Ok(params)
 }
 
 /// A finished render.

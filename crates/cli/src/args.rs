@@ -114,71 +114,72 @@ pub(crate) struct RenderArgs {
     pub(crate) run: RunArgs,
 }
 
-/// Integrator parameters; each overrides the scene's `[render]` table.
-#[derive(Debug, Args)]
-#[command(next_help_heading = "Integrator")]
+/// Integrator parameters, one flag per entry of `ppm::PARAMS` (names, help and parsing are
+/// defined there once); each overrides the scene's `[render]` table.
+#[derive(Debug, Default)]
 pub(crate) struct ParamArgs {
-    /// Integrator [default: scene's [render] method, else ppm].
-    #[arg(long, value_enum)]
-    pub(crate) method: Option<MethodArg>,
-    /// Photons traced per pass, e.g. 200000, 200_000, 200k or 2M [default: scene, else 100k].
-    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_count)]
-    pub(crate) photons_per_pass: Option<i64>,
-    /// Radius reduction α in (0, 1] [default: scene, else 0.7].
-    #[arg(long, allow_negative_numbers = true)]
-    pub(crate) alpha: Option<f64>,
-    /// Initial gather radius in scene units [default: scene, else picked from the scene size].
-    #[arg(long, value_name = "RADIUS", allow_negative_numbers = true)]
-    pub(crate) initial_radius: Option<f64>,
-    /// Share of photons that carry a light-field spectrum, in [0, 1] (frequency methods)
-    /// [default: 0.1].
-    #[arg(long, value_name = "SHARE", allow_negative_numbers = true)]
-    pub(crate) freq_fraction: Option<f64>,
-    /// How a hitpoint merges frequency estimates [default: min].
-    #[arg(long, value_enum, value_name = "POLICY")]
-    pub(crate) freq_merge: Option<MergeArg>,
-    /// What happens once the PPM radius reaches the frequency radius [default: keep].
-    #[arg(long, value_enum, value_name = "RULE")]
-    pub(crate) freq_floor: Option<FloorArg>,
-    /// Kernel radius constant K of the frequency estimate [default: 0.0720909, the strict
-    /// 95 %-of-peak radius; the poster's is 0.7115].
-    #[arg(long, value_name = "K", allow_negative_numbers = true)]
-    pub(crate) kernel_k: Option<f64>,
-    /// Largest kernel of a frequency method, as a multiple of the initial radius, in [1, 64]
-    /// [default: 1, measured in docs/integrators.md; 1 never grows a kernel beyond R₀].
-    #[arg(long, value_name = "G", allow_negative_numbers = true)]
-    pub(crate) freq_grow: Option<f64>,
-    /// α of a hitpoint held by its frequency radius, in (0, 1] [default: 0.9; 1 keeps the
-    /// radius for ever, the poster's rule, which does not converge].
-    #[arg(long, value_name = "A", allow_negative_numbers = true)]
-    pub(crate) freq_hold_alpha: Option<f64>,
-    /// Passes of the frequency pilot before the kernels are sized and the statistics restart
-    /// [default: 4; 0 never grows kernels; only with --freq-grow above 1].
-    #[arg(long, value_name = "N", allow_negative_numbers = true)]
-    pub(crate) freq_pilot: Option<i64>,
-    /// Cap every slot's radius of a frequency method at the clear radius of its gather disc
-    /// (probed at every visible point), not only the held ones.
-    #[arg(long)]
-    pub(crate) freq_clear_cap: bool,
-    /// Maximum number of scattering events on a light path, in [1, 1024] [default: scene,
-    /// else 1024: in effect unlimited, paths end by Russian roulette].
-    #[arg(long, value_name = "N", allow_negative_numbers = true)]
-    pub(crate) max_depth: Option<i64>,
-    /// Hitpoints per pixel (paths per pixel per pass for --method path), in [1, 1024]
-    /// [default: 1].
-    #[arg(long, value_name = "N", allow_negative_numbers = true)]
-    pub(crate) spp: Option<i64>,
-    /// Seed of every random number [default: scene, else 0].
-    #[arg(long)]
-    pub(crate) seed: Option<u64>,
-    /// Add direct lighting by light sampling at hitpoints instead of gathering photons that
-    /// arrive straight from an emitter.
-    #[arg(long)]
-    pub(crate) direct_lighting: bool,
-    /// Let frequency methods hold a radius even where the gather disc hangs over an edge or a
-    /// corner of the surface (no geometric bound on held kernels).
-    #[arg(long)]
-    pub(crate) no_freq_geometry: bool,
+    /// (parameter name, text) of the flags given, in the order of `ppm::PARAMS`.
+    pub(crate) values: Vec<(&'static str, String)>,
+}
+
+impl clap::FromArgMatches for ParamArgs {
+    fn from_arg_matches(matches: &clap::ArgMatches) -> Result<Self, clap::Error> {
+        let mut args = Self::default();
+        args.update_from_arg_matches(matches)?;
+        Ok(args)
+    }
+
+    fn update_from_arg_matches(&mut self, matches: &clap::ArgMatches) -> Result<(), clap::Error> {
+        for param in ppm::PARAMS {
+            let value = match param.kind {
+                ppm::ParamKind::Value { .. } => matches.get_one::<String>(param.name).cloned(),
+                ppm::ParamKind::Switch { sets } => matches
+                    .get_flag(param.name)
+                    .then(|| if sets { "on" } else { "off" }.to_owned()),
+            };
+            if let Some(value) = value {
+                self.values.retain(|(name, _)| *name != param.name);
+                self.values.push((param.name, value));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Args for ParamArgs {
+    fn augment_args(cmd: clap::Command) -> clap::Command {
+        let mut cmd = cmd.next_help_heading("Integrator");
+        for param in ppm::PARAMS {
+            let arg = clap::Arg::new(param.name).long(param.flag).help(param.help);
+            let arg = match param.kind {
+                ppm::ParamKind::Value {
+                    value_name,
+                    choices: [],
+                } => arg
+                    .value_name(value_name)
+                    .allow_negative_numbers(true)
+                    .action(clap::ArgAction::Set),
+                ppm::ParamKind::Value {
+                    value_name,
+                    choices,
+                } => arg
+                    .value_name(value_name)
+                    .value_parser(clap::builder::PossibleValuesParser::new(
+                        choices.iter().map(|&(name, help)| {
+                            clap::builder::PossibleValue::new(name).help(help)
+                        }),
+                    ))
+                    .action(clap::ArgAction::Set),
+                ppm::ParamKind::Switch { .. } => arg.action(clap::ArgAction::SetTrue),
+            };
+            cmd = cmd.arg(arg);
+        }
+        cmd
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
 }
 
 /// How long to render.
@@ -281,51 +282,6 @@ pub(crate) struct DiffArgs {
     pub(crate) json: bool,
 }
 
-/// `--method`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub(crate) enum MethodArg {
-    /// Progressive photon mapping (Hachisuka, Ogaki & Jensen 2008).
-    Ppm,
-    /// Stochastic progressive photon mapping (Hachisuka & Jensen 2009).
-    Sppm,
-    /// PPM with frequency-guided kernels (Belcour & Soler 2011).
-    Freq,
-    /// SPPM with frequency-guided kernels.
-    FreqSppm,
-    /// Path tracing with next-event estimation: the reference.
-    Path,
-}
-
-impl MethodArg {
-    pub(crate) fn method(self) -> ppm::Method {
-        match self {
-            MethodArg::Ppm => ppm::Method::Ppm,
-            MethodArg::Sppm => ppm::Method::Sppm,
-            MethodArg::Freq => ppm::Method::FreqPpm,
-            MethodArg::FreqSppm => ppm::Method::FreqSppm,
-            MethodArg::Path => ppm::Method::Path,
-        }
-    }
-}
-
-/// `--freq-merge`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub(crate) enum MergeArg {
-    /// Keep the smallest radius (the most conservative estimate).
-    Min,
-    /// Merge as on the poster (the largest frequency content).
-    PosterMax,
-}
-
-/// `--freq-floor`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub(crate) enum FloorArg {
-    /// Keep the radius once it reaches the frequency radius.
-    Keep,
-    /// Clamp the shrinking radius at the frequency radius.
-    Clamp,
-}
-
 /// `--tonemap`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -381,53 +337,33 @@ impl AovArg {
     }
 }
 
-/// A count with optional `_` separators and a `k` (10³) or `M` (10⁶) suffix; negative values
-/// parse (and are refused later with a message naming the flag).
-fn parse_count(text: &str) -> Result<i64, String> {
-    let cleaned: String = text.chars().filter(|&c| c != '_').collect();
-    let (digits, factor) = if let Some(d) = cleaned.strip_suffix(['k', 'K']) {
-        (d, 1_000)
-    } else if let Some(d) = cleaned.strip_suffix('M') {
-        (d, 1_000_000)
-    } else {
-        (cleaned.as_str(), 1)
-    };
-    digits
-        .parse::<i64>()
-        .ok()
-        .and_then(|n| n.checked_mul(factor))
-        .ok_or_else(|| "expected a whole number such as 200000, 200_000, 200k or 2M".to_string())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn method_names_match_the_library() {
-        for m in MethodArg::value_variants() {
-            let name = m.to_possible_value().map(|v| v.get_name().to_string());
-            assert_eq!(name.as_deref(), Some(m.method().name()));
-        }
-        assert_eq!(MethodArg::value_variants().len(), ppm::Method::ALL.len());
-    }
-
-    #[test]
-    fn counts() {
-        assert_eq!(parse_count("200000"), Ok(200_000));
-        assert_eq!(parse_count("200_000"), Ok(200_000));
-        assert_eq!(parse_count("200k"), Ok(200_000));
-        assert_eq!(parse_count("2M"), Ok(2_000_000));
-        assert_eq!(parse_count("-5"), Ok(-5));
-        assert!(parse_count("lots").is_err());
-        assert!(parse_count("1.5").is_err());
-    }
 
     #[test]
     fn aov_names() {
         for a in AovArg::value_variants() {
             let name = a.to_possible_value().map(|v| v.get_name().to_string());
             assert_eq!(name.as_deref(), Some(a.name()));
+        }
+    }
+
+    #[test]
+    fn every_render_parameter_has_its_flag() {
+        use clap::CommandFactory;
+        let cli = Cli::command();
+        let render = cli
+            .find_subcommand("render")
+            .expect("the render subcommand");
+        for param in ppm::PARAMS {
+            assert!(
+                render
+                    .get_arguments()
+                    .any(|a| a.get_long() == Some(param.flag)),
+                "--{}",
+                param.flag
+            );
         }
     }
 

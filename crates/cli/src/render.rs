@@ -12,7 +12,6 @@ use ppm::{PassStats, Renderer, StateHeader};
 
 use crate::args::{RenderArgs, ResumeArgs};
 use crate::duration;
-use crate::output::{self, Frame};
 use crate::settings::{self, Budget, Job, Note};
 use crate::{DEFAULT_SCENE_NAME, Outcome, usage};
 
@@ -205,52 +204,29 @@ fn write_images(job: &Job, renderer: &Renderer<'_>, elapsed: Duration) -> anyhow
         || DEFAULT_SCENE_NAME.to_string(),
         |p| p.display().to_string(),
     );
-    let metadata = [
-        ("scene", scene_name),
-        ("method", params.method.name().to_string()),
-        ("passes", renderer.passes().to_string()),
-        ("photons", renderer.photons_emitted().to_string()),
-        ("photons_per_pass", params.photons_per_pass.to_string()),
-        ("seed", params.seed.to_string()),
-        ("alpha", params.alpha.to_string()),
-        ("spp", params.samples_per_pixel.to_string()),
-        ("max_depth", params.max_depth.to_string()),
-        (
-            "render_seconds",
-            format!("{:.3}", job.earlier_seconds + elapsed.as_secs_f64()),
-        ),
-        ("version", env!("CARGO_PKG_VERSION").to_string()),
+    // Every render parameter (`ppm::PARAMS`), so that the image says exactly how it was made.
+    let mut metadata = vec![
+        ("scene".to_owned(), scene_name),
+        ("passes".to_owned(), renderer.passes().to_string()),
+        ("photons".to_owned(), renderer.photons_emitted().to_string()),
     ];
-    let mut frame = Frame {
-        width: width as usize,
-        height: height as usize,
-        beauty: renderer.image(),
-        channels: Vec::new(),
-        metadata: metadata
+    metadata.extend(
+        params
+            .entries()
             .into_iter()
-            .map(|(k, v)| (k.to_string(), v))
-            .collect(),
-    };
-    if params.method.uses_frequency() {
-        frame
-            .metadata
-            .push(("freq_fraction".into(), params.freq_fraction.to_string()));
-        frame
-            .metadata
-            .push(("kernel_k".into(), params.kernel_k.to_string()));
-        frame.metadata.push((
-            "freq_geometry".into(),
-            if params.freq_geometry { "on" } else { "off" }.into(),
-        ));
-        for (key, value) in [
-            ("freq_grow", params.freq_grow.to_string()),
-            ("freq_hold_alpha", params.freq_hold_alpha.to_string()),
-            ("freq_pilot", params.freq_pilot.to_string()),
-            ("freq_clear_cap", params.freq_clear_cap.to_string()),
-        ] {
-            frame.metadata.push((key.into(), value));
-        }
-    }
+            .map(|(name, value)| (name.to_owned(), value)),
+    );
+    metadata.push((
+        "render_seconds".to_owned(),
+        format!("{:.3}", job.earlier_seconds + elapsed.as_secs_f64()),
+    ));
+    metadata.push(("version".to_owned(), env!("CARGO_PKG_VERSION").to_owned()));
+    let mut frame = film::Frame::new(film::Image::new(
+        width as usize,
+        height as usize,
+        renderer.image(),
+    ));
+    frame.metadata = metadata;
     for aov_flag in &job.outputs.aovs {
         for &aov in aov_flag.aovs() {
             match renderer.aov(aov) {
@@ -262,8 +238,13 @@ fn write_images(job: &Job, renderer: &Renderer<'_>, elapsed: Duration) -> anyhow
             }
         }
     }
-    output::write_exr(&job.outputs.exr, &frame)?;
-    output::write_preview(&job.outputs.png, &frame, job.outputs.tonemap)?;
+    film::write_exr(&job.outputs.exr, &frame)?;
+    film::write_preview(
+        &job.outputs.png,
+        &frame.image,
+        job.outputs.tonemap.film(),
+        1,
+    )?;
     Ok(())
 }
 
@@ -291,10 +272,10 @@ fn write_checkpoint(
     let note = serde_json::to_string(&note)
         .context("internal error: cannot encode the checkpoint note")?;
     let bytes = renderer.save_state(&note);
-    output::write_atomically(path, |w| {
-        std::io::Write::write_all(w, &bytes)?;
-        Ok(())
-    })
+    film::write_atomically(path, |w| {
+        std::io::Write::write_all(w, &bytes).map_err(|e| film::lower_first(&e.to_string()))
+    })?;
+    Ok(())
 }
 
 /// `1.2M`, `350k`, `999`.

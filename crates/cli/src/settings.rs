@@ -8,12 +8,10 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::Context;
-use geometry::{RenderDefaults, SceneDescription};
+use geometry::SceneDescription;
 use ppm::{Method, ParamError, RenderParams};
 
-use crate::args::{
-    AovArg, FloorArg, MergeArg, OutputArgs, ParamArgs, RenderArgs, RunArgs, TonemapArg,
-};
+use crate::args::{AovArg, OutputArgs, ParamArgs, RenderArgs, RunArgs, TonemapArg};
 use crate::output::{self, Tonemap};
 use crate::{DEFAULT_SCENE, DEFAULT_SCENE_NAME, usage};
 
@@ -109,7 +107,9 @@ pub(crate) fn render_job(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Res
     apply_film(&mut description, film);
     let defaults = description.render.clone();
     let source = description.source.clone();
-    let base = apply_scene_defaults(RenderParams::preview(), &defaults, &source)?;
+    let base = RenderParams::preview()
+        .with_scene_defaults(&defaults)
+        .map_err(|e| anyhow::anyhow!("{}: [render] {}", source.display(), param_message(&e)))?;
     let params = apply_flags(base, &args.params)?;
     params
         .validate()
@@ -289,117 +289,8 @@ pub(crate) fn check_aovs(aovs: &[AovArg], method: Method) -> anyhow::Result<()> 
 /// [`RenderParams::validate`].
 fn apply_flags(base: RenderParams, flags: &ParamArgs) -> anyhow::Result<RenderParams> {
     let mut p = base;
-    if let Some(m) = flags.method {
-        p.method = m.method();
-    }
-    if let Some(n) = flags.photons_per_pass {
-        if n <= 0 {
-            usage!("--photons-per-pass {n} must be positive");
-        }
-        p.photons_per_pass = match u32::try_from(n) {
-            Ok(n) => n,
-            Err(_) => usage!("--photons-per-pass {n} is too large (at most {})", u32::MAX),
-        };
-    }
-    if let Some(a) = flags.alpha {
-        p.alpha = a;
-    }
-    if let Some(r) = flags.initial_radius {
-        p.initial_radius = Some(r);
-    }
-    if let Some(f) = flags.freq_fraction {
-        p.freq_fraction = f;
-    }
-    if let Some(m) = flags.freq_merge {
-        p.freq_merge = match m {
-            MergeArg::Min => ppm::MergePolicy::MinRadius,
-            MergeArg::PosterMax => ppm::MergePolicy::PosterMax,
-        };
-    }
-    if let Some(f) = flags.freq_floor {
-        p.freq_floor = match f {
-            FloorArg::Keep => ppm::FrequencyFloor::Keep,
-            FloorArg::Clamp => ppm::FrequencyFloor::Clamp,
-        };
-    }
-    if let Some(k) = flags.kernel_k {
-        p.kernel_k = k;
-    }
-    if let Some(d) = flags.max_depth {
-        p.max_depth = small_count("--max-depth", d)?;
-    }
-    if let Some(g) = flags.freq_grow {
-        p.freq_grow = g;
-    }
-    if let Some(a) = flags.freq_hold_alpha {
-        p.freq_hold_alpha = a;
-    }
-    if flags.freq_clear_cap {
-        p.freq_clear_cap = true;
-    }
-    if let Some(n) = flags.freq_pilot {
-        p.freq_pilot = match u32::try_from(n) {
-            Ok(n) => n,
-            Err(_) => usage!("--freq-pilot {n} is outside [0, 1000000]"),
-        };
-    }
-    if let Some(s) = flags.spp {
-        p.samples_per_pixel = small_count("--spp", s)?;
-    }
-    if let Some(seed) = flags.seed {
-        p.seed = seed;
-    }
-    if flags.no_freq_geometry {
-        p.freq_geometry = false;
-    }
-    if flags.direct_lighting {
-        p.direct_lighting = true;
-    }
-    Ok(p)
-}
-
-/// A count whose range `validate` knows; values that do not fit a `u32` are refused here.
-fn small_count(flag: &str, n: i64) -> anyhow::Result<u32> {
-    match u32::try_from(n) {
-        Ok(v) => Ok(v),
-        Err(_) => usage!("{flag} {n} is outside [1, 1024]"),
-    }
-}
-
-/// The scene's `[render]` table over `base`.
-fn apply_scene_defaults(
-    base: RenderParams,
-    d: &RenderDefaults,
-    source: &Path,
-) -> anyhow::Result<RenderParams> {
-    let mut p = base;
-    let bad = |what: String| anyhow::anyhow!("{}: [render] {what}", source.display());
-    if let Some(name) = &d.method {
-        p.method = Method::from_name(name).ok_or_else(|| {
-            let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
-            bad(format!(
-                "method {name:?} is not one of {}",
-                names.join(", ")
-            ))
-        })?;
-    }
-    if let Some(n) = d.photons_per_pass {
-        p.photons_per_pass = u32::try_from(n)
-            .ok()
-            .filter(|&n| n > 0)
-            .ok_or_else(|| bad(format!("photons_per_pass {n} is outside [1, 2^32)")))?;
-    }
-    if let Some(a) = d.alpha {
-        p.alpha = a;
-    }
-    if let Some(r) = d.initial_radius {
-        p.initial_radius = Some(r);
-    }
-    if let Some(m) = d.max_depth {
-        p.max_depth = m;
-    }
-    if let Some(s) = d.seed {
-        p.seed = s;
+    for (name, value) in &flags.values {
+        p.set(name, value).map_err(flag_error)?;
     }
     Ok(p)
 }
@@ -408,17 +299,27 @@ fn apply_scene_defaults(
 fn flag_error(e: ParamError) -> anyhow::Error {
     anyhow::Error::new(crate::UsageError(match &e {
         ParamError::OutOfRange { name, value, range } => {
-            format!("--{name} {value} is outside {range}")
+            format!("--{} {value} is outside {range}", flag_name(name))
         }
+        ParamError::Unreadable {
+            name,
+            value,
+            problem,
+        } => format!("--{} {value} {problem}", flag_name(name)),
         other => other.to_string(),
     }))
+}
+
+/// The flag of the parameter called `name`.
+fn flag_name(name: &str) -> &str {
+    ppm::param(name).map_or(name, |p| p.flag)
 }
 
 /// `alpha 1.5 is outside (0, 1]`.
 fn param_message(e: &ParamError) -> String {
     match e {
         ParamError::OutOfRange { name, value, range } => {
-            format!("{} {value} is outside {range}", name.replace('-', "_"))
+            format!("{name} {value} is outside {range}")
         }
         other => other.to_string(),
     }

@@ -213,22 +213,35 @@ pub enum Light {
     },
 }
 
-/// Optional render settings stored with a scene (`[render]` table). Every field is optional;
-/// the command line overrides them and the integrators validate them.
+/// Optional render settings stored with a scene (`[render]` table): the number of passes,
+/// and render parameters as text, which `ppm` reads (`ppm::RenderParams::set`: the names,
+/// their parsing and their ranges are defined there, once). The command line overrides them.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct RenderDefaults {
-    /// Integrator name, e.g. `"ppm"`, `"sppm"`, `"freq"`.
-    pub method: Option<String>,
     /// Number of passes.
     pub passes: Option<u32>,
-    /// Photons traced per pass.
-    pub photons_per_pass: Option<u64>,
-    /// Radius reduction parameter α.
-    pub alpha: Option<f64>,
-    /// Initial gather radius in scene units.
-    pub initial_radius: Option<f64>,
-    /// Maximum path depth.
-    pub max_depth: Option<u32>,
-    /// Random seed.
-    pub seed: Option<u64>,
+    /// Every other key of the table with its value as text (a string without its quotes, a
+    /// number or `true`/`false` as written by Rust), in the order of the keys' names.
+    pub params: Vec<(String, String)>,
+}
+
+impl RenderDefaults {
+    /// The text of render parameter `name`, if the scene sets it.
+    #[must_use]
+    pub fn get(&self, name: &str) -> Option<&str> {
+        self.params
+            .iter()
+            .find(|(key, _)| key == name)
+            .map(|(_, value)| value.as_str())
+    }
+
+    /// Sets render parameter `name` (what an importer reads from another renderer's
+    /// settings), replacing an earlier value.
+    pub fn set(&mut self, name: &str, value: impl ToString) {
+        let value = value.to_string();
+        match self.params.iter_mut().find(|(key, _)| key == name) {
+            Some(entry) => entry.1 = value,
+            None => self.params.push((name.to_owned(), value)),
+        }
+    }
 }

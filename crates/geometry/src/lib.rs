@@ -78,4 +78,4 @@ pub use load::{
 };
 pub use ray::{Hit, Primitive, Ray};
 pub use scene::{Scene, SceneError};
-pub use summary::{Bounds, CameraSummary, F6, LightCounts, MaterialSummary, Rgb6, SceneSummary};
+pub use summary::{Bounds, CameraSummary, LightCounts, MaterialSummary, SceneSummary};

@@ -9,8 +9,8 @@ use crate::description::{Light, MaterialKind, SceneDescription};
 
 /// Counts and parameters of a [`SceneDescription`], for display and snapshots.
 ///
-/// Floats serialize rounded to 6 significant digits so that snapshots do not flip on
-/// last-bit changes.
+/// Floats serialize and display rounded to 6 significant digits so that snapshots do not flip
+/// on last-bit changes.
 #[derive(Clone, Debug, Serialize)]
 pub struct SceneSummary {
     /// The scene file.
@@ -62,19 +62,20 @@ pub struct MaterialSummary {
     /// `diffuse`, `mirror`, `dielectric` or `glossy`.
     pub kind: &'static str,
     /// Diffuse albedo, or the Lambertian base of a glossy material from an OBJ file.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub albedo: Option<Rgb6>,
+    #[serde(skip_serializing_if = "Option::is_none", serialize_with = "opt3")]
+    pub albedo: Option<Vec3>,
     /// Mirror or glossy reflectance.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub reflectance: Option<Rgb6>,
+    #[serde(skip_serializing_if = "Option::is_none", serialize_with = "opt3")]
+    pub reflectance: Option<Vec3>,
     /// Dielectric index of refraction.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub ior: Option<F6>,
+    #[serde(skip_serializing_if = "Option::is_none", serialize_with = "opt")]
+    pub ior: Option<f32>,
     /// Glossy GGX α.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub roughness: Option<F6>,
+    #[serde(skip_serializing_if = "Option::is_none", serialize_with = "opt")]
+    pub roughness: Option<f32>,
     /// Emitted radiance (zero if none).
-    pub emission: Rgb6,
+    #[serde(serialize_with = "rounded3")]
+    pub emission: Vec3,
     /// Triangles using the material.
     pub triangles: usize,
     /// Spheres using the material.
@@ -92,36 +93,37 @@ fn is_zero(n: &usize) -> bool {
 #[derive(Clone, Debug, Serialize)]
 pub struct CameraSummary {
     /// Eye position.
-    pub position: Rgb6,
+    #[serde(serialize_with = "rounded3")]
+    pub position: Vec3,
     /// Point looked at.
-    pub look_at: Rgb6,
+    #[serde(serialize_with = "rounded3")]
+    pub look_at: Vec3,
     /// Up vector.
-    pub up: Rgb6,
+    #[serde(serialize_with = "rounded3")]
+    pub up: Vec3,
     /// Vertical field of view in degrees.
-    pub fov_y_degrees: F6,
+    #[serde(serialize_with = "rounded")]
+    pub fov_y_degrees: f32,
     /// Lens radius.
-    pub aperture_radius: F6,
+    #[serde(serialize_with = "rounded")]
+    pub aperture_radius: f32,
     /// Focus distance.
-    pub focus_distance: F6,
+    #[serde(serialize_with = "rounded")]
+    pub focus_distance: f32,
 }
 
 /// Axis-aligned bounds.
 #[derive(Clone, Debug, Serialize)]
 pub struct Bounds {
     /// Smallest corner.
-    pub min: Rgb6,
+    #[serde(serialize_with = "rounded3")]
+    pub min: Vec3,
     /// Largest corner.
-    pub max: Rgb6,
+    #[serde(serialize_with = "rounded3")]
+    pub max: Vec3,
 }
 
-/// A float that serializes rounded to 6 significant digits.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct F6(pub f32);
-
-/// Three floats that serialize rounded to 6 significant digits.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Rgb6(pub Vec3);
-
+/// `x` rounded to 6 significant digits, so that snapshots do not flip on last-bit changes.
 fn round6(x: f32) -> f64 {
     if !x.is_finite() || x == 0.0 {
         return f64::from(x) + 0.0;
@@ -131,33 +133,43 @@ fn round6(x: f32) -> f64 {
         .unwrap_or(f64::from(x))
 }
 
-impl Serialize for F6 {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_f64(round6(self.0))
-    }
+/// `x` rounded, as a number.
+fn rounded<S: Serializer>(x: &f32, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_f64(round6(*x))
 }
 
-impl Serialize for Rgb6 {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        [round6(self.0.x), round6(self.0.y), round6(self.0.z)].serialize(s)
-    }
+/// `v` rounded, as an array of three numbers.
+fn rounded3<S: Serializer>(v: &Vec3, s: S) -> Result<S::Ok, S::Error> {
+    [round6(v.x), round6(v.y), round6(v.z)].serialize(s)
 }
 
-impl fmt::Display for F6 {
+/// [`rounded`] of an optional float (`serialize_with` passes the field by reference).
+fn opt<S: Serializer>(x: &Option<f32>, s: S) -> Result<S::Ok, S::Error> {
+    x.map(round6).serialize(s)
+}
+
+/// [`rounded3`] of an optional vector.
+fn opt3<S: Serializer>(v: &Option<Vec3>, s: S) -> Result<S::Ok, S::Error> {
+    v.map(|v| [round6(v.x), round6(v.y), round6(v.z)])
+        .serialize(s)
+}
+
+/// A float as the summary shows it (6 significant digits).
+struct Show(f32);
+
+impl fmt::Display for Show {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}", round6(self.0))
     }
 }
 
-impl fmt::Display for Rgb6 {
+/// A vector as the summary shows it.
+struct Show3(Vec3);
+
+impl fmt::Display for Show3 {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "[{}, {}, {}]",
-            round6(self.0.x),
-            round6(self.0.y),
-            round6(self.0.z)
-        )
+        let v = self.0;
+        write!(f, "[{}, {}, {}]", round6(v.x), round6(v.y), round6(v.z))
     }
 }
 
@@ -170,25 +182,21 @@ impl SceneDescription {
             .iter()
             .map(|m| {
                 let (kind, albedo, reflectance, ior, roughness) = match m.kind {
-                    MaterialKind::Diffuse { albedo } => {
-                        ("diffuse", Some(Rgb6(albedo)), None, None, None)
-                    }
+                    MaterialKind::Diffuse { albedo } => ("diffuse", Some(albedo), None, None, None),
                     MaterialKind::Mirror { reflectance } => {
-                        ("mirror", None, Some(Rgb6(reflectance)), None, None)
+                        ("mirror", None, Some(reflectance), None, None)
                     }
-                    MaterialKind::Dielectric { ior } => {
-                        ("dielectric", None, None, Some(F6(ior)), None)
-                    }
+                    MaterialKind::Dielectric { ior } => ("dielectric", None, None, Some(ior), None),
                     MaterialKind::Glossy {
                         reflectance,
                         roughness,
                         diffuse,
                     } => (
                         "glossy",
-                        (diffuse != Vec3::ZERO).then_some(Rgb6(diffuse)),
-                        Some(Rgb6(reflectance)),
+                        (diffuse != Vec3::ZERO).then_some(diffuse),
+                        Some(reflectance),
                         None,
-                        Some(F6(roughness)),
+                        Some(roughness),
                     ),
                 };
                 MaterialSummary {
@@ -198,7 +206,7 @@ impl SceneDescription {
                     reflectance,
                     ior,
                     roughness,
-                    emission: Rgb6(m.emission),
+                    emission: m.emission,
                     triangles: 0,
                     spheres: 0,
                     cylinders: 0,
@@ -244,20 +252,16 @@ impl SceneDescription {
             lights,
             materials,
             camera: CameraSummary {
-                position: Rgb6(c.position),
-                look_at: Rgb6(c.look_at),
-                up: Rgb6(c.up),
-                fov_y_degrees: F6(c.fov_y.to_degrees()),
-                aperture_radius: F6(c.aperture_radius),
-                focus_distance: F6(c.focus_distance),
+                position: c.position,
+                look_at: c.look_at,
+                up: c.up,
+                fov_y_degrees: c.fov_y.to_degrees(),
+                aperture_radius: c.aperture_radius,
+                focus_distance: c.focus_distance,
             },
             film: [self.film.width, self.film.height],
-            bounds: crate::load::bounds(&self.triangles, &self.spheres, &self.cylinders).map(
-                |(min, max)| Bounds {
-                    min: Rgb6(min),
-                    max: Rgb6(max),
-                },
-            ),
+            bounds: crate::load::bounds(&self.triangles, &self.spheres, &self.cylinders)
+                .map(|(min, max)| Bounds { min, max }),
             degenerate_triangles: self.notes.degenerate_triangles,
             camera_framed: self.notes.camera_framed,
             warnings: self.notes.warnings.clone(),
@@ -298,35 +302,35 @@ impl fmt::Display for SceneSummary {
         writeln!(
             f,
             "camera     {} -> {}, up {}, fov_y {}°, aperture {}, focus {}{}",
-            c.position,
-            c.look_at,
-            c.up,
-            c.fov_y_degrees,
-            c.aperture_radius,
-            c.focus_distance,
+            Show3(c.position),
+            Show3(c.look_at),
+            Show3(c.up),
+            Show(c.fov_y_degrees),
+            Show(c.aperture_radius),
+            Show(c.focus_distance),
             if self.camera_framed { " (framed)" } else { "" }
         )?;
         writeln!(f, "film       {} x {}", self.film[0], self.film[1])?;
         if let Some(b) = &self.bounds {
-            writeln!(f, "bounds     {} .. {}", b.min, b.max)?;
+            writeln!(f, "bounds     {} .. {}", Show3(b.min), Show3(b.max))?;
         }
         writeln!(f, "materials  {}", self.materials.len())?;
         for m in &self.materials {
             write!(f, "  {:?} {}", m.name, m.kind)?;
             if let Some(a) = m.albedo {
-                write!(f, " albedo {a}")?;
+                write!(f, " albedo {}", Show3(a))?;
             }
             if let Some(r) = m.reflectance {
-                write!(f, " reflectance {r}")?;
+                write!(f, " reflectance {}", Show3(r))?;
             }
             if let Some(i) = m.ior {
-                write!(f, " ior {i}")?;
+                write!(f, " ior {}", Show(i))?;
             }
             if let Some(r) = m.roughness {
-                write!(f, " roughness {r}")?;
+                write!(f, " roughness {}", Show(r))?;
             }
-            if m.emission.0 != Vec3::ZERO {
-                write!(f, " emission {}", m.emission)?;
+            if m.emission != Vec3::ZERO {
+                write!(f, " emission {}", Show3(m.emission))?;
             }
             write!(f, " ({} triangles, {} spheres", m.triangles, m.spheres)?;
             if m.cylinders > 0 {

@@ -70,15 +70,19 @@ where
 pub struct GatherScratch<T> {
     /// Per photon chunk, per hitpoint range.
     bins: Vec<Vec<Vec<(u32, T)>>>,
-    /// The bins the last gather filled: its photon chunks, its hitpoint count and range length.
-    last: Option<LastGather>,
 }
 
-/// The shape of the bins of the last gather, for [`accumulate_again`].
-#[derive(Clone, Copy, Debug)]
-struct LastGather {
+/// The bins of a finished [`gather_with`], which folds its `(hitpoint, value)` pairs again with
+/// [`Gathered::accumulate_again`]: only a gather makes one, so nothing can fold bins that no
+/// gather filled.
+#[derive(Debug)]
+pub struct Gathered<'a, T> {
+    scratch: &'a GatherScratch<T>,
+    /// The gather's photon chunks.
     n_chunks: usize,
+    /// Its hitpoint count.
     n_hitpoints: usize,
+    /// Its hitpoint range length.
     range_len: usize,
 }
 
@@ -103,28 +107,27 @@ impl<T> GatherScratch<T> {
 
 impl<T> Default for GatherScratch<T> {
     fn default() -> Self {
-        Self {
-            bins: Vec::new(),
-            last: None,
-        }
+        Self { bins: Vec::new() }
     }
 }
 
 /// [`gather`] with caller-kept buffers: the bins in `scratch`, and the accumulators in
 /// `accumulators`, which is overwritten with `n_hitpoints` accumulators (reusing its
-/// allocation). Same results as [`gather`], bit for bit.
+/// allocation). Same results as [`gather`], bit for bit. The bins stay in `scratch`, and the
+/// returned [`Gathered`] can fold them again into other accumulators.
 ///
 /// # Panics
 /// If the grid reports a hitpoint index ≥ `n_hitpoints`.
-pub fn gather_with<P, T, A>(
-    scratch: &mut GatherScratch<T>,
+pub fn gather_with<'a, P, T, A>(
+    scratch: &'a mut GatherScratch<T>,
     grid: &HitPointGrid,
     photons: &[P],
     accumulators: &mut Vec<A>,
     n_hitpoints: usize,
     contribution: impl Fn(&P, u32) -> Option<T> + Sync,
     accumulate: impl Fn(&mut A, T) + Sync,
-) where
+) -> Gathered<'a, T>
+where
     P: AsRef<Photon> + Sync,
     T: Copy + Send + Sync,
     A: Default + Clone + Send,
@@ -136,11 +139,6 @@ pub fn gather_with<P, T, A>(
     if scratch.bins.len() < n_chunks {
         scratch.bins.resize_with(n_chunks, Vec::new);
     }
-    scratch.last = Some(LastGather {
-        n_chunks,
-        n_hitpoints,
-        range_len,
-    });
     let bins = &mut scratch.bins[..n_chunks];
     bins.par_iter_mut()
         .zip(photons.par_chunks(GATHER_CHUNK))
@@ -157,53 +155,56 @@ pub fn gather_with<P, T, A>(
                 });
             }
         });
-    accumulate_again(scratch, accumulators, |acc, _, value| {
-        accumulate(acc, value)
-    });
-}
-
-/// Folds the `(hitpoint, value)` pairs that the last [`gather_with`] on `scratch` recorded into
-/// a second set of accumulators, in the same order (photon order for every hitpoint) and as
-/// deterministically, without querying the grid again.
-///
-/// For a second quantity carried by some of the photons: the contribution of the gather returns
-/// both (e.g. a flux and a tag naming a record with more state, see [`Photon::tag`]), its
-/// accumulation folds the first, and this folds the second, with the hitpoint's index at hand
-/// (`accumulate(&mut acc[h], h, value)`) for whatever the hitpoint's side of it needs.
-/// `accumulators` is overwritten with one `B::default()` per hitpoint of that gather.
-/// ([`gather_with`] folds its own accumulators with this, ignoring the index.)
-///
-/// # Panics
-/// If `scratch` has not been through [`gather_with`].
-pub fn accumulate_again<T, B>(
-    scratch: &GatherScratch<T>,
-    accumulators: &mut Vec<B>,
-    accumulate: impl Fn(&mut B, u32, T) + Sync,
-) where
-    T: Copy + Send + Sync,
-    B: Default + Clone + Send,
-{
-    let LastGather {
+    let gathered = Gathered {
+        scratch,
         n_chunks,
         n_hitpoints,
         range_len,
-    } = scratch
-        .last
-        .expect("accumulate_again needs the bins of a gather_with");
-    accumulators.clear();
-    // Exactly: the default growth would double the capacity when the count grows a little.
-    accumulators.reserve_exact(n_hitpoints);
-    accumulators.resize(n_hitpoints, B::default());
-    let bins = &scratch.bins[..n_chunks];
-    accumulators
-        .par_chunks_mut(range_len)
-        .enumerate()
-        .for_each(|(range_idx, accs)| {
-            let first = range_idx * range_len;
-            for chunk_bins in bins {
-                for &(idx, value) in &chunk_bins[range_idx] {
-                    accumulate(&mut accs[idx as usize - first], idx, value);
+    };
+    gathered.accumulate_again(accumulators, |acc, _, value| accumulate(acc, value));
+    gathered
+}
+
+impl<T: Copy + Send + Sync> Gathered<'_, T> {
+    /// Folds the `(hitpoint, value)` pairs of this gather into a second set of accumulators,
+    /// in the same order (photon order for every hitpoint) and as deterministically, without
+    /// querying the grid again.
+    ///
+    /// For a second quantity carried by some of the photons: the contribution of the gather
+    /// returns both (e.g. a flux and a tag naming a record with more state, see
+    /// [`Photon::tag`]), its accumulation folds the first, and this folds the second, with the
+    /// hitpoint's index at hand (`accumulate(&mut acc[h], h, value)`) for whatever the
+    /// hitpoint's side of it needs. `accumulators` is overwritten with one `B::default()` per
+    /// hitpoint of the gather. ([`gather_with`] folds its own accumulators with this, ignoring
+    /// the index.)
+    pub fn accumulate_again<B>(
+        &self,
+        accumulators: &mut Vec<B>,
+        accumulate: impl Fn(&mut B, u32, T) + Sync,
+    ) where
+        B: Default + Clone + Send,
+    {
+        let Self {
+            scratch,
+            n_chunks,
+            n_hitpoints,
+            range_len,
+        } = *self;
+        accumulators.clear();
+        // Exactly: the default growth would double the capacity when the count grows a little.
+        accumulators.reserve_exact(n_hitpoints);
+        accumulators.resize(n_hitpoints, B::default());
+        let bins = &scratch.bins[..n_chunks];
+        accumulators
+            .par_chunks_mut(range_len)
+            .enumerate()
+            .for_each(|(range_idx, accs)| {
+                let first = range_idx * range_len;
+                for chunk_bins in bins {
+                    for &(idx, value) in &chunk_bins[range_idx] {
+                        accumulate(&mut accs[idx as usize - first], idx, value);
+                    }
                 }
-            }
-        });
+            });
+    }
 }

@@ -29,7 +29,7 @@ mod hitpoints;
 mod morton;
 mod photon;
 
-pub use crate::gather::{GatherScratch, accumulate_again, gather, gather_with};
+pub use crate::gather::{GatherScratch, Gathered, gather, gather_with};
 pub use crate::grid::{CellSize, GridParams, GridStats, HitPointGrid};
 pub use crate::hitpoints::{HitPointColumnsMut, HitPoints, NewHitPoint};
 pub use crate::morton::{MortonScratch, morton_order, morton_sort};

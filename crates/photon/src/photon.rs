@@ -21,7 +21,7 @@ pub struct Photon {
     pub bounces: u32,
     /// Free for the caller: this crate never reads it. E.g. the index of a record with more
     /// state about some of the photons, which a gather's contribution can carry to the
-    /// accumulators ([`crate::gather_with`], [`crate::accumulate_again`]).
+    /// accumulators ([`crate::gather_with`], [`crate::Gathered::accumulate_again`]).
     pub tag: u32,
 }
 

@@ -47,7 +47,7 @@ mod rng;
 mod state;
 mod update;
 
-pub use crate::params::{Method, ParamError, RenderParams};
+pub use crate::params::{Method, PARAMS, Param, ParamError, ParamKind, RenderParams, param};
 pub use crate::photon_mapper::{
     MemoryUse, PassStats, PassTimings, auto_initial_radius, bytes_per_hitpoint,
 };

@@ -57,6 +57,7 @@ fn outputs_go_where_asked_and_metadata_is_written() {
     let exr = read_exr(&dir.join("a.exr"));
     let m = &exr.metadata;
     assert_eq!(m["fppm.passes"], "2");
+    // The library's default method.
     assert_eq!(m["fppm.method"], "freq-sppm");
     assert_eq!(m["fppm.seed"], "7");
     assert_eq!(m["fppm.photons"], "8000");
@@ -66,6 +67,17 @@ fn outputs_go_where_asked_and_metadata_is_written() {
         "{m:?}"
     );
     assert!(m["fppm.render_seconds"].parse::<f64>().unwrap() > 0.0);
+    // Every render parameter, with the value the library reads back.
+    for param in ppm::PARAMS {
+        assert!(
+            m.contains_key(&format!("fppm.{}", param.name)),
+            "{}",
+            param.name
+        );
+    }
+    assert_eq!(m["fppm.freq_merge"], "min");
+    assert_eq!(m["fppm.freq_floor"], "keep");
+    assert_eq!(m["fppm.initial_radius"], "auto");
     assert_eq!(exr.channels.keys().collect::<Vec<_>>(), ["B", "G", "R"]);
     assert!(exr.mean() > 0.0, "the Cornell box is lit");
 }

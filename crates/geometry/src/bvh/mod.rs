@@ -7,101 +7,9 @@
 //! one SoA pack of eight lanes (`prim::TriPack`), and its spheres and cylinders one by one.
 //! obvhs types never leave this module.
 //!
-//! This replaced traversal of obvhs' `CwBvh`, whose compressed 8-wide nodes (a GPU layout) are
-//! decoded per node on the CPU (bunny diffuse-bounce closest hits ×1.7, occluded ×1.9, primary
-//! ×1.5; `Scene::new` of the 1M-triangle MetalRoughSpheres ×1.7 faster).
-//!
-//! Where the time of an incoherent ray goes (callgrind, bunny diffuse-bounce closest hits, which
-//! mostly leave the surface and miss: 7.8 node visits and 4 leaf tests per ray): building the
-//! `Hit` afterwards costs about 1 % of the instructions, ray setup about 5 %, the node tests and
-//! the stack about two thirds and the leaf tests a quarter. Replaying each ray four times (hot
-//! caches, trained branches) was only ~15 % faster, and shuffling the rays ~30 % slower, so the
-//! pixel-ordered benchmark is mostly bound by instructions and branches, not by memory. A
-//! stronger obvhs build does not help much: even `reinsertion_batch_ratio` 1 (a build ~20× as
-//! slow) cut the instructions by only 5 %. What did help: one AVX test of the eight child boxes
-//! instead of two SSE tests of four (and no zeroing of the traversal stack per ray), 957 instead
-//! of 1200 instructions per ray; then leaves of up to eight triangles in one 8-lane pack, with
-//! the collapse cost raised from 3 to 6 so that obvhs fills them, 943 instructions per ray
-//! (occluded 1037 → 763, primary closest hits 829 → 655). Measured with `benches/bvh.rs`, old
-//! and new binaries alternating, rays per CPU-second of one thread on a shared, loaded 2-core
-//! machine (±15 % run to run): bunny diffuse-bounce closest hits ×1.1–1.3 (3.0–3.3 → 3.3–4.2
-//! M/s), occluded ×1.15 (3.9 → 4.5 M/s), primary ×1.2 (6.0 → 7.2 M/s); MetalRoughSpheres
-//! diffuse-bounce closest hits ×1.3 (1.17 → 1.5 M/s), `Scene::new` unchanged (0.93–0.98 s);
-//! with `examples/prof.rs`, which runs one query kind alone, bunny diffuse-bounce closest hits
-//! ×1.25 and occluded ×1.4.
-//!
-//! The round after that (callgrind instructions per ray, bunny; bounce closest / bounce occluded /
-//! primary closest, before: 943 / 763 / 655): the leaf pack stores ng = e1 × e2 (384 instead of
-//! 288 bytes per leaf), drops the finiteness test of 1/det (redundant, see `TriPack::intersect`)
-//! and skips the nearest-lane search when no lane is hit, 852 / – / –; the hit children of a
-//! node are pushed with one compressing AVX store into a two-array stack whose length stays in a
-//! register, 796 / 658 / –; the node test takes per-ray byte offsets of its entry and exit rows
-//! and subtracts the bounds from the origin (so the loads fold into the subtraction),
-//! 729 / 577 / 541; one SIMD finiteness test of the ray instead of six scalar ones and no
-//! bounds check of node indices, 680 / 540 / 504; the ray's octant from one SIMD comparison,
-//! 656 / 528 / 485. Checksums of every answer (`examples/prof.rs`) are unchanged. Time fell
-//! less than the instructions (old and new `examples/prof.rs` alternating, rays per CPU-second,
-//! loaded 2-core machine): bunny diffuse-bounce closest hits ×1.08–1.29 (median ×1.15; 3.3–3.9
-//! → 4.2–4.4 M/s), occluded ×1.06–1.18, primary ×0.94–1.21; `benches/bvh.rs` agreed within its
-//! noise, and `Scene::new` of MetalRoughSpheres stayed at 0.6–0.8 s. callgrind's branch
-//! simulator counts 5.4 mispredicted branches per bounce ray, mostly on "one child hit or more"
-//! (1.7), "leaf or node" (1.4) and "any child hit" (1.1); pushing every hit child with the
-//! nearest on top and popping it, without those two branches, saved 1.9 of them but cost 48 %
-//! more instructions as compiled, and was ×0.7 as fast.
-//!
-//! The round after that (same figures, before: 656 / 528 / 485) started from the clock: at about
-//! 2.9 GHz, 4.3 M bounce rays/s is ~680 cycles per ray for 656 instructions, so the traversal waits
-//! mostly on the chain from a node's loads to its mask of hit children, its nearest child and that
-//! child's reference, the next node's address (~40 cycles per node, ~55 with two hits or more), and
-//! on mispredicted branches. Shortening that chain, with the same bits: the nearest hit child from
-//! an unsigned-integer minimum of the entry distances' bits (one cycle per step instead of four;
-//! lanes not hit are all-ones bits rather than a blend of ∞), the slab minima and maxima as trees
-//! of two levels rather than chains of three, and the exit widening folded into the inverse
-//! direction (one multiplication less), 636 / 532 / 479, ×1.1–1.2 (4.6 → 5.2 M/s); the child
-//! references moved into the first cache line of the node, fetched with the bounds instead of after
-//! the mask, and the hit mask from a comparison of its own rather than the complement of another's,
-//! 634 / 532 / 478, ×1.08 (medians 4.86 → 5.27 M/s); the hit mask from an integer comparison of the
-//! distances' bits (exact here, see `wide::Node::intersect`; one cycle instead of four), and node
-//! references scaled so that a node's row is one addressing mode away (no shift and addition before
-//! its loads), 637 / 524 / 479, ×1.04 (5.37 → 5.56 M/s); 0 ≤ u, v, w in the leaf test as one
-//! comparison of min(min(u, v), w), 633 / 519 / 477; the collapse into wide nodes by dynamic
-//! programming (least total surface area of the wide nodes, `wide::Plan`) instead of greedily
-//! opening the largest child, which leaves fewer nearly empty nodes near the leaves (the greedy
-//! collapse gave the bunny 3886 nodes for 11805 leaves, four children per node on average; the plan
-//! gives 2406, 5.9 children per node; MetalRoughSpheres: 37098 nodes for 183165 leaves), 621 / 513
-//! / 477, its time within the noise (medians of 6 and 10 runs 5.03 → 4.74 and 5.53 → 5.53 M/s, best
-//! 5.62 → 5.72 and 5.84 → 5.75). Checksums of every answer (bunny and MetalRoughSpheres, primary
-//! and bounce, closest and occluded) are unchanged.
-//!
-//! All of it (old and new `examples/prof.rs` alternating, rays per CPU-second, best of 10 queries
-//! per run, loaded 2-core machine): bunny diffuse-bounce closest hits ×1.18–1.27 (medians of 8 and
-//! 10 runs: 4.33 → 5.12 and 3.79 → 4.80 M/s; best runs 4.71 → 5.88), occluded ×1.08 (5.33 → 5.76,
-//! best 5.85 → 6.49), primary closest hits ×1.16 (7.58 → 8.83, best 8.06 → 9.44). `benches/bvh.rs`
-//! (two alternations, 1 thread, per CPU-second) agreed: bunny bounce closest hits 3.50, 3.92 →
-//! 4.77, 5.52 M/s, occluded 4.48, 4.61 → 5.33, 5.68, primary 7.53, 8.05 → 9.25, 9.64;
-//! MetalRoughSpheres bounce closest hits 1.24, 1.28 → 1.67, 1.92. The plan costs `Scene::new` of
-//! MetalRoughSpheres ~0.06 s (thread CPU time of the collapse and the packing 0.13–0.16 → 0.19–0.23
-//! s, of all of `Accel::build` 0.74–0.90 → 0.83–0.98 s; wall-clock `Scene::new` said 2–5 s for both
-//! on the loaded machine); walking the binary nodes in memory order instead of a preorder saved
-//! nothing measurable.
-//!
-//! What did not pay: the six row addresses precomputed per ray (so that a node's loads need no
-//! address arithmetic at all), 15 more instructions per ray (registers spilled) and no faster (5.76
-//! vs 5.74 M/s); unchecked indexing of the child references and leaf packs, as fast (5.27 vs 5.27
-//! M/s); taking the multi-hit path for a single hit too (no branch on the number of hits), 621 →
-//! 681 instructions and ×0.91 (5.59 → 5.11 M/s); leaves of up to four primitives from obvhs merged
-//! into packs of up to eight by the plan (leaf cost 0.8–3 times a node's), 621 → 618 instructions,
-//! not worth the code.
-//!
-//! December 2026, photon tracing (callgrind, `passes` bench of `ppm`, CornellBox-Sphere, where
-//! every ray hits): the barycentrics of a triangle hit are the leaf test's own u and v of the hit
-//! lane (the leaf keeps its u, v rows when it lowers the bound) instead of a scalar recomputation
-//! for the one triangle, which cost ~50 instructions per hit and could differ by rounding from the
-//! numbers the inside test accepted (glam's `cross` uses FMA where the CPU has it; the reported
-//! barycentrics now always pass 0 ≤ b1, b2, 1 − b1 − b2). Photon paths 4108 → 3978 instructions;
-//! bunny primary closest hits 1023 → 980 per ray, diffuse-bounce closest hits (91 % misses) 606 →
-//! 612. Hits move by rounding, so images are no longer bit for bit those of before; the other
-//! changes of that round were exact.
+//! Why a layout of our own: obvhs' `CwBvh` is a GPU layout whose compressed nodes are decoded
+//! per node on the CPU; this one is tested as it is stored. docs/performance.md ("BVH
+//! traversal") has the measurements behind each choice, and what did not pay.
 //!
 //! Exactness: the box test is conservative (exit distances are widened by 1 + 2γ₃, and every
 //! primitive's box is padded by a few ulps so that no primitive touches a box face), so the BVH
@@ -236,16 +144,8 @@ impl Leaves for Query<'_> {
 /// up to [`LANES`] primitives, one [`TriPack`] each, and a leaf-collapse traversal cost of 6
 /// instead of 3.
 ///
-/// Measured with `benches/bvh.rs` (1 thread, CPU time), with the 4-lane leaves of before: on
-/// the 1M-triangle MetalRoughSpheres, `fast` builds in about 0.7 s with 1.4 M diffuse-bounce
-/// rays/s; `very_fast_build` saves ~0.1 s but traces 10 % slower, `fastest_build` (no
-/// reinsertion) saved nothing overall and traces 20–30 % slower, and `medium_build` costs ~0.1 s
-/// more for no measurable speed-up; leaves of at most 2 or 1 primitives were 10 % and 45 %
-/// slower on the bunny. With 8-lane packs (callgrind, bunny diffuse-bounce closest hits): a
-/// collapse cost of 6 gives 1.4 % fewer instructions than 3 (any value from 6 to 30 gives the same
-/// tree), 1 gives 8 % more; PLOC search distance, search depth and reinsertion ratio as in
-/// `medium_build` save 0 %, as in `slow_build` (without pre-splitting) 1 %, `very_slow_build`'s
-/// reinsertion 5 % at ~20× the build time.
+/// Faster builds trace slower and slower ones do not trace faster on our scenes; the
+/// measurements are in docs/performance.md ("BVH traversal").
 fn build_params() -> BvhBuildParams {
     BvhBuildParams {
         max_prims_per_leaf: LANES as u32,
@@ -425,18 +325,15 @@ impl Accel {
     /// The closest hit with 0 ≤ t < `ray.t_max` (t > 0 for spheres).
     ///
     /// Never inlined, so that the traversal is compiled once, alone, and its speed does not depend
-    /// on the caller: inlined into the benchmark's rayon closure (beside `occluded`), it seemed
-    /// slower than through a call from `examples/prof.rs` (within the noise of the shared
-    /// machine); a call costs a few instructions of the ~900 of an incoherent ray. The photon
-    /// loop, whose rays are short (2.2 nodes and 1.3 leaves in the Cornell box), takes the
-    /// inlined form instead ([`Accel::intersect_inlined`]).
+    /// on the caller; a call costs little next to an incoherent ray. The photon loop, whose rays
+    /// are short, takes the inlined form instead ([`Accel::intersect_inlined`]).
     #[inline(never)]
     pub(crate) fn intersect(&self, ray: &Ray) -> Option<RawHit> {
         self.intersect_inlined(ray)
     }
 
     /// [`Accel::intersect`] compiled into its caller: for the photon loop, where the call and
-    /// the caller's vector registers saved around it cost about 40 instructions per ray.
+    /// the caller's vector registers saved around it are a noticeable share of a short ray.
     #[inline(always)]
     pub(crate) fn intersect_inlined(&self, ray: &Ray) -> Option<RawHit> {
         let bvh = self.bvh.as_ref()?;

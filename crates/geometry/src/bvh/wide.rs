@@ -7,15 +7,9 @@
 //! leaf's number directly, and the leaf's triangles sit in one SIMD pack (`prim::TriPack`) of the
 //! same number.
 //!
-//! Measured against a 4-wide layout of the same kind (bunny, diffuse-bounce rays, CPU time):
-//! 8-wide was ~12 % faster for closest hits and ~20 % for any hit. One 8-lane test per node
-//! written lane by lane (which the compiler vectorised) was not faster than two 4-lane ones; with
-//! AVX intrinsics (`simd.rs`) it is: 20 % fewer instructions per incoherent ray. Sorting the
-//! pushed children, branchless pushes and prefetching gained nothing (earlier measurements).
-//! Pushing all the children a node test leaves behind with one compressing store
-//! (`simd::compress`: a table lookup and two lane permutations) instead of one by one cut the
-//! instructions of an incoherent closest-hit ray by 7 %, per-ray byte offsets of the rows a node
-//! test reads by another 8 %.
+//! Eight lanes rather than four, AVX intrinsics rather than lane-by-lane code, and compressing
+//! stores for the pushed children each paid on incoherent rays (docs/performance.md, "BVH
+//! traversal").
 
 use std::mem::MaybeUninit;
 

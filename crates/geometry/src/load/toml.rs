@@ -142,16 +142,12 @@ enum LightToml {
     },
 }
 
+/// The `[render]` table: `passes`, and render parameters that `ppm` reads.
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RenderToml {
-    method: Option<String>,
     passes: Option<u32>,
-    photons_per_pass: Option<u64>,
-    alpha: Option<f64>,
-    initial_radius: Option<f64>,
-    max_depth: Option<u32>,
-    seed: Option<u64>,
+    #[serde(flatten)]
+    params: std::collections::BTreeMap<String, ::toml::Value>,
 }
 
 /// Parses and converts a TOML scene.
@@ -623,23 +619,28 @@ impl Converter<'_> {
     }
 
     fn render(&self, r: RenderToml) -> Result<RenderDefaults, LoadError> {
-        for (k, v) in [("alpha", r.alpha), ("initial_radius", r.initial_radius)] {
-            if let Some(v) = v
-                && !v.is_finite()
-            {
-                return Err(
-                    self.invalid(format!("[render] {k}"), format!("must be finite, got {v}"))
-                );
-            }
+        let mut params = Vec::with_capacity(r.params.len());
+        for (key, value) in r.params {
+            let text = match value {
+                ::toml::Value::String(s) => s,
+                ::toml::Value::Integer(n) => n.to_string(),
+                ::toml::Value::Float(x) => x.to_string(),
+                ::toml::Value::Boolean(b) => b.to_string(),
+                other => {
+                    return Err(self.invalid(
+                        format!("[render] {key}"),
+                        format!(
+                            "must be a string, a number or a boolean, got a {}",
+                            other.type_str()
+                        ),
+                    ));
+                }
+            };
+            params.push((key, text));
         }
         Ok(RenderDefaults {
-            method: r.method,
             passes: r.passes,
-            photons_per_pass: r.photons_per_pass,
-            alpha: r.alpha,
-            initial_radius: r.initial_radius,
-            max_depth: r.max_depth,
-            seed: r.seed,
+            params,
         })
     }
 }

@@ -256,9 +256,8 @@ impl Scene {
     /// The closest hit with 0 < t < `ray.t_max`, or `None`.
     ///
     /// Always inlined, with the triangle hit, so that callers get the `Hit` in registers
-    /// rather than through two copies in memory (4.5 % fewer instructions per photon path with
-    /// the other changes of that round; see `ppm`'s `trace_photon`); the traversal itself stays
-    /// a call ([`Scene::intersect_inlined`] compiles it in too).
+    /// rather than through two copies in memory; the traversal itself stays a call
+    /// ([`Scene::intersect_inlined`] compiles it in too).
     #[inline(always)]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let raw = self.accel.intersect(ray)?;
@@ -266,9 +265,11 @@ impl Scene {
     }
 
     /// [`Scene::intersect`], with the BVH traversal compiled into the caller instead of called:
-    /// the same answer, for a hot loop that does little else (the photon tracer: about 140
-    /// fewer instructions per photon path, the call and the vector registers saved around it).
-    /// Every caller gets its own copy of the traversal, so use it sparingly.
+    /// the same answer, for the photon tracer's loop, which does little else, so that the call
+    /// and the vector registers saved around it do not weigh on its short rays. A code
+    /// generation choice of that one loop rather than a query of its own, hence hidden from
+    /// the documentation; every caller gets its own copy of the traversal.
+    #[doc(hidden)]
     #[inline(always)]
     pub fn intersect_inlined(&self, ray: &Ray) -> Option<Hit> {
         let raw = self.accel.intersect_inlined(ray)?;
@@ -282,16 +283,6 @@ impl Scene {
             RawHit::Sphere { index, t } => self.sphere_hit(ray, index, t),
             RawHit::Cylinder { index, t } => self.cylinder_hit(ray, index, t),
         }
-    }
-
-    /// The distance `t` of the closest hit with 0 < t < `ray.t_max`: exactly
-    /// `self.intersect(ray).map(|hit| hit.t)`, without building the [`Hit`] (its position, error
-    /// bound and normals cost about 200 instructions for a triangle).
-    #[inline]
-    pub fn hit_distance(&self, ray: &Ray) -> Option<f32> {
-        Some(match self.accel.intersect(ray)? {
-            RawHit::Triangle { t, .. } | RawHit::Sphere { t, .. } | RawHit::Cylinder { t, .. } => t,
-        })
     }
 
     /// Whether anything is hit with 0 < t < `ray.t_max` (a shadow-ray query, faster than [`Scene::intersect`]).

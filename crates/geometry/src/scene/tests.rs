@@ -141,10 +141,10 @@ fn intersect_matches_brute_force() {
                 assert!(grazing, "{ray:?}: got {got:?}, want {want:?}");
             }
         }
-        // occluded agrees with intersect, and hit_distance is its t (bit for bit).
+        // occluded agrees with intersect, and the inlined traversal gives the same hit.
         assert_eq!(scene.occluded(&ray), got.is_some(), "{ray:?}");
         assert_eq!(
-            scene.hit_distance(&ray).map(f32::to_bits),
+            scene.intersect_inlined(&ray).map(|h| h.t.to_bits()),
             got.map(|h| h.t.to_bits()),
             "{ray:?}"
         );

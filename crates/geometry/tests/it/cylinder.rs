@@ -80,8 +80,8 @@ material = "silver"
     assert_eq!(silver.cylinders, 1);
     assert!(summary.to_string().contains("1 cylinders"), "{summary}");
     let b = summary.bounds.unwrap();
-    assert_close(b.min.0, Vec3::new(0.5, 1.5, 3.0));
-    assert_close(b.max.0, Vec3::new(1.5, 2.5, 3.35));
+    assert_close(b.min, Vec3::new(0.5, 1.5, 3.0));
+    assert_close(b.max, Vec3::new(1.5, 2.5, 3.35));
 }
 
 #[test]

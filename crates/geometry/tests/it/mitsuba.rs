@@ -118,7 +118,7 @@ fn cornell_boxes_render_settings_follow_mitsuba() {
     assert_eq!((scene.film.width, scene.film.height), (256, 256));
     assert!((scene.camera.fov_y.to_degrees() - 39.3077).abs() < 1e-3);
     // Mitsuba's max_depth 6 counts path segments: 5 scattering events in fppm's convention.
-    assert_eq!(scene.render.max_depth, Some(5));
+    assert_eq!(scene.render.get("max_depth"), Some("5"));
     // The emitter declared after the includes reaches the light through <ref>.
     let light = scene
         .materials
@@ -388,7 +388,7 @@ fn version_0_6_names_are_upgraded() {
         );
     let path = fixture("mitsuba_v06", &[("scene.xml", &old)]);
     let scene = load(&path).unwrap();
-    assert_eq!(scene.render.max_depth, Some(3));
+    assert_eq!(scene.render.get("max_depth"), Some("3"));
     assert_eq!(scene.camera.position, glam::Vec3::new(0.0, 0.0, 4.0));
 }
 

@@ -106,7 +106,7 @@ fn every_shared_pbrt_scene_loads_with_independent_counts() {
 fn veach_mis_conventions() {
     let scene = load(&pbrt("veach-mis/veach-mis.pbrt")).unwrap();
     // maxdepth 5 counts scattering events in both renderers.
-    assert_eq!(scene.render.max_depth, Some(5));
+    assert_eq!(scene.render.get("max_depth"), Some("5"));
     // pbrt's fov spans the shorter side (the height of a 1152 x 864 film).
     assert!((scene.camera.fov_y.to_degrees() - 28.000_026).abs() < 1e-3);
     // `Scale -1 1 1` before and after LookAt cancel in position: the eye is at (0, 2, 15).

@@ -268,12 +268,23 @@ fn every_key_of_the_format() {
 
     // Render defaults.
     let r = &scene.render;
-    assert_eq!(r.method.as_deref(), Some("ppm"));
+    assert_eq!(r.passes, Some(64));
+    let params: Vec<(&str, &str)> = r
+        .params
+        .iter()
+        .map(|(k, v)| (k.as_str(), v.as_str()))
+        .collect();
     assert_eq!(
-        (r.passes, r.photons_per_pass, r.max_depth, r.seed),
-        (Some(64), Some(100_000), Some(12), Some(7))
+        params,
+        [
+            ("alpha", "0.7"),
+            ("initial_radius", "0.05"),
+            ("max_depth", "12"),
+            ("method", "ppm"),
+            ("photons_per_pass", "100000"),
+            ("seed", "7"),
+        ]
     );
-    assert_eq!((r.alpha, r.initial_radius), (Some(0.7), Some(0.05)));
 }
 
 #[test]
@@ -379,7 +390,7 @@ material = "lamp"
     assert_eq!(red.triangles, 12);
     // The Box is a unit cube around the origin; moved to z = −3.
     let bounds = summary.bounds.unwrap();
-    assert!((bounds.min.0.z - -3.5).abs() < 1e-5 && (bounds.max.0.y - 2.0).abs() < 1e-5);
+    assert!((bounds.min.z - -3.5).abs() < 1e-5 && (bounds.max.y - 2.0).abs() < 1e-5);
     // The lamp quad's front is edge1 × edge2 = (0, 0, 2) × (2, 0, 0) = (0, 4, 0): up.
     let quad = scene.triangles.iter().find(|t| t.material == 0).unwrap();
     let [a, b, c] = quad.positions;

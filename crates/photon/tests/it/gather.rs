@@ -2,8 +2,7 @@
 
 use glam::Vec3;
 use photon::{
-    AcceptParams, GatherScratch, GridParams, HitPointGrid, Photon, accepts, accumulate_again,
-    gather, gather_with,
+    AcceptParams, GatherScratch, GridParams, HitPointGrid, Photon, accepts, gather, gather_with,
 };
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
@@ -198,7 +197,7 @@ fn accumulating_again_equals_a_second_gather() {
         let (flux, again) = pool.install(|| {
             let mut scratch = GatherScratch::default();
             let mut flux = Vec::new();
-            gather_with(
+            let gathered = gather_with(
                 &mut scratch,
                 &grid,
                 &s.photons,
@@ -208,7 +207,7 @@ fn accumulating_again_equals_a_second_gather() {
                 |acc: &mut Acc, (v, _)| add(acc, v),
             );
             let mut again = Vec::new();
-            accumulate_again(&scratch, &mut again, fold_odd);
+            gathered.accumulate_again(&mut again, fold_odd);
             (flux, again)
         });
         let plain = gather(&grid, &s.photons, s.positions.len(), contribution(&s), add);

@@ -8,13 +8,13 @@
 //! record a frequency photon), `photon_pass` (tags and deposits), `update` (probes and the
 //! frequency radius of each slot), and the AOVs.
 
-use geometry::{Bsdf, EmitterShape, Hit, Lobe as MaterialLobe, Ray};
+use geometry::{Bsdf, EmitterShape, Hit, Lobe as MaterialLobe, Ray, Rgb};
 use glam::Vec3;
-use photon::HitPoints;
+use photon::{Gathered, HitPoints};
 use rayon::prelude::*;
 use spectrum::{Caps, FrequencyEstimate, Lobe, Spectrum};
 
-use super::photon_pass::{NOT_IN_GRID, PhotonPass};
+use super::photon_pass::NOT_IN_GRID;
 use super::trace::TracedPhotons;
 use super::{PHOTON_CHUNK, PhotonMapper, SLOT_CHUNK, Setup};
 use crate::rng::Sampler;
@@ -388,13 +388,14 @@ impl FrequencyDeposits {
     pub(super) fn deposit(
         &mut self,
         setup: &Setup<'_>,
-        layout: TagLayout,
-        photons: &PhotonPass,
+        traced: &[TracedPhotons],
+        tagged_gather: &Gathered<'_, (Rgb, u32)>,
         grid_slots: &[u32],
+        slot_entry: &[u32],
         slots: &mut HitPoints<SlotFrequency>,
     ) {
         let policy = setup.params.freq_merge;
-        let (traced, slot_entry) = (&photons.traced, &photons.slot_entry);
+        let layout = self.layout(traced.len(), setup.params.max_depth);
         let concatenated = &self.records;
         let record = |tag: u32| match layout {
             TagLayout::Packed { local_bits } => {
@@ -405,8 +406,7 @@ impl FrequencyDeposits {
         };
         let material_idx = slots.material_idx();
         let slot_freq = slots.freq();
-        photon::accumulate_again(
-            &photons.tagged_gather,
+        tagged_gather.accumulate_again(
             &mut self.per_entry,
             |acc: &mut FrequencyEstimate, entry, (_, tag)| {
                 if tag == UNTAGGED {
@@ -572,9 +572,9 @@ impl Setup<'_> {
                 lo = mid;
             }
         }
-        // `occluded` and `hit_distance` agree on whether a ray is blocked (tested in geometry);
+        // `occluded` and `intersect` agree on whether a ray is blocked (tested in geometry);
         // `None` cannot happen, and would mean no occlusion.
-        let t_blocker = self.scene.hit_distance(&probe(hi))?;
+        let t_blocker = self.scene.intersect(&probe(hi)).map(|hit| hit.t)?;
         let t_b = f64::from(t_blocker).clamp(0.0, distance);
         // The offset lies in the receiver's tangent plane; the gap that matters is across the
         // photon's ray, shorter at grazing incidence by the sine between `side` and the ray.

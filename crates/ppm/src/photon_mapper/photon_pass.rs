@@ -30,11 +30,11 @@ pub(super) struct PhotonPass {
     sorted: Vec<Photon>,
     gather: GatherScratch<Rgb>,
     /// The flux gather of the frequency-guided methods: each pair with its photon's tag.
-    pub(super) tagged_gather: GatherScratch<(Rgb, u32)>,
+    tagged_gather: GatherScratch<(Rgb, u32)>,
     /// Per grid entry: M and Φ of the pass.
     per_entry: Vec<(u32, [f64; 3])>,
     /// Per slot: its grid entry, or [`NOT_IN_GRID`].
-    pub(super) slot_entry: Vec<u32>,
+    slot_entry: Vec<u32>,
 }
 
 impl PhotonPass {
@@ -165,9 +165,9 @@ impl PhotonMapper<'_> {
             acc.1[1] += f64::from(flux.y);
             acc.1[2] += f64::from(flux.z);
         };
-        if uses_frequency {
+        let tagged = if uses_frequency {
             // The flux pairs carry the photon's tag, for the frequency deposits below.
-            photon::gather_with(
+            Some(photon::gather_with(
                 &mut buffers.tagged_gather,
                 grid,
                 &buffers.sorted,
@@ -175,7 +175,7 @@ impl PhotonMapper<'_> {
                 grid_slots.len(),
                 |photon, entry| flux(photon, entry).map(|f| (f, photon.tag)),
                 |acc, (f, _)| add(acc, f),
-            );
+            ))
         } else {
             photon::gather_with(
                 &mut buffers.gather,
@@ -186,18 +186,25 @@ impl PhotonMapper<'_> {
                 flux,
                 add,
             );
-        }
+            None
+        };
         stats.photons_stored = buffers.sorted.len() as u64;
         for &(m, _) in &buffers.per_entry {
             stats.photons_deposited += u64::from(m);
             stats.hitpoints_hit += u64::from(m > 0);
         }
-        if !uses_frequency {
+        let Some(tagged) = tagged else {
             return;
-        }
+        };
         let frequency_clock = Instant::now();
-        self.frequency
-            .deposit(setup, layout, buffers, grid_slots, &mut self.slots);
+        self.frequency.deposit(
+            setup,
+            &buffers.traced,
+            &tagged,
+            grid_slots,
+            &buffers.slot_entry,
+            &mut self.slots,
+        );
         stats.timings.frequency += frequency_clock.elapsed().as_secs_f64();
     }
 }

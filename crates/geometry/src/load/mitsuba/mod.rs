@@ -1129,7 +1129,7 @@ impl<'a> Importer<'a> {
             match depth {
                 -1 => {}
                 d if d >= 2 => {
-                    render.max_depth = Some(u32::try_from(d - 1).unwrap_or(u32::MAX).min(1024));
+                    render.set("max_depth", u32::try_from(d - 1).unwrap_or(u32::MAX).min(1024));
                 }
                 d => self.builder.warn(format!(
                     "{label}: max_depth {d} (emitters seen directly only) cannot be rendered; fppm's default depth is used"

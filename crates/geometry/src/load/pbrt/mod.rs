@@ -631,7 +631,7 @@ impl Parser {
                                 format!("Integrator: maxdepth must be ≥ 1, got {depth}"),
                             )
                         })?;
-                    self.render.max_depth = Some(depth.min(1024));
+                    self.render.set("max_depth", depth.min(1024));
                 }
                 if !matches!(
                     kind.as_str(),

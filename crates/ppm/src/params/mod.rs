@@ -1,10 +1,15 @@
-//! Render parameters: plain typed values, validated once.
+//! Render parameters: plain typed values, validated once; `names.rs` says how each is named,
+//! read and shown.
+
+mod names;
 
 use std::fmt;
 
 use spectrum::{K_STRICT, MergePolicy};
 
 use crate::update::FrequencyFloor;
+
+pub use self::names::{PARAMS, Param, ParamKind, param};
 
 /// The integrators.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -147,12 +152,28 @@ pub enum ParamError {
     /// A parameter is outside its allowed range.
     #[error("{name} = {value} is outside {range}")]
     OutOfRange {
-        /// Parameter name as on the command line.
+        /// Parameter name (see [`PARAMS`]).
         name: &'static str,
         /// The value given.
         value: String,
         /// The allowed range, as text.
         range: &'static str,
+    },
+    /// No render parameter has this name.
+    #[error("{name} is not a render parameter")]
+    Unknown {
+        /// The name given.
+        name: String,
+    },
+    /// The text is not a value of the parameter.
+    #[error("{name} {value} {problem}")]
+    Unreadable {
+        /// Parameter name (see [`PARAMS`]).
+        name: &'static str,
+        /// The text given.
+        value: String,
+        /// What is wrong with it, e.g. `is not a number`.
+        problem: String,
     },
     /// The film has no pixels or more than the renderer can index.
     #[error(
@@ -225,7 +246,7 @@ impl RenderParams {
             }
         }
         if self.photons_per_pass == 0 {
-            return Err(out("photons-per-pass", self.photons_per_pass, "[1, 2^32)"));
+            return Err(out("photons_per_pass", self.photons_per_pass, "[1, 2^32)"));
         }
         if !(self.alpha > 0.0 && self.alpha <= 1.0) {
             return Err(out("alpha", self.alpha, "(0, 1]"));
@@ -233,28 +254,28 @@ impl RenderParams {
         if let Some(r) = self.initial_radius
             && !(r > 0.0 && r.is_finite())
         {
-            return Err(out("initial-radius", r, "(0, inf)"));
+            return Err(out("initial_radius", r, "(0, inf)"));
         }
         if self.max_depth == 0 || self.max_depth > 1024 {
-            return Err(out("max-depth", self.max_depth, "[1, 1024]"));
+            return Err(out("max_depth", self.max_depth, "[1, 1024]"));
         }
         if self.samples_per_pixel == 0 || self.samples_per_pixel > 1024 {
             return Err(out("spp", self.samples_per_pixel, "[1, 1024]"));
         }
         if !(0.0..=1.0).contains(&self.freq_fraction) {
-            return Err(out("freq-fraction", self.freq_fraction, "[0, 1]"));
+            return Err(out("freq_fraction", self.freq_fraction, "[0, 1]"));
         }
         if !(self.kernel_k > 0.0 && self.kernel_k.is_finite()) {
-            return Err(out("kernel-k", self.kernel_k, "(0, inf)"));
+            return Err(out("kernel_k", self.kernel_k, "(0, inf)"));
         }
         if !(1.0..=64.0).contains(&self.freq_grow) {
-            return Err(out("freq-grow", self.freq_grow, "[1, 64]"));
+            return Err(out("freq_grow", self.freq_grow, "[1, 64]"));
         }
         if !(self.freq_hold_alpha > 0.0 && self.freq_hold_alpha <= 1.0) {
-            return Err(out("freq-hold-alpha", self.freq_hold_alpha, "(0, 1]"));
+            return Err(out("freq_hold_alpha", self.freq_hold_alpha, "(0, 1]"));
         }
         if self.freq_pilot > 1_000_000 {
-            return Err(out("freq-pilot", self.freq_pilot, "[0, 1000000]"));
+            return Err(out("freq_pilot", self.freq_pilot, "[0, 1000000]"));
         }
         Ok(())
     }

@@ -1,0 +1,536 @@
+//! The one definition of the render parameters' names: how each is written on the command line
+//! (`--photons-per-pass 200k`), in a scene's `[render]` table (`photons_per_pass = 200000`) and
+//! in an image's metadata, how its text is read and shown, and its help line.
+//!
+//! Reading a value only converts it; ranges are checked by [`RenderParams::validate`], once the
+//! values of every source (preset, scene, flags) are merged.
+
+use spectrum::{K_POSTER, K_STRICT, MergePolicy};
+
+use super::{Method, ParamError, RenderParams};
+use crate::update::FrequencyFloor;
+
+/// One render parameter.
+pub struct Param {
+    /// The name: `snake_case` in scene tables and metadata.
+    pub name: &'static str,
+    /// The command-line flag without `--`: the name with `-` for `_`, or for a switch what it
+    /// does (`no-freq-geometry`).
+    pub flag: &'static str,
+    /// One line of help, with the default.
+    pub help: &'static str,
+    /// How the command line gives it.
+    pub kind: ParamKind,
+    get: fn(&RenderParams) -> String,
+    set: fn(&mut RenderParams, &str) -> Result<(), String>,
+}
+
+/// How a parameter is given on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParamKind {
+    /// A flag with a value, e.g. `--alpha 0.5`; `choices` lists the accepted words with their
+    /// meaning (empty for numbers).
+    Value {
+        /// The placeholder in the help, e.g. `N`.
+        value_name: &'static str,
+        /// Accepted words and what they mean (empty: any text the parser reads).
+        choices: &'static [(&'static str, &'static str)],
+    },
+    /// A switch whose presence sets the parameter to `sets`, e.g. `--no-freq-geometry`.
+    Switch {
+        /// The value it sets.
+        sets: bool,
+    },
+}
+
+impl Param {
+    /// The parameter's value in `params`, as text that [`RenderParams::set`] reads back.
+    #[must_use]
+    pub fn get(&self, params: &RenderParams) -> String {
+        (self.get)(params)
+    }
+}
+
+/// Every render parameter, in the order help and metadata list them.
+pub const PARAMS: &[Param] = &[
+    Param {
+        name: "method",
+        flag: "method",
+        help: "Integrator [default: scene's [render] method, else freq-sppm]",
+        kind: ParamKind::Value {
+            value_name: "METHOD",
+            choices: &[
+                (
+                    "ppm",
+                    "Progressive photon mapping (Hachisuka, Ogaki & Jensen 2008)",
+                ),
+                (
+                    "sppm",
+                    "Stochastic progressive photon mapping (Hachisuka & Jensen 2009)",
+                ),
+                (
+                    "freq",
+                    "PPM with frequency-guided kernels (Belcour & Soler 2011)",
+                ),
+                ("freq-sppm", "SPPM with frequency-guided kernels"),
+                (
+                    "path",
+                    "Path tracing with next-event estimation: the reference",
+                ),
+            ],
+        },
+        get: |p| p.method.name().to_owned(),
+        set: |p, v| {
+            p.method = Method::from_name(v).ok_or_else(|| {
+                let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+                format!("is not one of {}", names.join(", "))
+            })?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "photons_per_pass",
+        flag: "photons-per-pass",
+        help: "Photons traced per pass, e.g. 200000, 200_000, 200k or 2M [default: scene, else 100k]",
+        kind: ParamKind::Value {
+            value_name: "N",
+            choices: &[],
+        },
+        get: |p| p.photons_per_pass.to_string(),
+        set: |p, v| {
+            let n = parse_count(v)?;
+            if n <= 0 {
+                return Err("must be positive".to_owned());
+            }
+            p.photons_per_pass =
+                u32::try_from(n).map_err(|_| format!("is too large (at most {})", u32::MAX))?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "alpha",
+        flag: "alpha",
+        help: "Radius reduction α in (0, 1] [default: scene, else 0.7]",
+        kind: ParamKind::Value {
+            value_name: "ALPHA",
+            choices: &[],
+        },
+        get: |p| p.alpha.to_string(),
+        set: |p, v| {
+            p.alpha = parse_number(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "initial_radius",
+        flag: "initial-radius",
+        help: "Initial gather radius in scene units, or auto [default: scene, else auto: picked from the scene size]",
+        kind: ParamKind::Value {
+            value_name: "RADIUS",
+            choices: &[],
+        },
+        get: |p| {
+            p.initial_radius
+                .map_or_else(|| "auto".to_owned(), |r| r.to_string())
+        },
+        set: |p, v| {
+            p.initial_radius = if v == "auto" {
+                None
+            } else {
+                Some(parse_number(v)?)
+            };
+            Ok(())
+        },
+    },
+    Param {
+        name: "freq_fraction",
+        flag: "freq-fraction",
+        help: "Share of photons that carry a light-field spectrum, in [0, 1] (frequency methods) [default: 0.1]",
+        kind: ParamKind::Value {
+            value_name: "SHARE",
+            choices: &[],
+        },
+        get: |p| p.freq_fraction.to_string(),
+        set: |p, v| {
+            p.freq_fraction = parse_number(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "freq_merge",
+        flag: "freq-merge",
+        help: "How a hitpoint merges frequency estimates [default: min]",
+        kind: ParamKind::Value {
+            value_name: "POLICY",
+            choices: &[
+                (
+                    "min",
+                    "Keep the smallest radius (the most conservative estimate)",
+                ),
+                (
+                    "poster-max",
+                    "Merge as on the poster (the largest frequency content)",
+                ),
+            ],
+        },
+        get: |p| {
+            match p.freq_merge {
+                MergePolicy::MinRadius => "min",
+                MergePolicy::PosterMax => "poster-max",
+            }
+            .to_owned()
+        },
+        set: |p, v| {
+            p.freq_merge = match v {
+                "min" => MergePolicy::MinRadius,
+                "poster-max" => MergePolicy::PosterMax,
+                _ => return Err("is not one of min, poster-max".to_owned()),
+            };
+            Ok(())
+        },
+    },
+    Param {
+        name: "freq_floor",
+        flag: "freq-floor",
+        help: "What happens once the PPM radius reaches the frequency radius [default: keep]",
+        kind: ParamKind::Value {
+            value_name: "RULE",
+            choices: &[
+                (
+                    "keep",
+                    "Keep the radius once it reaches the frequency radius",
+                ),
+                (
+                    "clamp",
+                    "Clamp the shrinking radius at the frequency radius",
+                ),
+            ],
+        },
+        get: |p| {
+            match p.freq_floor {
+                FrequencyFloor::Keep => "keep",
+                FrequencyFloor::Clamp => "clamp",
+            }
+            .to_owned()
+        },
+        set: |p, v| {
+            p.freq_floor = match v {
+                "keep" => FrequencyFloor::Keep,
+                "clamp" => FrequencyFloor::Clamp,
+                _ => return Err("is not one of keep, clamp".to_owned()),
+            };
+            Ok(())
+        },
+    },
+    Param {
+        name: "kernel_k",
+        flag: "kernel-k",
+        help: "Kernel radius constant K of the frequency estimate, a number, strict or poster [default: strict = 0.0720909, the 95 %-of-peak radius; the poster's is 0.7115]",
+        kind: ParamKind::Value {
+            value_name: "K",
+            choices: &[],
+        },
+        get: |p| p.kernel_k.to_string(),
+        set: |p, v| {
+            p.kernel_k = match v {
+                "strict" => K_STRICT,
+                "poster" => K_POSTER,
+                _ => parse_number(v)?,
+            };
+            Ok(())
+        },
+    },
+    Param {
+        name: "freq_grow",
+        flag: "freq-grow",
+        help: "Largest kernel of a frequency method, as a multiple of the initial radius, in [1, 64] [default: 1, measured in docs/integrators.md; 1 never grows a kernel beyond R₀]",
+        kind: ParamKind::Value {
+            value_name: "G",
+            choices: &[],
+        },
+        get: |p| p.freq_grow.to_string(),
+        set: |p, v| {
+            p.freq_grow = parse_number(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "freq_hold_alpha",
+        flag: "freq-hold-alpha",
+        help: "α of a hitpoint held by its frequency radius, in (0, 1] [default: 0.9; 1 keeps the radius for ever, the poster's rule, which does not converge]",
+        kind: ParamKind::Value {
+            value_name: "A",
+            choices: &[],
+        },
+        get: |p| p.freq_hold_alpha.to_string(),
+        set: |p, v| {
+            p.freq_hold_alpha = parse_number(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "freq_pilot",
+        flag: "freq-pilot",
+        help: "Passes of the frequency pilot before the kernels are sized and the statistics restart [default: 4; 0 never grows kernels; only with --freq-grow above 1]",
+        kind: ParamKind::Value {
+            value_name: "N",
+            choices: &[],
+        },
+        get: |p| p.freq_pilot.to_string(),
+        set: |p, v| {
+            let n: i64 = v.parse().map_err(|_| "is not a whole number".to_owned())?;
+            p.freq_pilot = u32::try_from(n).map_err(|_| "is outside [0, 1000000]".to_owned())?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "freq_clear_cap",
+        flag: "freq-clear-cap",
+        help: "Cap every slot's radius of a frequency method at the clear radius of its gather disc (probed at every visible point), not only the held ones",
+        kind: ParamKind::Switch { sets: true },
+        get: |p| on_off(p.freq_clear_cap),
+        set: |p, v| {
+            p.freq_clear_cap = parse_switch(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "max_depth",
+        flag: "max-depth",
+        help: "Maximum number of scattering events on a light path, in [1, 1024] [default: scene, else 1024: in effect unlimited, paths end by Russian roulette]",
+        kind: ParamKind::Value {
+            value_name: "N",
+            choices: &[],
+        },
+        get: |p| p.max_depth.to_string(),
+        set: |p, v| {
+            p.max_depth = parse_small(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "spp",
+        flag: "spp",
+        help: "Hitpoints per pixel (paths per pixel per pass for --method path), in [1, 1024] [default: 1]",
+        kind: ParamKind::Value {
+            value_name: "N",
+            choices: &[],
+        },
+        get: |p| p.samples_per_pixel.to_string(),
+        set: |p, v| {
+            p.samples_per_pixel = parse_small(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "seed",
+        flag: "seed",
+        help: "Seed of every random number [default: scene, else 0]",
+        kind: ParamKind::Value {
+            value_name: "SEED",
+            choices: &[],
+        },
+        get: |p| p.seed.to_string(),
+        set: |p, v| {
+            p.seed = v
+                .parse()
+                .map_err(|_| "is not a whole number in [0, 2^64)".to_owned())?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "direct_lighting",
+        flag: "direct-lighting",
+        help: "Add direct lighting by light sampling at hitpoints instead of gathering photons that arrive straight from an emitter",
+        kind: ParamKind::Switch { sets: true },
+        get: |p| on_off(p.direct_lighting),
+        set: |p, v| {
+            p.direct_lighting = parse_switch(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "freq_geometry",
+        flag: "no-freq-geometry",
+        help: "Let frequency methods hold a radius even where the gather disc hangs over an edge or a corner of the surface (no geometric bound on held kernels)",
+        kind: ParamKind::Switch { sets: false },
+        get: |p| on_off(p.freq_geometry),
+        set: |p, v| {
+            p.freq_geometry = parse_switch(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "freq_occlusion",
+        flag: "no-freq-occlusion",
+        help: "Let frequency photons travel without probing for partial occlusion near their hits (no shadow edges in their spectra)",
+        kind: ParamKind::Switch { sets: false },
+        get: |p| on_off(p.freq_occlusion),
+        set: |p, v| {
+            p.freq_occlusion = parse_switch(v)?;
+            Ok(())
+        },
+    },
+];
+
+/// The parameter called `name` (`snake_case`, or with `-` for `_`).
+#[must_use]
+pub fn param(name: &str) -> Option<&'static Param> {
+    let name = name.replace('-', "_");
+    PARAMS.iter().find(|p| p.name == name)
+}
+
+impl RenderParams {
+    /// Sets the parameter called `name` (see [`PARAMS`]) from its text, as a flag or a scene
+    /// table gives it. Only the conversion is checked; ranges are checked by
+    /// [`Self::validate`].
+    ///
+    /// # Errors
+    ///
+    /// [`ParamError::Unknown`] if no parameter has that name, [`ParamError::Unreadable`] if
+    /// the text is not a value of the parameter.
+    pub fn set(&mut self, name: &str, value: &str) -> Result<(), ParamError> {
+        let param = param(name).ok_or_else(|| ParamError::Unknown {
+            name: name.to_owned(),
+        })?;
+        (param.set)(self, value.trim()).map_err(|problem| ParamError::Unreadable {
+            name: param.name,
+            value: value.to_owned(),
+            problem,
+        })
+    }
+
+    /// These parameters with a scene's `[render]` table over them.
+    ///
+    /// # Errors
+    ///
+    /// As [`Self::set`], for the first key of the table that is not a render parameter or
+    /// whose value does not read.
+    pub fn with_scene_defaults(
+        mut self,
+        defaults: &geometry::RenderDefaults,
+    ) -> Result<Self, ParamError> {
+        for (name, value) in &defaults.params {
+            self.set(name, value)?;
+        }
+        Ok(self)
+    }
+
+    /// Every parameter with its value, as `(name, text)` in the order of [`PARAMS`]: what an
+    /// image's metadata records.
+    #[must_use]
+    pub fn entries(&self) -> Vec<(&'static str, String)> {
+        PARAMS.iter().map(|p| (p.name, p.get(self))).collect()
+    }
+}
+
+/// `on` or `off`.
+fn on_off(value: bool) -> String {
+    if value { "on" } else { "off" }.to_owned()
+}
+
+fn parse_switch(text: &str) -> Result<bool, String> {
+    match text {
+        "on" | "true" => Ok(true),
+        "off" | "false" => Ok(false),
+        _ => Err("is not one of on, off, true, false".to_owned()),
+    }
+}
+
+fn parse_number(text: &str) -> Result<f64, String> {
+    text.parse().map_err(|_| "is not a number".to_owned())
+}
+
+/// A count whose range `validate` knows; values that do not fit a `u32` are refused here.
+fn parse_small(text: &str) -> Result<u32, String> {
+    let n: i64 = text
+        .parse()
+        .map_err(|_| "is not a whole number".to_owned())?;
+    u32::try_from(n).map_err(|_| "is outside [1, 1024]".to_owned())
+}
+
+/// A whole number written as 200000, 200_000, 200k or 2M.
+fn parse_count(text: &str) -> Result<i64, String> {
+    let cleaned: String = text.chars().filter(|&c| c != '_').collect();
+    let (digits, factor) = if let Some(d) = cleaned.strip_suffix(['k', 'K']) {
+        (d, 1_000)
+    } else if let Some(d) = cleaned.strip_suffix('M') {
+        (d, 1_000_000)
+    } else {
+        (cleaned.as_str(), 1)
+    };
+    digits
+        .parse::<i64>()
+        .ok()
+        .and_then(|n| n.checked_mul(factor))
+        .ok_or_else(|| "is not a whole number such as 200000, 200_000, 200k or 2M".to_owned())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_value_reads_back_as_itself() {
+        let mut params = RenderParams::preview();
+        params.method = Method::FreqSppm;
+        params.initial_radius = Some(0.125);
+        params.freq_merge = MergePolicy::PosterMax;
+        params.freq_floor = FrequencyFloor::Clamp;
+        params.freq_geometry = false;
+        params.direct_lighting = true;
+        params.alpha = 2.0 / 3.0;
+        params.freq_grow = 2.5;
+        params.freq_hold_alpha = 1.0;
+        params.freq_pilot = 0;
+        params.freq_clear_cap = true;
+        for base in [RenderParams::preview(), params] {
+            let mut copy = RenderParams::preview();
+            copy.method = Method::Path;
+            copy.seed = 99;
+            for (name, value) in base.entries() {
+                copy.set(name, &value).unwrap();
+            }
+            assert_eq!(copy, base);
+        }
+    }
+
+    #[test]
+    fn names_are_unique_and_flags_follow_them() {
+        for (i, p) in PARAMS.iter().enumerate() {
+            assert!(PARAMS[..i].iter().all(|q| q.name != p.name), "{}", p.name);
+            assert!(!p.name.contains('-'), "{}", p.name);
+            if let ParamKind::Value { .. } = p.kind {
+                assert_eq!(p.flag, p.name.replace('_', "-"));
+            }
+        }
+        assert_eq!(
+            param("photons-per-pass").map(|p| p.name),
+            Some("photons_per_pass")
+        );
+    }
+
+    #[test]
+    fn counts() {
+        for (text, n) in [
+            ("200000", 200_000),
+            ("200_000", 200_000),
+            ("200k", 200_000),
+            ("2M", 2_000_000),
+        ] {
+            assert_eq!(parse_count(text), Ok(n));
+        }
+        assert!(parse_count("2G").is_err());
+        let mut p = RenderParams::preview();
+        assert!(matches!(
+            p.set("photons_per_pass", "0"),
+            Err(ParamError::Unreadable { .. })
+        ));
+        assert!(matches!(
+            p.set("colour", "red"),
+            Err(ParamError::Unknown { .. })
+        ));
+        p.set("kernel-k", "poster").unwrap();
+        assert_eq!(p.kernel_k, K_POSTER);
+    }
+}
