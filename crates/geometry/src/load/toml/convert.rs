@@ -1,207 +1,24 @@
-//! TOML scene files, format version 1 (`shared/design/scene-format.md`).
-//!
-//! The file is read with serde (`deny_unknown_fields`, internally tagged `type` enums). The
-//! toml crate reports the byte span of a problem but not the table it is in; the table
-//! (`[materials.white]`, `[[shapes]] #2`) is recovered from the text before the span, and
-//! serde's standard messages are sorted into [`LoadError`] variants.
-//!
-//! Decisions beyond the format page: `[camera]` is optional (a missing camera frames the
-//! bounding box) and so is `[film]` (512 × 512); film sides are 1 to 16384; albedo and
-//! reflectance must lie in [0, 1]; a spot light's `falloff_start` defaults to `cone_angle`
-//! (a hard edge); `cone_angle` is in (0, 180]; a mesh file's own materials are named
-//! `FILE/NAME` in the scene; lights and cameras inside a mesh file are ignored (with a warning).
-//!
-//! Extensions (`docs/scene-format-extensions.md`): the `cylinder` shape, an analytic open
-//! cylinder cut to an optional arc; its material must not emit.
+//! From the file as read to a `SceneDescription`: units, transforms, meshes, checks of each value.
 
-use std::collections::{BTreeMap, HashSet};
-use std::path::Path;
-
-use glam::{Mat3, Mat4, Vec3};
-use serde::Deserialize;
-
-use super::{LoadOptions, MAX_FILM_SIDE, MeshData, SceneParts, fmt_vec};
 use crate::description::{
     Camera, Cylinder, Film, Light, LoadNotes, Material, MaterialKind, RenderDefaults,
     SceneDescription, Sphere, Triangle,
 };
 use crate::error::LoadError;
+use crate::load::{LoadOptions, MAX_FILM_SIDE, MeshData, SceneParts, fmt_vec};
+use glam::{Mat3, Mat4, Vec3};
+use std::collections::{BTreeMap, HashSet};
+use std::path::Path;
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SceneFile {
-    #[allow(dead_code, reason = "checked before the typed parse")]
-    format: ::toml::Value,
-    camera: Option<CameraToml>,
-    film: Option<FilmToml>,
-    #[serde(default)]
-    materials: BTreeMap<String, MaterialToml>,
-    #[serde(default)]
-    shapes: Vec<ShapeToml>,
-    #[serde(default)]
-    lights: Vec<LightToml>,
-    render: Option<RenderToml>,
-}
+use super::schema::*;
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CameraToml {
-    position: [f32; 3],
-    look_at: [f32; 3],
-    up: Option<[f32; 3]>,
-    fov_y: f32,
-    aperture_radius: Option<f32>,
-    focus_distance: Option<f32>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct FilmToml {
-    width: i64,
-    height: i64,
-}
-
-#[derive(Deserialize)]
-#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
-enum MaterialToml {
-    Diffuse {
-        albedo: [f32; 3],
-        emission: Option<[f32; 3]>,
-    },
-    Mirror {
-        reflectance: Option<[f32; 3]>,
-        emission: Option<[f32; 3]>,
-    },
-    Dielectric {
-        ior: f32,
-        emission: Option<[f32; 3]>,
-    },
-    Glossy {
-        reflectance: [f32; 3],
-        roughness: f32,
-        emission: Option<[f32; 3]>,
-    },
-}
-
-#[derive(Deserialize)]
-#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
-enum ShapeToml {
-    Mesh {
-        file: String,
-        material: Option<String>,
-        transform: Option<TransformToml>,
-    },
-    Sphere {
-        center: [f32; 3],
-        radius: f32,
-        material: String,
-    },
-    Quad {
-        corner: [f32; 3],
-        edge1: [f32; 3],
-        edge2: [f32; 3],
-        material: String,
-    },
-    /// Extension to format 1 (`docs/scene-format-extensions.md`).
-    Cylinder {
-        center: [f32; 3],
-        axis: Option<[f32; 3]>,
-        radius: f32,
-        height: f32,
-        arc: Option<f32>,
-        facing: Option<[f32; 3]>,
-        material: String,
-    },
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct TransformToml {
-    scale: Option<[f32; 3]>,
-    rotate: Option<[f32; 3]>,
-    translate: Option<[f32; 3]>,
-}
-
-#[derive(Deserialize)]
-#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
-enum LightToml {
-    Point {
-        position: [f32; 3],
-        intensity: [f32; 3],
-    },
-    Spot {
-        position: [f32; 3],
-        direction: [f32; 3],
-        intensity: [f32; 3],
-        cone_angle: f32,
-        falloff_start: Option<f32>,
-    },
-    Directional {
-        direction: [f32; 3],
-        irradiance: [f32; 3],
-    },
-}
-
-/// The `[render]` table: `passes`, and render parameters that `ppm` reads.
-#[derive(Deserialize)]
-struct RenderToml {
-    passes: Option<u32>,
-    #[serde(flatten)]
-    params: std::collections::BTreeMap<String, ::toml::Value>,
-}
-
-/// Parses and converts a TOML scene.
-pub(crate) fn load_toml(
-    text: &str,
-    path: &Path,
-    options: &LoadOptions,
-) -> Result<SceneDescription, LoadError> {
-    // Syntax first, then the version, so that a future version's keys are not reported as
-    // unknown keys.
-    let table: ::toml::Table = ::toml::from_str(text).map_err(|e| syntax_error(path, text, &e))?;
-    match table.get("format") {
-        None => {
-            return Err(LoadError::MissingKey {
-                path: path.to_path_buf(),
-                line: None,
-                column: None,
-                table: "the top level".to_owned(),
-                key: "format".to_owned(),
-            });
-        }
-        Some(::toml::Value::Integer(1)) => {}
-        Some(::toml::Value::Integer(v)) => {
-            return Err(LoadError::UnsupportedVersion {
-                path: path.to_path_buf(),
-                found: v.to_string(),
-            });
-        }
-        Some(other) => {
-            return Err(LoadError::WrongType {
-                path: path.to_path_buf(),
-                line: None,
-                column: None,
-                table: "the top level".to_owned(),
-                key: "format".to_owned(),
-                message: format!("expected the integer 1, got {} {other}", other.type_str()),
-            });
-        }
-    }
-    let file: SceneFile = ::toml::from_str(text).map_err(|e| schema_error(path, text, &e))?;
-    Converter {
-        path,
-        dir: path.parent().unwrap_or(Path::new("")),
-    }
-    .convert(file, options)
-}
-
-struct Converter<'a> {
-    path: &'a Path,
-    dir: &'a Path,
+pub(super) struct Converter<'a> {
+    pub(super) path: &'a Path,
+    pub(super) dir: &'a Path,
 }
 
 impl Converter<'_> {
-    fn invalid(&self, key: impl Into<String>, message: impl Into<String>) -> LoadError {
+    pub(super) fn invalid(&self, key: impl Into<String>, message: impl Into<String>) -> LoadError {
         LoadError::InvalidValue {
             path: self.path.to_path_buf(),
             key: key.into(),
@@ -209,7 +26,7 @@ impl Converter<'_> {
         }
     }
 
-    fn finite(&self, key: &str, v: [f32; 3]) -> Result<Vec3, LoadError> {
+    pub(super) fn finite(&self, key: &str, v: [f32; 3]) -> Result<Vec3, LoadError> {
         let v = Vec3::from(v);
         if v.is_finite() {
             Ok(v)
@@ -218,19 +35,19 @@ impl Converter<'_> {
         }
     }
 
-    fn direction(&self, key: &str, v: [f32; 3]) -> Result<Vec3, LoadError> {
+    pub(super) fn direction(&self, key: &str, v: [f32; 3]) -> Result<Vec3, LoadError> {
         let v = self.finite(key, v)?;
         v.try_normalize()
             .ok_or_else(|| self.invalid(key, "must not be the zero vector"))
     }
 
-    fn colour(&self, key: &str, v: [f32; 3]) -> Result<Vec3, LoadError> {
+    pub(super) fn colour(&self, key: &str, v: [f32; 3]) -> Result<Vec3, LoadError> {
         let c = Vec3::from(v);
         crate::validate::colour(key, c).map_err(|e| e.in_file(self.path))?;
         Ok(c)
     }
 
-    fn reflectance(&self, key: &str, v: [f32; 3]) -> Result<Vec3, LoadError> {
+    pub(super) fn reflectance(&self, key: &str, v: [f32; 3]) -> Result<Vec3, LoadError> {
         let c = self.colour(key, v)?;
         if c.max_element() > 1.0 {
             return Err(self.invalid(key, format!("must be at most 1, got {}", fmt_vec(c))));
@@ -238,7 +55,7 @@ impl Converter<'_> {
         Ok(c)
     }
 
-    fn positive(&self, key: &str, x: f32) -> Result<f32, LoadError> {
+    pub(super) fn positive(&self, key: &str, x: f32) -> Result<f32, LoadError> {
         if x.is_finite() && x > 0.0 {
             Ok(x)
         } else {
@@ -246,7 +63,7 @@ impl Converter<'_> {
         }
     }
 
-    fn convert(
+    pub(super) fn convert(
         &self,
         file: SceneFile,
         options: &LoadOptions,
@@ -254,7 +71,7 @@ impl Converter<'_> {
         let camera = file.camera.map(|c| self.camera(c)).transpose()?;
         let film = match file.film {
             Some(f) => self.film(&f)?,
-            None => super::default_film(),
+            None => crate::load::default_film(),
         };
 
         let mut names: BTreeMap<String, u32> = BTreeMap::new();
@@ -444,10 +261,10 @@ impl Converter<'_> {
             notes: acc.notes,
             degenerate_materials: acc.degenerate_materials,
         };
-        super::finish(self.path, parts, options)
+        crate::load::finish(self.path, parts, options)
     }
 
-    fn camera(&self, c: CameraToml) -> Result<Camera, LoadError> {
+    pub(super) fn camera(&self, c: CameraToml) -> Result<Camera, LoadError> {
         let position = self.finite("[camera] position", c.position)?;
         let look_at = self.finite("[camera] look_at", c.look_at)?;
         let up = self.direction("[camera] up", c.up.unwrap_or([0.0, 1.0, 0.0]))?;
@@ -485,7 +302,7 @@ impl Converter<'_> {
         })
     }
 
-    fn film(&self, f: &FilmToml) -> Result<Film, LoadError> {
+    pub(super) fn film(&self, f: &FilmToml) -> Result<Film, LoadError> {
         let side = |key: &str, v: i64| -> Result<u32, LoadError> {
             u32::try_from(v)
                 .ok()
@@ -503,7 +320,7 @@ impl Converter<'_> {
         })
     }
 
-    fn material(&self, name: &str, m: MaterialToml) -> Result<Material, LoadError> {
+    pub(super) fn material(&self, name: &str, m: MaterialToml) -> Result<Material, LoadError> {
         let key = |k: &str| format!("[materials.{name}] {k}");
         let (kind, emission) = match m {
             MaterialToml::Diffuse { albedo, emission } => (
@@ -553,7 +370,7 @@ impl Converter<'_> {
     }
 
     /// Scale, then rotate about x, y, z (degrees), then translate.
-    fn transform(&self, context: &str, t: &TransformToml) -> Result<Mat4, LoadError> {
+    pub(super) fn transform(&self, context: &str, t: &TransformToml) -> Result<Mat4, LoadError> {
         let key = |k: &str| format!("{context} transform.{k}");
         let scale = self.finite(&key("scale"), t.scale.unwrap_or([1.0; 3]))?;
         if scale.abs().min_element() <= 0.0 {
@@ -570,7 +387,7 @@ impl Converter<'_> {
         Ok(Mat4::from_translation(translate) * rotation * Mat4::from_scale(scale))
     }
 
-    fn light(&self, context: &str, l: LightToml) -> Result<Light, LoadError> {
+    pub(super) fn light(&self, context: &str, l: LightToml) -> Result<Light, LoadError> {
         let key = |k: &str| format!("{context} {k}");
         Ok(match l {
             LightToml::Point {
@@ -618,7 +435,7 @@ impl Converter<'_> {
         })
     }
 
-    fn render(&self, r: RenderToml) -> Result<RenderDefaults, LoadError> {
+    pub(super) fn render(&self, r: RenderToml) -> Result<RenderDefaults, LoadError> {
         let mut params = Vec::with_capacity(r.params.len());
         for (key, value) in r.params {
             let text = match value {
@@ -647,17 +464,17 @@ impl Converter<'_> {
 
 /// Geometry gathered from the shapes.
 #[derive(Default)]
-struct Accumulator {
-    triangles: Vec<Triangle>,
-    spheres: Vec<Sphere>,
-    cylinders: Vec<Cylinder>,
-    notes: LoadNotes,
-    degenerate_materials: HashSet<u32>,
+pub(super) struct Accumulator {
+    pub(super) triangles: Vec<Triangle>,
+    pub(super) spheres: Vec<Sphere>,
+    pub(super) cylinders: Vec<Cylinder>,
+    pub(super) notes: LoadNotes,
+    pub(super) degenerate_materials: HashSet<u32>,
 }
 
 impl Accumulator {
-    fn push(&mut self, positions: [Vec3; 3], normals: Option<[Vec3; 3]>, material: u32) {
-        if super::is_degenerate(positions) {
+    pub(super) fn push(&mut self, positions: [Vec3; 3], normals: Option<[Vec3; 3]>, material: u32) {
+        if crate::load::is_degenerate(positions) {
             self.notes.degenerate_triangles += 1;
             self.degenerate_materials.insert(material);
         } else {
@@ -672,267 +489,23 @@ impl Accumulator {
 
 /// The default `facing` of a cylinder with unit `axis`: +Z made perpendicular to the axis, or +X
 /// when the axis is within about 25° of ±Z.
-fn default_facing(axis: Vec3) -> Vec3 {
+pub(super) fn default_facing(axis: Vec3) -> Vec3 {
     let reference = if axis.z.abs() < 0.9 { Vec3::Z } else { Vec3::X };
     (reference - reference.dot(axis) * axis).normalize_or(axis.any_orthonormal_vector())
 }
 
 /// Loads the mesh file of a `[[shapes]]` entry.
-fn load_mesh(path: &Path) -> Result<MeshData, LoadError> {
+pub(super) fn load_mesh(path: &Path) -> Result<MeshData, LoadError> {
     let extension = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     match extension.as_str() {
-        "obj" => super::obj::load_obj(path),
-        "gltf" | "glb" => super::gltf::load_gltf(path),
+        "obj" => crate::load::obj::load_obj(path),
+        "gltf" | "glb" => crate::load::gltf::load_gltf(path),
         _ => Err(LoadError::UnsupportedExtension {
             path: path.to_path_buf(),
             extension,
         }),
-    }
-}
-
-/// 1-based line and column of a byte offset.
-fn line_column(text: &str, offset: usize) -> (u32, u32) {
-    let offset = offset.min(text.len());
-    let before = text.get(..offset).unwrap_or(text);
-    let line = before.matches('\n').count() + 1;
-    let column = before
-        .rsplit('\n')
-        .next()
-        .map_or(1, |l| l.chars().count() + 1);
-    (to_u32(line), to_u32(column))
-}
-
-fn to_u32(x: usize) -> u32 {
-    u32::try_from(x).unwrap_or(u32::MAX)
-}
-
-fn syntax_error(path: &Path, text: &str, e: &::toml::de::Error) -> LoadError {
-    let (line, column) = match e.span() {
-        Some(span) => {
-            let (l, c) = line_column(text, span.start);
-            (Some(l), Some(c))
-        }
-        None => (None, None),
-    };
-    LoadError::Toml {
-        path: path.to_path_buf(),
-        line,
-        column,
-        message: first_line(e.message()),
-    }
-}
-
-fn first_line(s: &str) -> String {
-    s.lines().next().unwrap_or("").trim().to_owned()
-}
-
-/// Byte offset of the end of the line holding `offset`.
-fn end_of_line(text: &str, offset: usize) -> usize {
-    let offset = offset.min(text.len());
-    text.get(offset..)
-        .and_then(|rest| rest.find('\n'))
-        .map_or(text.len(), |i| offset + i)
-}
-
-/// Strips a `#` comment (good enough for header lines).
-fn uncomment(line: &str) -> &str {
-    line.split('#').next().unwrap_or(line).trim()
-}
-
-/// The table header in force at byte `offset` (the header line itself counts):
-/// `[camera]`, `[materials.white]`, `[[shapes]] #2`, or `the top level`.
-fn table_at(text: &str, offset: usize) -> String {
-    let before = text.get(..end_of_line(text, offset)).unwrap_or(text);
-    let header = before.lines().map(str::trim).rfind(|l| l.starts_with('['));
-    match header {
-        None => "the top level".to_owned(),
-        Some(h) => {
-            let h = uncomment(h);
-            if h.starts_with("[[") {
-                let n = before.lines().filter(|l| uncomment(l) == h).count();
-                format!("{h} #{n}")
-            } else {
-                h.to_owned()
-            }
-        }
-    }
-}
-
-/// The key on the line at byte `offset` (`albedo` in `albedo = "red"`), if any.
-fn key_at(text: &str, offset: usize) -> Option<String> {
-    let start = text
-        .get(..offset.min(text.len()))
-        .and_then(|b| b.rfind('\n'))
-        .map_or(0, |i| i + 1);
-    let line = text
-        .get(start..)
-        .and_then(|l| l.lines().next())
-        .unwrap_or("");
-    match line.split_once('=') {
-        Some((k, _)) if !line.trim_start().starts_with('[') => Some(k.trim().to_owned()),
-        _ => None,
-    }
-}
-
-/// The lines of the table whose header (or any line) holds `offset`, with 0-based indices:
-/// from the table's header line to the line before the next header.
-fn section(text: &str, offset: usize) -> Vec<(usize, &str)> {
-    let first = text
-        .get(..end_of_line(text, offset))
-        .unwrap_or(text)
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| l.trim_start().starts_with('['))
-        .map(|(i, _)| i)
-        .last()
-        .unwrap_or(0);
-    text.lines()
-        .enumerate()
-        .skip(first)
-        .take_while(|(i, l)| *i == first || !l.trim_start().starts_with('['))
-        .collect()
-}
-
-/// The line and column of `key = …` inside the table holding `offset`.
-fn find_key(text: &str, offset: usize, key: &str) -> Option<(u32, u32)> {
-    section(text, offset).into_iter().find_map(|(i, l)| {
-        let (k, _) = l.split_once('=')?;
-        (k.trim() == key).then(|| (to_u32(i + 1), to_u32(l.len() - l.trim_start().len() + 1)))
-    })
-}
-
-/// For `invalid type: string "white", …`, the key in the table holding `offset` whose value
-/// is written `"white"` (serde does not name the key; this finds it for plain values).
-fn find_key_by_value(text: &str, offset: usize, message: &str) -> Option<(String, u32, u32)> {
-    let matches: Box<dyn Fn(&str) -> bool> = if let Some(rest) =
-        message.strip_prefix("invalid length ")
-    {
-        // `invalid length 2, expected an array of length 3`: an array of 2 elements.
-        let n: usize = rest.split(',').next()?.trim().parse().ok()?;
-        Box::new(move |v: &str| {
-            v.strip_prefix('[')
-                .and_then(|v| v.strip_suffix(']'))
-                .is_some_and(|inner| inner.split(',').filter(|e| !e.trim().is_empty()).count() == n)
-        })
-    } else {
-        let rest = message.strip_prefix("invalid type: ")?;
-        let literal = if let Some(r) = rest.strip_prefix("string ") {
-            r.split(", expected").next()?.to_owned()
-        } else {
-            let (_, r) = rest.split_once('`')?;
-            r.split('`').next()?.to_owned()
-        };
-        Box::new(move |v: &str| v == literal)
-    };
-    section(text, offset).into_iter().find_map(|(i, l)| {
-        let (k, v) = l.split_once('=')?;
-        matches(uncomment(v)).then(|| {
-            (
-                k.trim().to_owned(),
-                to_u32(i + 1),
-                to_u32(l.len() - l.trim_start().len() + 1),
-            )
-        })
-    })
-}
-
-/// Turns a serde/toml error into the most specific variant.
-fn schema_error(path: &Path, text: &str, e: &::toml::de::Error) -> LoadError {
-    let message = first_line(e.message());
-    let offset = e.span().map(|s| s.start);
-    let (line, column) = match offset {
-        Some(o) => {
-            let (l, c) = line_column(text, o);
-            (Some(l), Some(c))
-        }
-        None => (None, None),
-    };
-    let table = offset.map_or_else(|| "the scene".to_owned(), |o| table_at(text, o));
-    let path = path.to_path_buf();
-    if let Some(rest) = message.strip_prefix("unknown field `")
-        && let Some((key, rest)) = rest.split_once('`')
-    {
-        let (line, column) = match offset.and_then(|o| find_key(text, o, key)) {
-            Some((l, c)) => (Some(l), Some(c)),
-            None => (line, column),
-        };
-        let mut expected = expected_list(rest);
-        // Serde leaves the tag out of a tagged table's list.
-        let tagged = ["[materials.", "[[shapes]]", "[[lights]]"]
-            .iter()
-            .any(|t| table.starts_with(t));
-        if tagged && !expected.split(", ").any(|k| k == "type") {
-            expected = format!("type, {expected}");
-        }
-        return LoadError::UnknownKey {
-            path,
-            line,
-            column,
-            table,
-            key: key.to_owned(),
-            expected,
-        };
-    }
-    if let Some(rest) = message.strip_prefix("missing field `")
-        && let Some((key, _)) = rest.split_once('`')
-    {
-        return LoadError::MissingKey {
-            path,
-            line,
-            column,
-            table,
-            key: key.to_owned(),
-        };
-    }
-    if let Some(rest) = message.strip_prefix("unknown variant `")
-        && let Some((found, rest)) = rest.split_once('`')
-    {
-        return LoadError::UnknownType {
-            path,
-            line,
-            column,
-            table,
-            found: found.to_owned(),
-            expected: expected_list(rest),
-        };
-    }
-    if message.starts_with("invalid type")
-        || message.starts_with("invalid length")
-        || message.starts_with("invalid value")
-    {
-        let (key, line, column) = match offset.and_then(|o| key_at(text, o)) {
-            Some(key) => (key, line, column),
-            None => match offset.and_then(|o| find_key_by_value(text, o, &message)) {
-                Some((key, l, c)) => (key, Some(l), Some(c)),
-                None => (String::new(), line, column),
-            },
-        };
-        return LoadError::WrongType {
-            path,
-            line,
-            column,
-            table,
-            key,
-            message,
-        };
-    }
-    LoadError::Toml {
-        path,
-        line,
-        column,
-        message,
-    }
-}
-
-/// `", expected one of `a`, `b`"` → `"a, b"`.
-fn expected_list(rest: &str) -> String {
-    let names: Vec<&str> = rest.split('`').skip(1).step_by(2).collect();
-    if names.is_empty() {
-        "none".to_owned()
-    } else {
-        names.join(", ")
     }
 }

@@ -1,0 +1,127 @@
+//! The file as serde reads it: one struct per table, `deny_unknown_fields`.
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct SceneFile {
+    #[allow(dead_code, reason = "checked before the typed parse")]
+    pub(super) format: ::toml::Value,
+    pub(super) camera: Option<CameraToml>,
+    pub(super) film: Option<FilmToml>,
+    #[serde(default)]
+    pub(super) materials: BTreeMap<String, MaterialToml>,
+    #[serde(default)]
+    pub(super) shapes: Vec<ShapeToml>,
+    #[serde(default)]
+    pub(super) lights: Vec<LightToml>,
+    pub(super) render: Option<RenderToml>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct CameraToml {
+    pub(super) position: [f32; 3],
+    pub(super) look_at: [f32; 3],
+    pub(super) up: Option<[f32; 3]>,
+    pub(super) fov_y: f32,
+    pub(super) aperture_radius: Option<f32>,
+    pub(super) focus_distance: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct FilmToml {
+    pub(super) width: i64,
+    pub(super) height: i64,
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+pub(super) enum MaterialToml {
+    Diffuse {
+        albedo: [f32; 3],
+        emission: Option<[f32; 3]>,
+    },
+    Mirror {
+        reflectance: Option<[f32; 3]>,
+        emission: Option<[f32; 3]>,
+    },
+    Dielectric {
+        ior: f32,
+        emission: Option<[f32; 3]>,
+    },
+    Glossy {
+        reflectance: [f32; 3],
+        roughness: f32,
+        emission: Option<[f32; 3]>,
+    },
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+pub(super) enum ShapeToml {
+    Mesh {
+        file: String,
+        material: Option<String>,
+        transform: Option<TransformToml>,
+    },
+    Sphere {
+        center: [f32; 3],
+        radius: f32,
+        material: String,
+    },
+    Quad {
+        corner: [f32; 3],
+        edge1: [f32; 3],
+        edge2: [f32; 3],
+        material: String,
+    },
+    /// Extension to format 1 (`docs/scene-format-extensions.md`).
+    Cylinder {
+        center: [f32; 3],
+        axis: Option<[f32; 3]>,
+        radius: f32,
+        height: f32,
+        arc: Option<f32>,
+        facing: Option<[f32; 3]>,
+        material: String,
+    },
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct TransformToml {
+    pub(super) scale: Option<[f32; 3]>,
+    pub(super) rotate: Option<[f32; 3]>,
+    pub(super) translate: Option<[f32; 3]>,
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+pub(super) enum LightToml {
+    Point {
+        position: [f32; 3],
+        intensity: [f32; 3],
+    },
+    Spot {
+        position: [f32; 3],
+        direction: [f32; 3],
+        intensity: [f32; 3],
+        cone_angle: f32,
+        falloff_start: Option<f32>,
+    },
+    Directional {
+        direction: [f32; 3],
+        irradiance: [f32; 3],
+    },
+}
+
+/// The `[render]` table: `passes`, and render parameters that `ppm` reads.
+#[derive(Deserialize)]
+pub(super) struct RenderToml {
+    pub(super) passes: Option<u32>,
+    #[serde(flatten)]
+    pub(super) params: std::collections::BTreeMap<String, ::toml::Value>,
+}
