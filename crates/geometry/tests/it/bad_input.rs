@@ -1,5 +1,6 @@
-//! Bad input: one test per kind of error. Each checks the variant and that the message is one
-//! line starting with the offending file's path.
+//! Bad input: tables of bad edits and bad files, each with the error it must give (its variant
+//! and fields), the message one line starting with the offending file's path; then the cases
+//! that need more than a table.
 
 use std::path::Path;
 
@@ -87,32 +88,258 @@ fn unreadable_path_is_an_io_error() {
     assert_names_file(&err, &dir);
 }
 
+/// Edits of `BASE` and what each error must be: fragments of its `Debug` form (the variant
+/// and the fields that matter).
+const EDITS: &[(&str, &str, &[&str])] = &[
+    (
+        "fov_y = 39.3",
+        "fov_y = = 39.3",
+        &["Toml {", "line: Some(6)"],
+    ),
+    (
+        "albedo = [0.8, 0.8, 0.8]",
+        "colour = [0.8, 0.8, 0.8]",
+        &[
+            "UnknownKey {",
+            "line: Some(10)",
+            "table: \"[materials.white]\"",
+            "key: \"colour\"",
+        ],
+    ),
+    (
+        "radius = 1.0",
+        "radius = 1.0\nradious = 2.0",
+        &[
+            "UnknownKey {",
+            "table: \"[[shapes]] #1\"",
+            "key: \"radious\"",
+        ],
+    ),
+    (
+        "albedo = [0.8, 0.8, 0.8]",
+        "albedo = \"white\"",
+        &[
+            "WrongType {",
+            "table: \"[materials.white]\"",
+            "key: \"albedo\"",
+        ],
+    ),
+    (
+        "albedo = [0.8, 0.8, 0.8]",
+        "albedo = [0.8, 0.8]",
+        &["WrongType {"],
+    ),
+    (
+        "fov_y = 39.3\n",
+        "",
+        &["MissingKey {", "table: \"[camera]\"", "key: \"fov_y\""],
+    ),
+    ("format = 1\n", "", &["MissingKey {", "key: \"format\""]),
+    (
+        "type = \"diffuse\"",
+        "type = \"velvet\"",
+        &[
+            "UnknownType {",
+            "table: \"[materials.white]\"",
+            "found: \"velvet\"",
+            "dielectric",
+        ],
+    ),
+    (
+        "material = \"white\"",
+        "material = \"chalk\"",
+        &[
+            "UnknownMaterial {",
+            "name: \"chalk\"",
+            "context: \"[[shapes]] #1\"",
+        ],
+    ),
+    // Unknown keys of a future version must not hide the version error.
+    (
+        "format = 1",
+        "format = 2\nsky = \"blue\"",
+        &["UnsupportedVersion {", "found: \"2\""],
+    ),
+    ("fov_y = 39.3", "fov_y = 0.0", &["InvalidValue {", "fov_y"]),
+    (
+        "fov_y = 39.3",
+        "fov_y = 180.0",
+        &["InvalidValue {", "fov_y"],
+    ),
+    ("fov_y = 39.3", "fov_y = -5.0", &["InvalidValue {", "fov_y"]),
+    ("fov_y = 39.3", "fov_y = nan", &["InvalidValue {", "fov_y"]),
+    (
+        "emission = [17.0, 12.0, 4.0]",
+        "emission = [17.0, -1.0, 4.0]",
+        &["InvalidValue {", "emission"],
+    ),
+    (
+        "albedo = [0.8, 0.8, 0.8]",
+        "albedo = [0.8, -0.1, 0.8]",
+        &["InvalidValue {"],
+    ),
+    ("radius = 1.0", "radius = 0.0", &["InvalidValue {"]),
+    ("radius = 1.0", "radius = -1.0", &["InvalidValue {"]),
+    ("radius = 1.0", "radius = inf", &["InvalidValue {"]),
+    (
+        "fov_y = 39.3",
+        "fov_y = 39.3\n\n[film]\nwidth = 0\nheight = 10",
+        &["InvalidValue {"],
+    ),
+    (
+        "fov_y = 39.3",
+        "fov_y = 39.3\n\n[film]\nwidth = 10\nheight = -3",
+        &["InvalidValue {"],
+    ),
+    (
+        "fov_y = 39.3",
+        "fov_y = 39.3\n\n[film]\nwidth = 100000\nheight = 10",
+        &["InvalidValue {"],
+    ),
+    // The camera looks at its own position.
+    (
+        "look_at = [0.0, 1.0, 0.0]",
+        "look_at = [0.0, 1.0, 3.9]",
+        &["InvalidValue {"],
+    ),
+    // The lamp quad has parallel edges: both its triangles are degenerate.
+    (
+        "edge2 = [0.0, 0.0, 0.4]",
+        "edge2 = [1.0, 0.0, 0.0]",
+        &["ZeroAreaEmitter {", "material: \"lamp\""],
+    ),
+    (
+        "emission = [17.0, 12.0, 4.0]",
+        "emission = [0.0, 0.0, 0.0]",
+        &["NoEmitter {"],
+    ),
+];
+
+/// Files (name, text; the first is loaded) and what the error must be, as in [`EDITS`], and
+/// the file it names.
+struct BadFile {
+    test: &'static str,
+    files: &'static [(&'static str, &'static str)],
+    expect: &'static [&'static str],
+    named: &'static str,
+}
+
+const FILES: &[BadFile] = &[
+    BadFile {
+        test: "unknown_extension",
+        files: &[("scene.ply", "ply\n")],
+        expect: &["UnsupportedExtension {", "extension: \"ply\""],
+        named: "scene.ply",
+    },
+    BadFile {
+        test: "malformed_obj",
+        files: &[(
+            "bad.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 1 x 0\nf 1 2 3\n",
+        )],
+        expect: &["Obj {", "line: Some(5)"],
+        named: "bad.obj",
+    },
+    BadFile {
+        test: "obj_face_out_of_range",
+        files: &[("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 7\n")],
+        expect: &["Obj {", "line: Some(5)"],
+        named: "bad.obj",
+    },
+    BadFile {
+        test: "malformed_mtl",
+        files: &[
+            (
+                "scene.obj",
+                "mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl lamp\nf 1 2 3\n",
+            ),
+            ("bad.mtl", "newmtl lamp\nKd 0.5 0.5 0.5\nKe 1 2\n"),
+        ],
+        expect: &["Mtl {", "line: Some(3)"],
+        named: "bad.mtl",
+    },
+    BadFile {
+        test: "malformed_gltf",
+        files: &[("bad.gltf", "{ \"asset\": { \"version\": \"2.0\" }, ")],
+        expect: &["Gltf {"],
+        named: "bad.gltf",
+    },
+    BadFile {
+        test: "nan_vertex",
+        files: &[("nan.obj", "v 0 0 0\nv 1 0 0\n\nv 0 NaN 0\nf 1 2 3\n")],
+        expect: &["NonFiniteVertex {", "line: Some(4)", "what: \"nan\""],
+        named: "nan.obj",
+    },
+    BadFile {
+        test: "inf_vertex",
+        files: &[("inf.obj", "v 0 0 0\nv 1 0 inf\nv 0 1 0\nf 1 2 3\n")],
+        expect: &["NonFiniteVertex {", "line: Some(2)", "what: \"infinite\""],
+        named: "inf.obj",
+    },
+    BadFile {
+        test: "big_vertex",
+        files: &[("big.obj", "v 0 0 0\nv 1 0 1e39\nv 0 1 0\nf 1 2 3\n")],
+        expect: &["NonFiniteVertex {"],
+        named: "big.obj",
+    },
+    BadFile {
+        test: "empty_obj",
+        files: &[("empty.obj", "# nothing\nv 0 0 0\n")],
+        expect: &["EmptyScene {"],
+        named: "empty.obj",
+    },
+    BadFile {
+        test: "no_emitter",
+        files: &[("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")],
+        expect: &["NoEmitter {"],
+        named: "tri.obj",
+    },
+];
+
 #[test]
-fn malformed_toml() {
-    let (result, path) = load_edited("fov_y = 39.3", "fov_y = = 39.3");
-    let err = result.unwrap_err();
-    assert!(
-        matches!(err, LoadError::Toml { line: Some(6), .. }),
-        "{err:?}: {err}"
-    );
-    assert_names_file(&err, path);
+fn every_bad_edit_is_its_own_error() {
+    for (from, to, expect) in EDITS {
+        let (result, path) = load_edited(from, to);
+        let err = result.expect_err(to);
+        let debug = format!("{err:?}");
+        for fragment in *expect {
+            assert!(
+                debug.contains(fragment),
+                "{to:?}: {fragment} not in {debug}"
+            );
+        }
+        assert_names_file(&err, path);
+    }
+    // Just inside the range.
+    load_edited("fov_y = 39.3", "fov_y = 179.9").0.unwrap();
 }
 
 #[test]
-fn unknown_key() {
-    let (result, path) = load_edited("albedo = [0.8, 0.8, 0.8]", "colour = [0.8, 0.8, 0.8]");
-    let err = result.unwrap_err();
-    let LoadError::UnknownKey {
-        key, table, line, ..
-    } = &err
-    else {
-        panic!("{err:?}: {err}")
-    };
-    assert_eq!(key, "colour");
-    assert_eq!(table, "[materials.white]");
-    assert_eq!(*line, Some(10));
-    assert_names_file(&err, path);
-    let msg = err.to_string();
+fn every_bad_file_is_its_own_error() {
+    for BadFile {
+        test,
+        files,
+        expect,
+        named,
+    } in FILES
+    {
+        let first = fixture(test, files);
+        let err = load(&first).expect_err(test);
+        let debug = format!("{err:?}");
+        for fragment in *expect {
+            assert!(
+                debug.contains(fragment),
+                "{test}: {fragment} not in {debug}"
+            );
+        }
+        assert_names_file(&err, &first.with_file_name(named));
+    }
+}
+
+#[test]
+fn unknown_key_lists_the_known_ones() {
+    let (result, _) = load_edited("albedo = [0.8, 0.8, 0.8]", "colour = [0.8, 0.8, 0.8]");
+    let msg = result.unwrap_err().to_string();
     assert!(
         msg.contains("unknown key \"colour\" in [materials.white]"),
         "{msg}"
@@ -121,243 +348,15 @@ fn unknown_key() {
 }
 
 #[test]
-fn unknown_key_in_array_of_tables() {
-    let (result, path) = load_edited("radius = 1.0", "radius = 1.0\nradious = 2.0");
-    let err = result.unwrap_err();
-    let LoadError::UnknownKey { key, table, .. } = &err else {
-        panic!("{err:?}: {err}")
-    };
-    assert_eq!(key, "radious");
-    assert_eq!(table, "[[shapes]] #1");
-    assert_names_file(&err, path);
-}
-
-#[test]
-fn wrong_type() {
-    let (result, path) = load_edited("albedo = [0.8, 0.8, 0.8]", "albedo = \"white\"");
-    let err = result.unwrap_err();
-    let LoadError::WrongType { key, table, .. } = &err else {
-        panic!("{err:?}: {err}")
-    };
-    assert_eq!(key, "albedo");
-    assert_eq!(table, "[materials.white]");
-    assert_names_file(&err, path);
-}
-
-#[test]
-fn wrong_vector_length() {
-    let (result, path) = load_edited("albedo = [0.8, 0.8, 0.8]", "albedo = [0.8, 0.8]");
-    let err = result.unwrap_err();
-    assert!(matches!(err, LoadError::WrongType { .. }), "{err:?}: {err}");
-    assert_names_file(&err, path);
-}
-
-#[test]
-fn missing_required_key() {
-    let (result, path) = load_edited("fov_y = 39.3\n", "");
-    let err = result.unwrap_err();
-    let LoadError::MissingKey { key, table, .. } = &err else {
-        panic!("{err:?}: {err}")
-    };
-    assert_eq!(key, "fov_y");
-    assert_eq!(table, "[camera]");
-    assert_names_file(&err, path);
-}
-
-#[test]
-fn missing_format() {
-    let (result, path) = load_edited("format = 1\n", "");
-    let err = result.unwrap_err();
-    assert!(
-        matches!(&err, LoadError::MissingKey { key, .. } if key == "format"),
-        "{err:?}: {err}"
-    );
-    assert_names_file(&err, path);
-}
-
-#[test]
-fn unknown_material_type() {
-    let (result, path) = load_edited("type = \"diffuse\"", "type = \"velvet\"");
-    let err = result.unwrap_err();
-    let LoadError::UnknownType {
-        found,
-        expected,
-        table,
-        ..
-    } = &err
-    else {
-        panic!("{err:?}: {err}")
-    };
-    assert_eq!(found, "velvet");
-    assert_eq!(table, "[materials.white]");
-    assert!(expected.contains("dielectric"), "{expected}");
-    assert_names_file(&err, path);
-}
-
-#[test]
-fn unknown_material_reference() {
-    let (result, path) = load_edited("material = \"white\"", "material = \"chalk\"");
-    let err = result.unwrap_err();
-    let LoadError::UnknownMaterial { name, context, .. } = &err else {
-        panic!("{err:?}: {err}")
-    };
-    assert_eq!(name, "chalk");
-    assert_eq!(context, "[[shapes]] #1");
-    assert_names_file(&err, path);
-}
-
-#[test]
-fn unsupported_format_version() {
-    // Unknown keys of a future version must not hide the version error.
-    let (result, path) = load_edited("format = 1", "format = 2\nsky = \"blue\"");
-    let err = result.unwrap_err();
-    assert!(
-        matches!(&err, LoadError::UnsupportedVersion { found, .. } if found == "2"),
-        "{err:?}: {err}"
-    );
-    assert_names_file(&err, path);
-}
-
-#[test]
-fn fov_zero_and_180() {
-    for fov in ["0.0", "180.0", "-5.0", "nan"] {
-        let (result, path) = load_edited("fov_y = 39.3", &format!("fov_y = {fov}"));
-        let err = result.unwrap_err();
-        assert!(
-            matches!(&err, LoadError::InvalidValue { key, .. } if key.contains("fov_y")),
-            "fov {fov}: {err:?}"
-        );
-        assert_names_file(&err, path);
-    }
-    let (result, _) = load_edited("fov_y = 39.3", "fov_y = 179.9");
-    result.unwrap();
-}
-
-#[test]
-fn negative_radiance() {
-    let (result, path) = load_edited(
-        "emission = [17.0, 12.0, 4.0]",
-        "emission = [17.0, -1.0, 4.0]",
-    );
-    let err = result.unwrap_err();
-    assert!(
-        matches!(&err, LoadError::InvalidValue { key, .. } if key.contains("emission")),
-        "{err:?}: {err}"
-    );
-    assert_names_file(&err, path);
-}
-
-#[test]
-fn negative_albedo() {
-    let (result, path) = load_edited("albedo = [0.8, 0.8, 0.8]", "albedo = [0.8, -0.1, 0.8]");
-    let err = result.unwrap_err();
-    assert!(
-        matches!(err, LoadError::InvalidValue { .. }),
-        "{err:?}: {err}"
-    );
-    assert_names_file(&err, path);
-}
-
-#[test]
-fn non_positive_radius_and_film() {
-    for (from, to) in [
-        ("radius = 1.0", "radius = 0.0"),
-        ("radius = 1.0", "radius = -1.0"),
-        ("radius = 1.0", "radius = inf"),
-        (
-            "fov_y = 39.3",
-            "fov_y = 39.3\n\n[film]\nwidth = 0\nheight = 10",
-        ),
-        (
-            "fov_y = 39.3",
-            "fov_y = 39.3\n\n[film]\nwidth = 10\nheight = -3",
-        ),
-        (
-            "fov_y = 39.3",
-            "fov_y = 39.3\n\n[film]\nwidth = 100000\nheight = 10",
-        ),
-    ] {
-        let (result, path) = load_edited(from, to);
-        let err = result.unwrap_err();
-        assert!(
-            matches!(err, LoadError::InvalidValue { .. }),
-            "{to}: {err:?}"
-        );
-        assert_names_file(&err, path);
-    }
-}
-
-#[test]
-fn camera_position_equals_look_at() {
-    let (result, path) = load_edited("look_at = [0.0, 1.0, 0.0]", "look_at = [0.0, 1.0, 3.9]");
-    let err = result.unwrap_err();
-    assert!(matches!(err, LoadError::InvalidValue { .. }), "{err:?}");
-    assert_names_file(&err, path);
-}
-
-#[test]
-fn unknown_extension() {
-    let path = fixture("unknown_extension", &[("scene.ply", "ply\n")]);
-    let err = load(&path).unwrap_err();
-    assert!(
-        matches!(&err, LoadError::UnsupportedExtension { extension, .. } if extension == "ply"),
-        "{err:?}"
-    );
-    assert_names_file(&err, &path);
-    assert!(err.to_string().contains("\"ply\""));
-}
-
-#[test]
-fn malformed_obj() {
+fn extension_and_vertex_messages() {
     let path = fixture(
-        "malformed_obj",
-        &[(
-            "bad.obj",
-            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 1 x 0\nf 1 2 3\n",
-        )],
+        "nan_message",
+        &[("nan.obj", "v 0 0 0\nv 1 0 0\n\nv 0 NaN 0\nf 1 2 3\n")],
     );
-    let err = load(&path).unwrap_err();
-    assert!(
-        matches!(err, LoadError::Obj { line: Some(5), .. }),
-        "{err:?}: {err}"
-    );
-    assert_names_file(&err, &path);
-}
-
-#[test]
-fn obj_face_index_out_of_range() {
-    let path = fixture(
-        "obj_face_out_of_range",
-        &[("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 7\n")],
-    );
-    let err = load(&path).unwrap_err();
-    assert!(
-        matches!(err, LoadError::Obj { line: Some(5), .. }),
-        "{err:?}: {err}"
-    );
-    assert_names_file(&err, &path);
-}
-
-#[test]
-fn malformed_mtl() {
-    let dir_file = fixture(
-        "malformed_mtl",
-        &[
-            ("bad.mtl", "newmtl lamp\nKd 0.5 0.5 0.5\nKe 1 2\n"),
-            (
-                "scene.obj",
-                "mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl lamp\nf 1 2 3\n",
-            ),
-        ],
-    );
-    let mtl = dir_file.clone();
-    let obj = dir_file.with_file_name("scene.obj");
-    let err = load(&obj).unwrap_err();
-    assert!(
-        matches!(err, LoadError::Mtl { line: Some(3), .. }),
-        "{err:?}: {err}"
-    );
-    assert_names_file(&err, &mtl);
+    let msg = load(&path).unwrap_err().to_string();
+    assert!(msg.contains("line 4: vertex has a nan coordinate"), "{msg}");
+    let path = fixture("ply_message", &[("scene.ply", "ply\n")]);
+    assert!(load(&path).unwrap_err().to_string().contains("\"ply\""));
 }
 
 #[test]
@@ -373,71 +372,6 @@ fn missing_mtl_is_a_warning() {
     assert_eq!(scene.triangles.len(), 1);
     assert_eq!(scene.materials[0].name, "default");
     assert!(scene.notes.warnings.iter().any(|w| w.contains("gone.mtl")));
-}
-
-#[test]
-fn malformed_gltf_json() {
-    let path = fixture(
-        "malformed_gltf",
-        &[("bad.gltf", "{ \"asset\": { \"version\": \"2.0\" }, ")],
-    );
-    let err = load(&path).unwrap_err();
-    assert!(matches!(err, LoadError::Gltf { .. }), "{err:?}: {err}");
-    assert_names_file(&err, &path);
-}
-
-#[test]
-fn nan_vertex() {
-    let path = fixture(
-        "nan_vertex",
-        &[("nan.obj", "v 0 0 0\nv 1 0 0\n\nv 0 NaN 0\nf 1 2 3\n")],
-    );
-    let err = load(&path).unwrap_err();
-    assert!(
-        matches!(
-            err,
-            LoadError::NonFiniteVertex {
-                line: Some(4),
-                what: "nan",
-                ..
-            }
-        ),
-        "{err:?}: {err}"
-    );
-    assert_names_file(&err, &path);
-    assert!(
-        err.to_string()
-            .contains("line 4: vertex has a nan coordinate"),
-        "{err}"
-    );
-}
-
-#[test]
-fn infinite_vertex() {
-    let path = fixture(
-        "inf_vertex",
-        &[("inf.obj", "v 0 0 0\nv 1 0 inf\nv 0 1 0\nf 1 2 3\n")],
-    );
-    let err = load(&path).unwrap_err();
-    assert!(
-        matches!(
-            err,
-            LoadError::NonFiniteVertex {
-                line: Some(2),
-                what: "infinite",
-                ..
-            }
-        ),
-        "{err:?}: {err}"
-    );
-    assert_names_file(&err, &path);
-    // Overflowing f32 is infinite too.
-    let path = fixture(
-        "big_vertex",
-        &[("big.obj", "v 0 0 0\nv 1 0 1e39\nv 0 1 0\nf 1 2 3\n")],
-    );
-    let err = load(&path).unwrap_err();
-    assert!(matches!(err, LoadError::NonFiniteVertex { .. }), "{err:?}");
 }
 
 #[test]
@@ -457,12 +391,7 @@ fn degenerate_triangles_are_skipped_and_counted() {
 }
 
 #[test]
-fn empty_scene() {
-    let path = fixture("empty_obj", &[("empty.obj", "# nothing\nv 0 0 0\n")]);
-    let err = load(&path).unwrap_err();
-    assert!(matches!(err, LoadError::EmptyScene { .. }), "{err:?}");
-    assert_names_file(&err, &path);
-
+fn empty_toml_scene() {
     let toml = "format = 1\n[materials.a]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n";
     let path = Path::new("empty.toml");
     let err = load_toml_str(toml, path).unwrap_err();
@@ -471,31 +400,11 @@ fn empty_scene() {
 }
 
 #[test]
-fn zero_area_emitter() {
-    // The lamp quad has parallel edges: both its triangles are degenerate.
-    let (result, path) = load_edited("edge2 = [0.0, 0.0, 0.4]", "edge2 = [1.0, 0.0, 0.0]");
-    let err = result.unwrap_err();
-    assert!(
-        matches!(&err, LoadError::ZeroAreaEmitter { material, .. } if material == "lamp"),
-        "{err:?}: {err}"
-    );
-    assert_names_file(&err, path);
-}
-
-#[test]
-fn no_emitter() {
-    let (result, path) = load_edited("emission = [17.0, 12.0, 4.0]", "emission = [0.0, 0.0, 0.0]");
-    let err = result.unwrap_err();
-    assert!(matches!(err, LoadError::NoEmitter { .. }), "{err:?}");
-    assert_names_file(&err, path);
-
+fn a_scene_without_emitter_loads_when_allowed() {
     let obj = fixture(
-        "no_emitter",
+        "no_emitter_allowed",
         &[("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")],
     );
-    let err = load(&obj).unwrap_err();
-    assert!(matches!(err, LoadError::NoEmitter { .. }), "{err:?}");
-    assert_names_file(&err, &obj);
     load_with(&obj, &LoadOptions::allow_no_emitter()).unwrap();
 }
 
