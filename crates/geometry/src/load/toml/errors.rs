@@ -1,8 +1,13 @@
-//! Where a problem is: the line, the column and the table of a toml error, and which
-//! `LoadError` variant it is.
+//! Where a problem is: the line, the column, the table and the key of a toml error, found in
+//! the spans of the toml crate's own parse of the file (`Spans`), and which `LoadError`
+//! variant it is (from serde's error kinds: unknown field, missing field, unknown variant,
+//! invalid type).
 
 use crate::error::LoadError;
+use std::ops::Range;
 use std::path::Path;
+
+use ::toml::de::{DeTable, DeValue};
 
 /// 1-based line and column of a byte offset.
 pub(super) fn line_column(text: &str, offset: usize) -> (u32, u32) {
@@ -40,6 +45,94 @@ pub(super) fn first_line(s: &str) -> String {
     s.lines().next().unwrap_or("").trim().to_owned()
 }
 
+/// Where things are in the file, from the spans of the toml crate's own parse: every table
+/// (by its header) and every key with its value.
+struct Spans {
+    /// `(start of the header, name)` of every table, in file order.
+    tables: Vec<(usize, String)>,
+    /// `(span of the key and its value, table name, key)` of every key of a table (the keys of
+    /// an inline table count as the key that holds it).
+    keys: Vec<(Range<usize>, String, String)>,
+}
+
+impl Spans {
+    fn new(text: &str) -> Option<Self> {
+        let root = DeTable::parse(text).ok()?;
+        let mut spans = Self {
+            tables: Vec::new(),
+            keys: Vec::new(),
+        };
+        spans.table(text, root.get_ref(), None, "the top level");
+        spans.tables.sort_by_key(|(start, _)| *start);
+        Some(spans)
+    }
+
+    /// Records the keys of `table`, whose dotted path is `path` (`None` at the top level) and
+    /// whose name in messages is `name`.
+    fn table(&mut self, text: &str, table: &DeTable<'_>, path: Option<&str>, name: &str) {
+        for (key, value) in table {
+            let key_name = key.get_ref().to_string();
+            let dotted = path.map_or_else(|| key_name.clone(), |p| format!("{p}.{key_name}"));
+            let starts_with = |span: Range<usize>, c: char| {
+                text.get(span.start..).is_some_and(|t| t.starts_with(c))
+            };
+            let is_header = |span: Range<usize>| starts_with(span, '[');
+            match value.get_ref() {
+                // A table of its own (a header, or implied by a dotted header), not an inline
+                // `{ … }` value.
+                DeValue::Table(inner) if !starts_with(value.span(), '{') => {
+                    let inner_name = format!("[{dotted}]");
+                    if is_header(value.span()) {
+                        self.tables.push((value.span().start, inner_name.clone()));
+                    }
+                    self.table(text, inner, Some(&dotted), &inner_name);
+                }
+                DeValue::Array(items)
+                    if items.iter().any(|i| {
+                        matches!(i.get_ref(), DeValue::Table(_)) && is_header(i.span())
+                    }) =>
+                {
+                    for (n, item) in items.iter().enumerate() {
+                        if let DeValue::Table(inner) = item.get_ref() {
+                            let inner_name = format!("[[{dotted}]] #{}", n + 1);
+                            self.tables.push((item.span().start, inner_name.clone()));
+                            self.table(text, inner, Some(&dotted), &inner_name);
+                        }
+                    }
+                }
+                _ => {
+                    let span = key.span().start.min(value.span().start)..value.span().end;
+                    self.keys.push((span, name.to_owned(), key_name));
+                }
+            }
+        }
+    }
+
+    /// The table in force at byte `offset`: that of the last header at or before it.
+    fn table_at(&self, offset: usize) -> String {
+        self.tables
+            .iter()
+            .rfind(|(start, _)| *start <= offset)
+            .map_or_else(|| "the top level".to_owned(), |(_, name)| name.clone())
+    }
+
+    /// The key whose key or value holds byte `offset`, with where it starts.
+    fn key_at(&self, offset: usize) -> Option<(&str, usize)> {
+        self.keys
+            .iter()
+            .find(|(span, _, _)| span.contains(&offset))
+            .map(|(span, _, key)| (key.as_str(), span.start))
+    }
+
+    /// Where key `key` of table `table` starts.
+    fn find_key(&self, table: &str, key: &str) -> Option<usize> {
+        self.keys
+            .iter()
+            .find(|(_, t, k)| t == table && k == key)
+            .map(|(span, _, _)| span.start)
+    }
+}
+
 /// Byte offset of the end of the line holding `offset`.
 pub(super) fn end_of_line(text: &str, offset: usize) -> usize {
     let offset = offset.min(text.len());
@@ -51,41 +144,6 @@ pub(super) fn end_of_line(text: &str, offset: usize) -> usize {
 /// Strips a `#` comment (good enough for header lines).
 pub(super) fn uncomment(line: &str) -> &str {
     line.split('#').next().unwrap_or(line).trim()
-}
-
-/// The table header in force at byte `offset` (the header line itself counts):
-/// `[camera]`, `[materials.white]`, `[[shapes]] #2`, or `the top level`.
-pub(super) fn table_at(text: &str, offset: usize) -> String {
-    let before = text.get(..end_of_line(text, offset)).unwrap_or(text);
-    let header = before.lines().map(str::trim).rfind(|l| l.starts_with('['));
-    match header {
-        None => "the top level".to_owned(),
-        Some(h) => {
-            let h = uncomment(h);
-            if h.starts_with("[[") {
-                let n = before.lines().filter(|l| uncomment(l) == h).count();
-                format!("{h} #{n}")
-            } else {
-                h.to_owned()
-            }
-        }
-    }
-}
-
-/// The key on the line at byte `offset` (`albedo` in `albedo = "red"`), if any.
-pub(super) fn key_at(text: &str, offset: usize) -> Option<String> {
-    let start = text
-        .get(..offset.min(text.len()))
-        .and_then(|b| b.rfind('\n'))
-        .map_or(0, |i| i + 1);
-    let line = text
-        .get(start..)
-        .and_then(|l| l.lines().next())
-        .unwrap_or("");
-    match line.split_once('=') {
-        Some((k, _)) if !line.trim_start().starts_with('[') => Some(k.trim().to_owned()),
-        _ => None,
-    }
 }
 
 /// The lines of the table whose header (or any line) holds `offset`, with 0-based indices:
@@ -107,16 +165,10 @@ pub(super) fn section(text: &str, offset: usize) -> Vec<(usize, &str)> {
         .collect()
 }
 
-/// The line and column of `key = …` inside the table holding `offset`.
-pub(super) fn find_key(text: &str, offset: usize, key: &str) -> Option<(u32, u32)> {
-    section(text, offset).into_iter().find_map(|(i, l)| {
-        let (k, _) = l.split_once('=')?;
-        (k.trim() == key).then(|| (to_u32(i + 1), to_u32(l.len() - l.trim_start().len() + 1)))
-    })
-}
-
-/// For `invalid type: string "white", …`, the key in the table holding `offset` whose value
-/// is written `"white"` (serde does not name the key; this finds it for plain values).
+/// For `invalid type: string "white", …` inside a table that serde buffered (an internally
+/// tagged enum: `[materials.*]`, `[[shapes]]`, `[[lights]]`), whose error spans the whole
+/// table: the key whose value is written `"white"`. Serde names neither the key nor the span
+/// there, so this one case still reads the message.
 pub(super) fn find_key_by_value(
     text: &str,
     offset: usize,
@@ -165,13 +217,21 @@ pub(super) fn schema_error(path: &Path, text: &str, e: &::toml::de::Error) -> Lo
         }
         None => (None, None),
     };
-    let table = offset.map_or_else(|| "the scene".to_owned(), |o| table_at(text, o));
+    let spans = Spans::new(text);
+    let table = match (offset, &spans) {
+        (Some(o), Some(spans)) => spans.table_at(o),
+        _ => "the scene".to_owned(),
+    };
+    let at = |o: usize| {
+        let (l, c) = line_column(text, o);
+        (Some(l), Some(c))
+    };
     let path = path.to_path_buf();
     if let Some(rest) = message.strip_prefix("unknown field `")
         && let Some((key, rest)) = rest.split_once('`')
     {
-        let (line, column) = match offset.and_then(|o| find_key(text, o, key)) {
-            Some((l, c)) => (Some(l), Some(c)),
+        let (line, column) = match spans.as_ref().and_then(|s| s.find_key(&table, key)) {
+            Some(o) => at(o),
             None => (line, column),
         };
         let mut expected = expected_list(rest);
@@ -218,8 +278,12 @@ pub(super) fn schema_error(path: &Path, text: &str, e: &::toml::de::Error) -> Lo
         || message.starts_with("invalid length")
         || message.starts_with("invalid value")
     {
-        let (key, line, column) = match offset.and_then(|o| key_at(text, o)) {
-            Some(key) => (key, line, column),
+        let found = offset.and_then(|o| spans.as_ref()?.key_at(o).map(|(k, s)| (k.to_owned(), s)));
+        let (key, line, column) = match found {
+            Some((key, start)) => {
+                let (line, column) = at(start);
+                (key, line, column)
+            }
             None => match offset.and_then(|o| find_key_by_value(text, o, &message)) {
                 Some((key, l, c)) => (key, Some(l), Some(c)),
                 None => (String::new(), line, column),
