@@ -159,7 +159,10 @@ impl Bsdf {
                 reflectance,
                 roughness,
                 diffuse,
-            } => coupled_diffuse(wo, wi, reflectance, diffuse) + ggx_eval(wo, wi, roughness, reflectance),
+            } => {
+                coupled_diffuse(wo, wi, reflectance, diffuse)
+                    + ggx_eval(wo, wi, roughness, reflectance)
+            }
         }
     }
 

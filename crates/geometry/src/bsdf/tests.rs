@@ -110,7 +110,10 @@ fn white_furnace() {
             // With a diffuse base the albedo stays below 1 and above the specular part.
             let gd = bsdf(glossy(alpha, 0.45, 0.5));
             let e = albedo_by_sampling(&gd, wo, TransportMode::Radiance);
-            assert!(e <= 1.0 + 5e-3 && e > 0.45 * floor, "α {alpha} θ {theta}: {e}");
+            assert!(
+                e <= 1.0 + 5e-3 && e > 0.45 * floor,
+                "α {alpha} θ {theta}: {e}"
+            );
         }
     }
 }
@@ -130,10 +133,16 @@ fn glossy_over_diffuse_never_reflects_more_than_it_receives() {
                     let theta = 89.0 * (k as f32 + 0.5) / 32.0;
                     let wo = outgoing(&b, theta);
                     let e = albedo_by_samples(&b, wo, TransportMode::Radiance, 20_000);
-                    assert!(e <= 1.01, "α {alpha}, Ks {ks}, Kd {kd}, θ {theta}: albedo {e}");
+                    assert!(
+                        e <= 1.01,
+                        "α {alpha}, Ks {ks}, Kd {kd}, θ {theta}: albedo {e}"
+                    );
                     if alpha >= 0.3 && k % 8 == 0 {
                         let q = albedo_by_eval(&b, wo);
-                        assert!(q <= 1.01, "α {alpha}, Ks {ks}, Kd {kd}, θ {theta}: quadrature {q}");
+                        assert!(
+                            q <= 1.01,
+                            "α {alpha}, Ks {ks}, Kd {kd}, θ {theta}: quadrature {q}"
+                        );
                     }
                 }
             }
