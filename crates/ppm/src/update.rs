@@ -117,18 +117,12 @@ impl GatherStats {
             self.flux = add(self.flux, flux_new);
             return;
         }
-        if keep {
-            let n_next = n + hold_alpha * m;
-            let r_next = r * (n_next / (n + m)).sqrt();
-            let scale = (r_next * r_next) / (r * r);
-            self.photon_count = n_next;
-            self.radius = r_next;
-            self.flux = add(self.flux, flux_new).map(|c| c * scale);
-            return;
-        }
+        // A held slot shrinks by α_hold, and the floor applies only to a shrinking one.
+        let alpha = if keep { hold_alpha } else { alpha };
         let mut n_next = n + alpha * m;
         let mut r_next = r * (n_next / (n + m)).sqrt();
-        if let (FrequencyFloor::Clamp, FrequencyRadius::Predicted(r_freq)) = (floor, freq)
+        if let (false, FrequencyFloor::Clamp, FrequencyRadius::Predicted(r_freq)) =
+            (keep, floor, freq)
             && r_next < r_freq
         {
             r_next = r_freq;
