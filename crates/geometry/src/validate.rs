@@ -2,7 +2,8 @@
 //! finishes (`load::finish`, which reports a [`LoadError`] naming the file) and by
 //! `Scene::new` for descriptions built in code (a [`SceneError`]). What follows from these
 //! checks (finite positions, unit directions, non-negative colours, material indices in range)
-//! is what the rest of the crate relies on: `LightSampler::new` and the BVH build cannot fail.
+//! is what the rest of the crate relies on: the BVH build cannot fail, and `LightSampler::new`
+//! takes the [`Powered`] emitters that only [`emitters`] makes, so it cannot fail either.
 
 use std::f32::consts::PI;
 use std::fmt;
@@ -11,6 +12,8 @@ use std::path::Path;
 use glam::Vec3;
 
 use crate::description::{Cylinder, Light, Material, MaterialKind, SceneDescription};
+use crate::light::Emitters;
+use crate::sampling::Distribution1D;
 use crate::{LoadError, SceneError};
 
 /// One problem of a scene description.
@@ -25,6 +28,8 @@ pub(crate) enum Invalid {
         index: u32,
         count: usize,
     },
+    /// No light and no emitter has positive power (or every emitter has zero area).
+    NoPower,
 }
 
 impl fmt::Display for Invalid {
@@ -34,6 +39,10 @@ impl fmt::Display for Invalid {
             Self::MaterialIndex { what, index, count } => write!(
                 f,
                 "{what} refers to material {index} but there are {count} materials"
+            ),
+            Self::NoPower => write!(
+                f,
+                "no light: every light and emitter has zero power or zero area"
             ),
         }
     }
@@ -53,6 +62,11 @@ impl Invalid {
         let (key, message) = match self {
             Self::Value { key, message } => (key, message),
             Self::MaterialIndex { what, .. } => (what, message),
+            Self::NoPower => {
+                return LoadError::NoEmitter {
+                    path: path.to_path_buf(),
+                };
+            }
         };
         LoadError::InvalidValue {
             path: path.to_path_buf(),
@@ -75,8 +89,33 @@ impl Invalid {
                 index,
                 count,
             },
+            Self::NoPower => SceneError::NoLight { path },
         }
     }
+}
+
+/// Emitters of which at least one carries power, with the distribution that picks them by
+/// power; only [`emitters`] makes one.
+#[derive(Clone, Debug)]
+pub(crate) struct Powered {
+    emitters: Emitters,
+    distribution: Distribution1D,
+}
+
+impl Powered {
+    /// The emitters and the distribution over them.
+    pub(crate) fn into_parts(self) -> (Emitters, Distribution1D) {
+        (self.emitters, self.distribution)
+    }
+}
+
+/// The emitters, if some light or emitter has positive (finite) power.
+pub(crate) fn emitters(emitters: Emitters) -> Result<Powered, Invalid> {
+    let distribution = Distribution1D::new(&emitters.weights()).ok_or(Invalid::NoPower)?;
+    Ok(Powered {
+        emitters,
+        distribution,
+    })
 }
 
 /// Formats a vector as `[x, y, z]`.

@@ -23,6 +23,7 @@ use crate::{
         Distribution1D, concentric_disk, cosine_hemisphere, uniform_cone, uniform_sphere,
         uniform_triangle,
     },
+    validate::Powered,
 };
 
 #[cfg(test)]
@@ -157,10 +158,20 @@ pub struct LightSampler {
     sphere_emitter: Vec<u32>,
 }
 
-impl LightSampler {
-    /// Collects the emitters of a valid description (see `crate::validate`); `None` if none
-    /// has positive power.
-    pub(crate) fn new(desc: &SceneDescription, bounds: Aabb) -> Option<Self> {
+/// The emitters of a valid description (see `crate::validate`) and their powers, before
+/// [`crate::validate::emitters`] checks that some of them carry power.
+#[derive(Clone, Debug)]
+pub(crate) struct Emitters {
+    emitters: Vec<Emitter>,
+    powers: Vec<Rgb>,
+    triangle_emitter: Vec<u32>,
+    sphere_emitter: Vec<u32>,
+}
+
+impl Emitters {
+    /// Collects the lights and the emissive triangles and spheres of `desc`; `bounds` sizes the
+    /// disc of directional lights.
+    pub(crate) fn collect(desc: &SceneDescription, bounds: Aabb) -> Self {
         let mut emitters = Vec::new();
         for light in &desc.lights {
             match *light {
@@ -253,15 +264,43 @@ impl LightSampler {
             });
         }
         let powers: Vec<Rgb> = emitters.iter().map(Emitter::power).collect();
-        let weights: Vec<f64> = powers.iter().map(|&p| f64::from(luminance(p))).collect();
-        let distribution = Distribution1D::new(&weights)?;
-        Some(Self {
+        Self {
+            emitters,
+            powers,
+            triangle_emitter,
+            sphere_emitter,
+        }
+    }
+
+    /// The weights by which emitters are picked: the luminance of their power.
+    pub(crate) fn weights(&self) -> Vec<f64> {
+        self.powers
+            .iter()
+            .map(|&p| f64::from(luminance(p)))
+            .collect()
+    }
+}
+
+impl LightSampler {
+    /// The sampler over emitters that [`crate::validate::emitters`] found to carry power: it
+    /// cannot fail, the validation has built the distribution.
+    pub(crate) fn new(powered: Powered) -> Self {
+        let (
+            Emitters {
+                emitters,
+                powers,
+                triangle_emitter,
+                sphere_emitter,
+            },
+            distribution,
+        ) = powered.into_parts();
+        Self {
             emitters,
             powers,
             distribution,
             triangle_emitter,
             sphere_emitter,
-        })
+        }
     }
 
     /// Number of emitters (lights plus emissive triangles and spheres).

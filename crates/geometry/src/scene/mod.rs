@@ -145,8 +145,10 @@ impl Scene {
             }
         }
         let extra = description.triangles.iter().map(triangle_extra).collect();
-        let lights = LightSampler::new(&description, bounds)
-            .ok_or_else(|| SceneError::NoLight { path: source() })?;
+        let emitters =
+            crate::validate::emitters(crate::light::Emitters::collect(&description, bounds))
+                .map_err(|e| e.in_scene(&description.source))?;
+        let lights = LightSampler::new(emitters);
         let primitives =
             description.triangles.len() + description.spheres.len() + description.cylinders.len();
         if primitives >= crate::bvh::MAX_PRIMITIVES {

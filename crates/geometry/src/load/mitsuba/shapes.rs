@@ -1,0 +1,190 @@
+//! Shapes: their meshes, BSDFs and area emitters.
+
+use super::*;
+
+impl<'a> Importer<'a> {
+    /// The BSDF of a shape: a nested `<bsdf>`, or a `<ref>` to one. `None` if it has none.
+    pub(super) fn shape_bsdf(&self, shape: &'a Node) -> Result<Option<&'a Node>, LoadError> {
+        for child in &shape.children {
+            let target = match child.tag.as_str() {
+                "bsdf" => child,
+                "ref" => {
+                    let t = self.deref(child)?;
+                    if t.tag != "bsdf" {
+                        continue;
+                    }
+                    t
+                }
+                _ => continue,
+            };
+            return Ok(Some(target));
+        }
+        Ok(None)
+    }
+
+    /// The area emitter of a shape: a nested `<emitter>` or a `<ref>` to one.
+    pub(super) fn shape_emitter(&self, shape: &'a Node) -> Result<Option<&'a Node>, LoadError> {
+        for child in &shape.children {
+            let target = match child.tag.as_str() {
+                "emitter" => child,
+                "ref" => {
+                    let t = self.deref(child)?;
+                    if t.tag != "emitter" {
+                        continue;
+                    }
+                    t
+                }
+                _ => continue,
+            };
+            if target.attr("type") != Some("area") {
+                return Err(self.err(target, "a shape can only carry an area emitter"));
+            }
+            return Ok(Some(target));
+        }
+        Ok(None)
+    }
+
+    pub(super) fn shape(&mut self, node: &'a Node, index: usize) -> Result<(), LoadError> {
+        let label = node.label();
+        let ty = node.attr("type").unwrap_or("");
+        let bsdf = match self.shape_bsdf(node)? {
+            Some(b) => self.bsdf(b)?,
+            None => ConvertedBsdf {
+                name: "default".to_owned(),
+                kind: Some(MaterialKind::Diffuse {
+                    albedo: Rgb::splat(DEFAULT_REFLECTANCE),
+                }),
+            },
+        };
+        let Some(kind) = bsdf.kind else {
+            return Ok(());
+        };
+        let emitter = self.shape_emitter(node)?;
+        let (name, emission) = match emitter {
+            Some(e) => {
+                let radiance = self
+                    .colour(e, "radiance", SpectrumUse::Emission)?
+                    .ok_or_else(|| self.err(e, "an area emitter needs a radiance"))?;
+                let id = e
+                    .attr("id")
+                    .map_or_else(|| format!("shape{index}"), str::to_owned);
+                (format!("{}+{id}", bsdf.name), radiance)
+            }
+            None => (bsdf.name.clone(), Rgb::ZERO),
+        };
+        let material = self.builder.material(Material {
+            name,
+            kind,
+            emission,
+        });
+        let to_world = self.transform(node, "to_world")?;
+        let m = to_world.as_mat4();
+        let flip = self.boolean(node, "flip_normals")?.unwrap_or(false);
+        let face_normals = self.boolean(node, "face_normals")?.unwrap_or(false);
+        let mesh = match ty {
+            "obj" | "ply" | "serialized" => {
+                let file = self
+                    .string(node, "filename")?
+                    .ok_or_else(|| self.err(node, "needs a filename"))?;
+                let path = self.doc.resolve(node, file);
+                let wrap = |e: LoadError| self.err(node, e.to_string());
+                let mut mesh = match ty {
+                    "obj" => {
+                        let data = super::super::obj::load_obj(&path).map_err(wrap)?;
+                        let mut mesh = IndexedMesh::default();
+                        let mut all_normals = true;
+                        let mut normals = Vec::new();
+                        for t in &data.triangles {
+                            let base = mesh.positions.len() as u32;
+                            mesh.positions.extend_from_slice(&t.positions);
+                            match t.normals {
+                                Some(n) => normals.extend_from_slice(&n),
+                                None => all_normals = false,
+                            }
+                            mesh.indices.push([base, base + 1, base + 2]);
+                        }
+                        if all_normals && !data.triangles.is_empty() {
+                            mesh.normals = Some(normals);
+                        }
+                        mesh
+                    }
+                    "ply" => super::super::ply::load_ply(&path).map_err(wrap)?,
+                    _ => {
+                        let index = self.integer(node, "shape_index")?.unwrap_or(0);
+                        let index = usize::try_from(index)
+                            .map_err(|_| self.err(node, "shape_index must not be negative"))?;
+                        super::super::serialized::load_serialized(&path, index).map_err(wrap)?
+                    }
+                };
+                if face_normals {
+                    mesh.normals = None;
+                } else if mesh.normals.is_none() && ty != "obj" {
+                    mesh.compute_vertex_normals();
+                }
+                mesh
+            }
+            "rectangle" => IndexedMesh::rectangle(),
+            "cube" => IndexedMesh::cube(),
+            "disk" => {
+                self.builder.warn(format!(
+                    "{label}: the disk is tessellated into {} triangles",
+                    import::DISK_SEGMENTS
+                ));
+                IndexedMesh::disk()
+            }
+            "sphere" => {
+                let center = self
+                    .vector(node, "center")?
+                    .unwrap_or(DVec3::ZERO)
+                    .as_vec3();
+                let radius = self.float(node, "radius")?.unwrap_or(1.0) as f32;
+                if !(radius > 0.0 && radius.is_finite()) {
+                    return Err(self.err(node, format!("radius must be > 0, got {radius}")));
+                }
+                if flip {
+                    self.builder
+                        .warn(format!("{label}: flip_normals is ignored on a sphere"));
+                }
+                self.builder.sphere(center, radius, m, material, &label);
+                return Ok(());
+            }
+            "cylinder" => {
+                let p0 = self.vector(node, "p0")?.unwrap_or(DVec3::ZERO).as_vec3();
+                let p1 = self.vector(node, "p1")?.unwrap_or(DVec3::Z).as_vec3();
+                let radius = self.float(node, "radius")?.unwrap_or(1.0) as f32;
+                if !(radius > 0.0 && radius.is_finite()) || (p1 - p0).length() <= 0.0 {
+                    return Err(self.err(node, "a cylinder needs radius > 0 and p0 != p1"));
+                }
+                if flip {
+                    self.builder
+                        .warn(format!("{label}: flip_normals is ignored on a cylinder"));
+                }
+                let emissive = emission_of(&self.builder, material);
+                import::cylinder(&mut self.builder, p0, p1, radius, m, material, emissive);
+                return Ok(());
+            }
+            "shapegroup" | "instance" => {
+                self.builder
+                    .warn(format!("{label}: instancing is not supported; skipped"));
+                return Ok(());
+            }
+            other => {
+                return Err(self.err(node, format!("shape type \"{other}\" is not supported")));
+            }
+        };
+        let mut mesh = mesh;
+        if flip {
+            mesh.flip();
+        }
+        self.builder.mesh(&mesh, m, material);
+        Ok(())
+    }
+}
+
+/// Whether material `index` emits.
+fn emission_of(builder: &Builder, index: u32) -> bool {
+    builder
+        .materials
+        .get(index as usize)
+        .is_some_and(|m| m.emission.max_element() > 0.0)
+}
