@@ -11,7 +11,7 @@
 //! An edge shared by more than two triangles (not a manifold) is treated as a boundary, and a
 //! vertex with other than two boundary edges keeps its position (a corner).
 
-use std::collections::HashMap;
+use std::collections::BTreeMap;
 
 use glam::Vec3;
 
@@ -41,8 +41,8 @@ fn key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
 }
 
-fn edges_of(faces: &[[u32; 3]]) -> HashMap<(u32, u32), Edge> {
-    let mut edges: HashMap<(u32, u32), Edge> = HashMap::with_capacity(faces.len() * 3 / 2 + 1);
+fn edges_of(faces: &[[u32; 3]]) -> BTreeMap<(u32, u32), Edge> {
+    let mut edges: BTreeMap<(u32, u32), Edge> = BTreeMap::new();
     for f in faces {
         for k in 0..3 {
             let (a, b, c) = (f[k], f[(k + 1) % 3], f[(k + 2) % 3]);
@@ -60,7 +60,7 @@ fn edges_of(faces: &[[u32; 3]]) -> HashMap<(u32, u32), Edge> {
     edges
 }
 
-fn rings(positions: &[Vec3], edges: &HashMap<(u32, u32), Edge>) -> Rings {
+fn rings(positions: &[Vec3], edges: &BTreeMap<(u32, u32), Edge>) -> Rings {
     let n = positions.len();
     let mut r = Rings {
         sum: vec![Vec3::ZERO; n],
@@ -178,6 +178,31 @@ mod tests {
             [0, 3, 5],
         ];
         (p, f)
+    }
+
+    #[test]
+    fn subdivision_is_deterministic() {
+        // The neighbour sums are taken in a fixed edge order: the same mesh gives the same bits
+        // every time (a hash map's per-instance random order made the killeroo scenes render
+        // differently from run to run).
+        let (p, f) = octahedron();
+        let p: Vec<Vec3> = p
+            .iter()
+            .enumerate()
+            .map(|(i, v)| *v * (1.0 + 0.1 * i as f32) + Vec3::splat(0.013 * i as f32))
+            .collect();
+        let first = subdivide(&p, &f, 3);
+        for _ in 0..8 {
+            let again = subdivide(&p, &f, 3);
+            assert_eq!(again.indices, first.indices);
+            let bits = |m: &IndexedMesh| -> Vec<[u32; 3]> {
+                m.positions
+                    .iter()
+                    .map(|v| v.to_array().map(f32::to_bits))
+                    .collect()
+            };
+            assert_eq!(bits(&again), bits(&first));
+        }
     }
 
     #[test]
