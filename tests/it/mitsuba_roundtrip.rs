@@ -9,9 +9,8 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use geometry::{Film, Light, MaterialKind, Scene, SceneDescription};
+use geometry::{Light, MaterialKind, SceneDescription};
 use glam::Vec3;
-use ppm::{Method, RenderParams, Renderer};
 
 /// The Fresnel reflectance at normal incidence of ior 1.5 (the coat of Mitsuba's plastic as
 /// written here), ((1.5 − 1) / (1.5 + 1))².
@@ -411,21 +410,8 @@ fn assert_same(a: &SceneDescription, b: &SceneDescription, name: &str) {
 }
 
 /// A few path-traced passes at a small size.
-fn render(mut scene: SceneDescription) -> Vec<[f32; 3]> {
-    scene.film = Film {
-        width: 24,
-        height: 18,
-    };
-    let scene = Scene::new(scene).unwrap();
-    let mut params = RenderParams::preview();
-    params.method = Method::Path;
-    params.max_depth = 5;
-    params.seed = 7;
-    let mut renderer = Renderer::new(&scene, params).unwrap();
-    for _ in 0..4 {
-        renderer.iterate();
-    }
-    renderer.image()
+fn render(scene: SceneDescription) -> Vec<[f32; 3]> {
+    crate::path_image(scene, (24, 18), 7, 4)
 }
 
 /// The two images agree: the same pixels up to the rounding of the camera frame rebuilt from

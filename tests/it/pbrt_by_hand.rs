@@ -18,9 +18,8 @@
 
 use std::path::Path;
 
-use geometry::{Film, MaterialKind, Scene, SceneDescription};
+use geometry::{MaterialKind, SceneDescription};
 use glam::Vec3;
-use ppm::{Method, RenderParams, Renderer};
 
 /// floor.ply and plate1..4.ply, x negated and every face reversed.
 const OBJS: &[(&str, &str)] = &[
@@ -175,21 +174,8 @@ file = "floor.obj"
 material = "floor"
 "#;
 
-fn render(mut scene: SceneDescription) -> Vec<[f32; 3]> {
-    scene.film = Film {
-        width: 48,
-        height: 36,
-    };
-    let scene = Scene::new(scene).unwrap();
-    let mut params = RenderParams::preview();
-    params.method = Method::Path;
-    params.max_depth = 5;
-    params.seed = 3;
-    let mut renderer = Renderer::new(&scene, params).unwrap();
-    for _ in 0..8 {
-        renderer.iterate();
-    }
-    renderer.image()
+fn render(scene: SceneDescription) -> Vec<[f32; 3]> {
+    crate::path_image(scene, (48, 36), 3, 8)
 }
 
 #[test]

@@ -477,7 +477,7 @@ impl Setup<'_> {
     #[inline]
     pub(super) fn record_frequency_photon(
         &self,
-        spectrum: Option<Axes>,
+        spectrum: Option<Spectrum>,
         hit: &Hit,
         arrived_from: Vec3,
         lobe: MaterialLobe,
@@ -487,14 +487,14 @@ impl Setup<'_> {
         match spectrum {
             // A chunk stores at most PHOTON_CHUNK × max_depth ≤ 2²¹ records, so the index
             // fits (see `TagLayout`).
-            Some(axes) => {
+            Some(s) => {
                 let tag = tag_base | out.frequency.len() as u32;
                 out.frequency.push(FrequencyPhoton::new(
                     out.photons.len() as u32,
                     hit.curvature,
                     arrived_from.dot(hit.shading_normal).abs(),
                     lobe,
-                    arrived(axes),
+                    s,
                     &self.caps,
                 ));
                 tag
@@ -616,7 +616,7 @@ fn emitter_spectrum(shape: EmitterShape, caps: &Caps) -> Spectrum {
 /// The photon's field after scattering at `hit` into `sample.incoming` (the new travel
 /// direction): the two tangent axes of design §8.5 from the field it arrived with.
 pub(super) fn scatter_spectrum(
-    axes: Axes,
+    spectrum: Spectrum,
     hit: &Hit,
     arrived_from: Vec3,
     sample: &geometry::BsdfSample,
@@ -624,7 +624,6 @@ pub(super) fn scatter_spectrum(
     material: &geometry::Material,
     caps: &Caps,
 ) -> Axes {
-    let spectrum = arrived(axes);
     let normal = hit.shading_normal;
     let mu_i = f64::from(arrived_from.dot(normal).abs());
     let mu_o = f64::from(sample.incoming.dot(normal).abs());

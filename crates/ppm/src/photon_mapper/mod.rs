@@ -6,7 +6,7 @@
 //! 2. `index.rs`: the hash grid over the hitpoint spheres;
 //! 3. `photon_pass.rs`: trace photons in fixed chunks (`trace.rs`, one photon path) and gather
 //!    them into the hitpoints;
-//! 4. `update.rs`: fold the pass into R, N, τ with the keep-or-shrink rule.
+//! 4. `update.rs`: fold the pass into R, N, τ, shrinking held slots by α_hold instead of α.
 //!
 //! `frequency.rs` holds the whole frequency extension, which those phases call into.
 //! `stats.rs` holds what a pass reports. This file holds the state they share and the image.
@@ -47,7 +47,7 @@ struct Setup<'s> {
     scene: &'s Scene,
     params: RenderParams,
     caps: Caps,
-    /// The initial gather radius: the scale of the occlusion probe.
+    /// The initial gather radius R₀ (the largest kernel is [`Setup::kernel_max`]).
     kernel_scale: f64,
     width: u32,
     height: u32,

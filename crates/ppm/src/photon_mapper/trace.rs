@@ -6,7 +6,7 @@ use glam::Vec3;
 use photon::Photon;
 
 use super::Setup;
-use super::frequency::{FrequencyPhoton, scatter_spectrum};
+use super::frequency::{FrequencyPhoton, arrived, scatter_spectrum};
 use crate::rng::Sampler;
 
 /// Path depth from which Russian roulette may end a photon path.
@@ -77,13 +77,15 @@ impl Setup<'_> {
             if let Some(s) = spectrum.as_mut() {
                 *s = self.travel_spectrum(*s, &ray, &hit, &mut sampler);
             }
+            // The frequency photon's field where it lands: the sharper of its two axes.
+            let here = spectrum.map(arrived);
             let bsdf = Bsdf::new(material, &hit);
             // With direct lighting by light sampling, photons straight from an emitter are
             // already accounted for at the hitpoints.
             let counted_by_light_sampling = self.params.direct_lighting && depth == 0;
             if !bsdf.is_specular() && !counted_by_light_sampling {
                 let tag = self.record_frequency_photon(
-                    spectrum,
+                    here,
                     &hit,
                     incoming,
                     material.kind.lobe(),
@@ -149,8 +151,10 @@ impl Setup<'_> {
             if power == Rgb::ZERO || !power.is_finite() {
                 break;
             }
-            if let Some(s) = spectrum.as_mut() {
-                *s = scatter_spectrum(*s, &hit, incoming, &sample, &bsdf, material, &self.caps);
+            if let Some(s) = here {
+                spectrum = Some(scatter_spectrum(
+                    s, &hit, incoming, &sample, &bsdf, material, &self.caps,
+                ));
             }
             ray = hit.spawn_ray(sample.incoming);
         }
