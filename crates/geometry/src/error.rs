@@ -251,6 +251,15 @@ pub enum LoadError {
         /// The skipped emitters, e.g. `<emitter type="envmap">`.
         skipped: String,
     },
+    /// A texture image cannot be used: missing, unreadable, corrupt, of an unsupported format,
+    /// empty, too large or with NaN or infinite texels.
+    #[error("{}: {message}", path.display())]
+    Texture {
+        /// The image file.
+        path: PathBuf,
+        /// What is wrong, e.g. `texture has zero size (0x0)`.
+        message: String,
+    },
     /// An emissive material is used only by degenerate (zero-area) triangles.
     #[error("{}: emissive material {material:?} has zero area (all its triangles are degenerate)", path.display())]
     ZeroAreaEmitter {
@@ -324,6 +333,7 @@ impl LoadError {
             | Self::Xml { path, .. }
             | Self::Pbrt { path, .. }
             | Self::MeshFile { path, .. }
+            | Self::Texture { path, .. }
             | Self::NoSupportedEmitter { path, .. } => path,
         }
     }

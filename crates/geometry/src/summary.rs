@@ -41,6 +41,9 @@ pub struct SceneSummary {
     pub camera_framed: bool,
     /// Loader warnings.
     pub warnings: Vec<String>,
+    /// The texture images, once each (left out of snapshots when there are none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub textures: Vec<crate::texture::TextureSummary>,
 }
 
 /// Number of delta lights of each kind.
@@ -265,6 +268,7 @@ impl SceneDescription {
             degenerate_triangles: self.notes.degenerate_triangles,
             camera_framed: self.notes.camera_framed,
             warnings: self.notes.warnings.clone(),
+            textures: crate::texture::summarize(&self.materials),
         }
     }
 }
@@ -337,6 +341,26 @@ impl fmt::Display for SceneSummary {
                 write!(f, ", {} cylinders", m.cylinders)?;
             }
             writeln!(f, ")")?;
+        }
+        if !self.textures.is_empty() {
+            let bytes: usize = self.textures.iter().map(|t| t.bytes).sum();
+            writeln!(
+                f,
+                "textures   {} ({:.1} MiB)",
+                self.textures.len(),
+                bytes as f64 / f64::from(1 << 20)
+            )?;
+            for t in &self.textures {
+                writeln!(
+                    f,
+                    "  {} {}x{} {:.1} MiB ({})",
+                    t.file,
+                    t.resolution[0],
+                    t.resolution[1],
+                    t.bytes as f64 / f64::from(1 << 20),
+                    t.uses.join(", ")
+                )?;
+            }
         }
         if self.degenerate_triangles > 0 {
             writeln!(

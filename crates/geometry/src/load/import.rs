@@ -246,6 +246,7 @@ impl Builder {
             positions,
             normals,
             material,
+            uv: None,
         });
     }
 
