@@ -57,7 +57,8 @@ pub(crate) enum Command {
     ///
     /// The scene is reloaded from the path stored in the checkpoint. With --passes N the render
     /// continues to N passes in total, and the image is bit-for-bit that of an uninterrupted
-    /// N-pass run. The checkpoint file is updated after every pass.
+    /// N-pass run. The checkpoint file is updated during the render as `render --checkpoint`
+    /// does, and at exit.
     Resume(ResumeArgs),
     /// Compare two EXR images: RMSE, relative MSE and mean ratio of their RGB channels.
     Diff(DiffArgs),
@@ -107,7 +108,8 @@ pub(crate) struct RenderArgs {
         help_heading = "Output"
     )]
     pub(crate) aov: Vec<AovArg>,
-    /// Save the exact render state to this file after every pass and at exit (see `fppm resume`).
+    /// Save the exact render state to this file (zstd-compressed) after the first pass, then as
+    /// often as keeps writing under about 5 % of the render time, and at exit (see `fppm resume`).
     #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub(crate) checkpoint: Option<PathBuf>,
     #[command(flatten)]
@@ -231,6 +233,10 @@ pub(crate) struct RunArgs {
     /// Print one JSON object per pass and a final summary object on stdout.
     #[arg(long)]
     pub(crate) json: bool,
+    /// Refuse a render whose estimated memory exceeds this, e.g. 8G, 512M or none [default: 80 %
+    /// of physical memory].
+    #[arg(long, value_name = "SIZE")]
+    pub(crate) max_memory: Option<String>,
 }
 
 /// `fppm resume`.

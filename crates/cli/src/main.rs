@@ -16,6 +16,7 @@
 mod args;
 mod diff;
 mod duration;
+mod memory;
 mod output;
 mod render;
 mod settings;

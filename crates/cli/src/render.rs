@@ -21,6 +21,7 @@ static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 /// `fppm render` (and `fppm` alone, with `scene = None`).
 pub(crate) fn render(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Result<Outcome> {
     let job = settings::render_job(scene, args)?;
+    check_memory(&job)?;
     let scene = geometry::Scene::new(job.description.clone())?;
     in_pool(job.run.threads, || {
         let renderer = Renderer::new(&scene, job.params)
@@ -66,6 +67,7 @@ pub(crate) fn resume(args: &ResumeArgs) -> anyhow::Result<Outcome> {
         run,
         earlier_seconds: note.render_seconds,
     };
+    check_memory(&job)?;
     let scene = geometry::Scene::new(job.description.clone())?;
     in_pool(job.run.threads, || {
         let renderer = Renderer::restore(&scene, &bytes)
@@ -81,6 +83,17 @@ pub(crate) fn resume(args: &ResumeArgs) -> anyhow::Result<Outcome> {
         }
         drive(&job, renderer)
     })
+}
+
+/// Refuses a job whose estimated memory exceeds `--max-memory` (or its default).
+fn check_memory(job: &Job) -> anyhow::Result<()> {
+    let film = job.description.film;
+    job.run.max_memory.check(
+        film.width,
+        film.height,
+        &job.params,
+        job.checkpoint.is_some(),
+    )
 }
 
 /// Runs `f` in a rayon pool of `threads` threads, or in the global pool.
@@ -105,6 +118,7 @@ fn drive(job: &Job, mut renderer: Renderer<'_>) -> anyhow::Result<Outcome> {
     let first_pass = renderer.passes();
     let mut progress = Progress::new(job, first_pass);
     let mut last_write = Instant::now();
+    let mut checkpoints = CheckpointPace::default();
     loop {
         if INTERRUPTED.load(Ordering::SeqCst) {
             break;
@@ -117,8 +131,12 @@ fn drive(job: &Job, mut renderer: Renderer<'_>) -> anyhow::Result<Outcome> {
         let stats = renderer.iterate();
         let elapsed = start.elapsed();
         progress.pass(&renderer, &stats, elapsed);
-        if let Some(checkpoint) = &job.checkpoint {
+        if let Some(checkpoint) = &job.checkpoint
+            && checkpoints.due()
+        {
+            let clock = Instant::now();
             write_checkpoint(job, &renderer, checkpoint, elapsed)?;
+            checkpoints.written(clock.elapsed());
         }
         if let Some(every) = job.run.snapshot_every
             && last_write.elapsed() >= every
@@ -179,6 +197,28 @@ fn drive(job: &Job, mut renderer: Renderer<'_>) -> anyhow::Result<Outcome> {
     } else {
         Outcome::Done
     })
+}
+
+/// When to write the checkpoint during a render: after the first pass, then whenever the time
+/// since the last write is at least [`CheckpointPace::RATIO`] times what that write took, so
+/// that writing takes at most about 5 % of the render however large the state and however short
+/// the passes. A kill loses at most those passes; `fppm resume` redoes them bit for bit.
+#[derive(Default)]
+struct CheckpointPace {
+    last: Option<(Instant, Duration)>,
+}
+
+impl CheckpointPace {
+    const RATIO: u32 = 20;
+
+    fn due(&self) -> bool {
+        self.last
+            .is_none_or(|(at, took)| at.elapsed() >= took * Self::RATIO)
+    }
+
+    fn written(&mut self, took: Duration) {
+        self.last = Some((Instant::now(), took));
+    }
 }
 
 /// The first Ctrl-C asks the loop to stop after the current pass; a second one exits at once

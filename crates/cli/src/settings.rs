@@ -58,6 +58,7 @@ pub(crate) struct RunSettings {
     pub(crate) snapshot_every: Option<Duration>,
     pub(crate) quiet: bool,
     pub(crate) json: bool,
+    pub(crate) max_memory: crate::memory::Limit,
 }
 
 /// What a checkpoint's note records so that `fppm resume` can go on: stored as JSON.
@@ -201,6 +202,7 @@ pub(crate) fn run_settings(run: &RunArgs) -> anyhow::Result<RunSettings> {
         snapshot_every: run.snapshot_every,
         quiet: run.quiet,
         json: run.json,
+        max_memory: crate::memory::Limit::from_flag(run.max_memory.as_deref())?,
     })
 }
 

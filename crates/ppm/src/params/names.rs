@@ -102,8 +102,14 @@ pub const PARAMS: &[Param] = &[
             if n <= 0 {
                 return Err("must be positive".to_owned());
             }
-            p.photons_per_pass =
-                u32::try_from(n).map_err(|_| format!("is too large (at most {})", u32::MAX))?;
+            p.photons_per_pass = u32::try_from(n).map_err(|_| {
+                format!(
+                    "is too large: a pass of {n} photons would need about {:.1} TiB of photon buffers (at most {} photons per pass)",
+                    crate::MemoryEstimate::photon_bytes(u64::try_from(n).unwrap_or(0)) as f64
+                        / (1u64 << 40) as f64,
+                    u32::MAX
+                )
+            })?;
             Ok(())
         },
     },
@@ -449,13 +455,15 @@ fn parse_small(text: &str) -> Result<u32, String> {
     u32::try_from(n).map_err(|_| "is outside [1, 1024]".to_owned())
 }
 
-/// A whole number written as 200000, 200_000, 200k or 2M.
+/// A whole number written as 200000, 200_000, 200k, 2M or 1G.
 fn parse_count(text: &str) -> Result<i64, String> {
     let cleaned: String = text.chars().filter(|&c| c != '_').collect();
     let (digits, factor) = if let Some(d) = cleaned.strip_suffix(['k', 'K']) {
         (d, 1_000)
     } else if let Some(d) = cleaned.strip_suffix('M') {
         (d, 1_000_000)
+    } else if let Some(d) = cleaned.strip_suffix('G') {
+        (d, 1_000_000_000)
     } else {
         (cleaned.as_str(), 1)
     };
@@ -463,7 +471,7 @@ fn parse_count(text: &str) -> Result<i64, String> {
         .parse::<i64>()
         .ok()
         .and_then(|n| n.checked_mul(factor))
-        .ok_or_else(|| "is not a whole number such as 200000, 200_000, 200k or 2M".to_owned())
+        .ok_or_else(|| "is not a whole number such as 200000, 200_000, 200k, 2M or 1G".to_owned())
 }
 
 #[cfg(test)]

@@ -29,7 +29,7 @@ use rayon::prelude::*;
 use spectrum::Caps;
 
 pub(crate) use self::frequency::SlotFrequency;
-pub use self::stats::{MemoryUse, PassStats, PassTimings};
+pub use self::stats::{MemoryEstimate, MemoryUse, PassStats, PassTimings};
 use self::{frequency::FrequencyDeposits, index::Index, photon_pass::PhotonPass};
 use crate::params::{ParamError, RenderParams};
 use crate::renderer::Aov;

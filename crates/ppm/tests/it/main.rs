@@ -14,5 +14,6 @@ mod checkpoint;
 mod determinism;
 mod frequency;
 mod kernels;
+mod memory;
 mod statistics;
 mod support;
