@@ -163,6 +163,7 @@ fn drive(job: &Job, mut renderer: Renderer<'_>) -> anyhow::Result<Outcome> {
             "interrupted": interrupted,
             "passes": renderer.passes(),
             "photons_emitted": renderer.photons_emitted(),
+            "non_finite": progress.non_finite,
             "seconds": elapsed.as_secs_f64(),
             "total_seconds": seconds,
             "exr": job.outputs.exr,
@@ -175,6 +176,12 @@ fn drive(job: &Job, mut renderer: Renderer<'_>) -> anyhow::Result<Outcome> {
         let (width, height) = renderer.resolution();
         if interrupted {
             eprintln!("fppm: interrupted after pass {}", renderer.passes());
+        }
+        if progress.non_finite > 0 {
+            eprintln!(
+                "fppm: warning: {} NaN or infinite values were dropped before entering the image (per pass: `non_finite` in --json)",
+                progress.non_finite
+            );
         }
         eprintln!(
             "wrote {} ({width}x{height}, {} passes, {} photons, {})",
@@ -338,6 +345,8 @@ struct Progress {
     quiet: bool,
     json: bool,
     first_pass: u32,
+    /// NaN or infinite values dropped over the passes of this run.
+    non_finite: u64,
 }
 
 impl Progress {
@@ -360,11 +369,13 @@ impl Progress {
             quiet,
             json: job.run.json,
             first_pass,
+            non_finite: 0,
         }
     }
 
     fn pass(&mut self, renderer: &Renderer<'_>, stats: &PassStats, elapsed: Duration) {
         let passes = renderer.passes();
+        self.non_finite += stats.non_finite;
         if self.json {
             let line = serde_json::json!({
                 "event": "pass",
@@ -381,6 +392,7 @@ impl Progress {
                 "max_radius": finite_or_null(stats.max_radius),
                 "frequency_held": finite_or_null(stats.frequency_held),
                 "photons_stored": stats.photons_stored,
+                "non_finite": stats.non_finite,
                 "timings": {
                     "camera": stats.timings.camera,
                     "index": stats.timings.index,

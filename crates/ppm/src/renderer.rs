@@ -133,9 +133,10 @@ impl<'s> Renderer<'s> {
             Engine::Path(p) => {
                 let pass = p.passes;
                 let clock = std::time::Instant::now();
-                let paths = p.iterate();
+                let (paths, non_finite) = p.iterate();
                 let mut stats = PassStats::empty(pass);
                 stats.camera_paths = paths;
+                stats.non_finite = non_finite;
                 stats.timings.camera = clock.elapsed().as_secs_f64();
                 stats
             }

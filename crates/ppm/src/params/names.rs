@@ -525,10 +525,16 @@ mod tests {
             ("200_000", 200_000),
             ("200k", 200_000),
             ("2M", 2_000_000),
+            ("2G", 2_000_000_000),
         ] {
             assert_eq!(parse_count(text), Ok(n));
         }
-        assert!(parse_count("2G").is_err());
+        assert!(parse_count("2T").is_err());
+        let mut p = RenderParams::preview();
+        let Err(ParamError::Unreadable { problem, .. }) = p.set("photons_per_pass", "10G") else {
+            panic!("10G photons per pass accepted");
+        };
+        assert!(problem.contains("TiB of photon buffers"), "{problem}");
         let mut p = RenderParams::preview();
         assert!(matches!(
             p.set("photons_per_pass", "0"),

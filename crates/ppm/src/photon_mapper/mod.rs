@@ -268,7 +268,7 @@ impl<'s> PhotonMapper<'s> {
         let clock = Instant::now();
         let stochastic = self.setup.params.method.is_stochastic();
         let retrace = self.slots.is_empty() || stochastic;
-        self.camera_pass(retrace);
+        stats.non_finite += self.camera_pass(retrace);
         let grow = self.setup.params.growth_pass() == Some(self.pass);
         if grow {
             self.grow_kernels();

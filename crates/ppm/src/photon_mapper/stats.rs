@@ -29,6 +29,12 @@ pub struct PassStats {
     pub frequency_held: f64,
     /// Photons stored on non-specular surfaces this pass: the gather queries.
     pub photons_stored: u64,
+    /// Values dropped this pass because they were NaN or infinite where they would have entered
+    /// a sum: photon powers (the path ends), photon–hitpoint fluxes, directly seen emission and
+    /// camera weights (the visible point is dropped), path-tracer samples. Zero in a healthy
+    /// scene; frequency spectra never need it (their coefficients are clamped into the caps,
+    /// NaN included, when they are made).
+    pub non_finite: u64,
     /// Wall-clock time of each phase (the only field that differs between identical runs).
     pub timings: PassTimings,
 }
@@ -71,6 +77,7 @@ impl PassStats {
             max_radius: 0.0,
             frequency_held: 0.0,
             photons_stored: 0,
+            non_finite: 0,
             timings: PassTimings::default(),
         }
     }

@@ -19,6 +19,8 @@ pub(super) struct TracedPhotons {
     /// The frequency records of the chunk's frequency photons, in trace order.
     pub(super) frequency: Vec<FrequencyPhoton>,
     pub(super) frequency_photons: u64,
+    /// Photon paths ended because their power became NaN or infinite.
+    pub(super) non_finite: u64,
 }
 
 impl TracedPhotons {
@@ -27,6 +29,7 @@ impl TracedPhotons {
         self.photons.clear();
         self.frequency.clear();
         self.frequency_photons = 0;
+        self.non_finite = 0;
     }
 }
 
@@ -59,6 +62,10 @@ impl Setup<'_> {
             return;
         };
         let mut power = emission.power;
+        if !power.is_finite() {
+            out.non_finite += 1;
+            return;
+        }
         let mut ray = emission.ray();
         let mut spectrum = self.start_spectrum(index, emission.emitter);
         if spectrum.is_some() {
@@ -148,7 +155,11 @@ impl Setup<'_> {
                 None => 1.0,
             };
             power = new_power / survive;
-            if power == Rgb::ZERO || !power.is_finite() {
+            if !power.is_finite() {
+                out.non_finite += 1;
+                break;
+            }
+            if power == Rgb::ZERO {
                 break;
             }
             if let Some(s) = here {

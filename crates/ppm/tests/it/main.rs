@@ -15,5 +15,6 @@ mod determinism;
 mod frequency;
 mod kernels;
 mod memory;
+mod non_finite;
 mod statistics;
 mod support;
