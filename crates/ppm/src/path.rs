@@ -12,8 +12,6 @@ use crate::rng::Sampler;
 
 /// Pixels per parallel work item; fixed so the work split does not depend on the thread count.
 const PIXEL_CHUNK: usize = 256;
-/// Path depth from which Russian roulette may end a path.
-const ROULETTE_DEPTH: u32 = 3;
 
 /// Progressive path tracing: every pass adds `samples_per_pixel` paths to every pixel.
 pub(crate) struct PathTracer<'s> {
@@ -124,7 +122,7 @@ impl<'s> PathTracer<'s> {
                 break;
             };
             beta *= sample.weight;
-            if depth + 1 >= ROULETTE_DEPTH {
+            if depth + 1 >= self.params.rr_depth {
                 let survive = beta.max_element().min(1.0);
                 if survive <= 0.0 || u_roulette >= survive {
                     break;

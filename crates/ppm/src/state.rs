@@ -188,6 +188,7 @@ fn write_params(w: &mut Writer, p: &RenderParams) {
     w.f64(p.alpha);
     w.f64(p.initial_radius.unwrap_or(-1.0));
     w.u32(p.max_depth);
+    w.u32(p.rr_depth);
     w.u32(p.samples_per_pixel);
     w.u64(p.seed);
     w.f64(p.freq_fraction);
@@ -215,6 +216,7 @@ fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
     let alpha = r.f64()?;
     let initial_radius = r.f64()?;
     let max_depth = r.u32()?;
+    let rr_depth = r.u32()?;
     let samples_per_pixel = r.u32()?;
     let seed = r.u64()?;
     let freq_fraction = r.f64()?;
@@ -242,6 +244,7 @@ fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
         alpha,
         initial_radius: (initial_radius >= 0.0).then_some(initial_radius),
         max_depth,
+        rr_depth,
         samples_per_pixel,
         seed,
         freq_fraction,

@@ -384,11 +384,13 @@ fn version_0_6_names_are_upgraded() {
         .replace("name=\"to_world\"", "name=\"toWorld\"")
         .replace(
             "<sensor type=\"perspective\">",
-            "<integrator type=\"path\"><integer name=\"maxDepth\" value=\"4\"/></integrator>\n    <sensor type=\"perspective\">",
+            "<integrator type=\"path\"><integer name=\"maxDepth\" value=\"4\"/><integer name=\"rrDepth\" value=\"7\"/></integrator>\n    <sensor type=\"perspective\">",
         );
     let path = fixture("mitsuba_v06", &[("scene.xml", &old)]);
     let scene = load(&path).unwrap();
     assert_eq!(scene.render.get("max_depth"), Some("3"));
+    // Both renderers apply the roulette from the rr_depth-th bounce on: carried as is.
+    assert_eq!(scene.render.get("rr_depth"), Some("7"));
     assert_eq!(scene.camera.position, glam::Vec3::new(0.0, 0.0, 4.0));
 }
 

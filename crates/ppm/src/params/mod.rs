@@ -100,6 +100,11 @@ pub struct RenderParams {
     /// scattering and the camera path's specular bounces; the path tracer the bounces before
     /// an emitter is hit or sampled.
     pub max_depth: u32,
+    /// The bounce from which Russian roulette may end a path (a photon's, or the path
+    /// tracer's), ≥ 1: the first `rr_depth − 1` bounces always continue. Unbiased whatever the
+    /// value; smaller values end dim paths sooner (faster passes, more noise per path). The
+    /// Mitsuba importer carries the integrator's `rr_depth` here.
+    pub rr_depth: u32,
     /// Hitpoint slots per pixel (jittered; ≥ 1); for the path tracer, paths per pixel per pass.
     pub samples_per_pixel: u32,
     /// Seed of every random number.
@@ -216,6 +221,7 @@ impl RenderParams {
             alpha: 0.7,
             initial_radius: None,
             max_depth: 1024,
+            rr_depth: 3,
             samples_per_pixel: 1,
             seed: 0,
             freq_fraction: 0.1,
@@ -258,6 +264,9 @@ impl RenderParams {
         }
         if self.max_depth == 0 || self.max_depth > 1024 {
             return Err(out("max_depth", self.max_depth, "[1, 1024]"));
+        }
+        if self.rr_depth == 0 || self.rr_depth > 1024 {
+            return Err(out("rr_depth", self.rr_depth, "[1, 1024]"));
         }
         if self.samples_per_pixel == 0 || self.samples_per_pixel > 1024 {
             return Err(out("spp", self.samples_per_pixel, "[1, 1024]"));

@@ -315,6 +315,20 @@ pub const PARAMS: &[Param] = &[
         },
     },
     Param {
+        name: "rr_depth",
+        flag: "rr-depth",
+        help: "The bounce from which Russian roulette may end a path, in [1, 1024] [default: scene, else 3]; unbiased whatever the value",
+        kind: ParamKind::Value {
+            value_name: "N",
+            choices: &[],
+        },
+        get: |p| p.rr_depth.to_string(),
+        set: |p, v| {
+            p.rr_depth = parse_small(v)?;
+            Ok(())
+        },
+    },
+    Param {
         name: "spp",
         flag: "spp",
         help: "Hitpoints per pixel (paths per pixel per pass for --method path), in [1, 1024] [default: 1]",

@@ -9,9 +9,6 @@ use super::Setup;
 use super::frequency::{FrequencyPhoton, arrived, scatter_spectrum};
 use crate::rng::Sampler;
 
-/// Path depth from which Russian roulette may end a photon path.
-const ROULETTE_DEPTH: u32 = 3;
-
 /// Photons of one chunk, in trace order.
 #[derive(Default)]
 pub(super) struct TracedPhotons {
@@ -122,7 +119,7 @@ impl Setup<'_> {
             // leaves out there), so the roulette runs before the direction is drawn and a killed
             // photon costs no BSDF sample; elsewhere it needs the sampled weight. Either way q
             // is fixed before `u_roulette` is compared with it: unbiased.
-            let roulette = depth + 1 >= ROULETTE_DEPTH;
+            let roulette = depth + 1 >= self.params.rr_depth;
             let kill_probability = |scattered: Rgb| {
                 let ratio = luminance(scattered) / luminance(power).max(f32::MIN_POSITIVE);
                 (1.0 - ratio).max(0.0)
