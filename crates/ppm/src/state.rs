@@ -98,6 +98,9 @@ impl<'s> Renderer<'s> {
         w.u32(self.passes());
         let mut body = Writer::default();
         match &self.engine {
+            Engine::Photons(p) if p.params().method.is_pass_independent() => {
+                write_independent(&mut body, p);
+            }
             Engine::Photons(p) => write_photon_mapper(&mut body, p),
             Engine::Path(p) => {
                 body.u64(p.sum.len() as u64);
@@ -138,6 +141,10 @@ impl<'s> Renderer<'s> {
         // The columns can be no longer than those of a full film: a bound known before
         // anything is decompressed, so that no checkpoint, however made, makes us allocate more.
         let most = match &renderer.engine {
+            Engine::Photons(p) if header.params.method.is_pass_independent() => {
+                let (width, height) = renderer.resolution();
+                independent_body_bound(width as usize * height as usize, p.n_slots())
+            }
             Engine::Photons(p) => photon_mapper_body_bound(p.n_slots()),
             Engine::Path(p) => 8 + p.sum.len().saturating_mul(24),
         };
@@ -151,6 +158,9 @@ impl<'s> Renderer<'s> {
         }
         let mut r = Reader { rest: &body };
         match &mut renderer.engine {
+            Engine::Photons(p) if header.params.method.is_pass_independent() => {
+                read_independent(&mut r, p, header.passes)?;
+            }
             Engine::Photons(p) => read_photon_mapper(&mut r, p, header.passes)?,
             Engine::Path(p) => read_path_tracer(&mut r, p, header.passes)?,
         }
@@ -259,6 +269,72 @@ fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
         freq_pilot,
         freq_clear_cap,
     })
+}
+
+/// The most bytes [`write_independent`] writes.
+fn independent_body_bound(pixels: usize, n_slots: usize) -> usize {
+    8 + 8 + pixels.saturating_mul(48) + 8 + n_slots.saturating_mul(8)
+}
+
+/// The pass-independent estimator: its exact sums and its kernels (nothing else carries from
+/// pass to pass). Before the first pass (no kernels yet) both are empty.
+fn write_independent(w: &mut Writer, p: &PhotonMapper<'_>) {
+    let empty = crate::PassSums::default();
+    let sums = p.pass_sums().unwrap_or(&empty);
+    w.u64(sums.passes);
+    w.u64(sums.sums.len() as u64);
+    for s in &sums.sums {
+        for v in s {
+            w.bytes(&v.to_le_bytes());
+        }
+    }
+    let kernels = p.kernels().unwrap_or(&[]);
+    w.u64(kernels.len() as u64);
+    kernels.iter().for_each(|&r| w.f64(r));
+}
+
+fn read_independent(
+    r: &mut Reader<'_>,
+    p: &mut PhotonMapper<'_>,
+    passes: u32,
+) -> Result<(), StateError> {
+    let summed = r.u64()?;
+    let n = usize::try_from(r.u64()?).map_err(|_| StateError::Corrupt)?;
+    let mut sums = Vec::with_capacity(n.min(r.rest.len() / 48));
+    for _ in 0..n {
+        let mut s = [0i128; 3];
+        for v in &mut s {
+            *v = i128::from_le_bytes(r.array()?);
+        }
+        sums.push(s);
+    }
+    let k = usize::try_from(r.u64()?).map_err(|_| StateError::Corrupt)?;
+    let mut kernels = Vec::with_capacity(k.min(r.rest.len() / 8));
+    for _ in 0..k {
+        kernels.push(r.f64()?);
+    }
+    if k == 0 && n == 0 && summed == 0 {
+        return Ok(());
+    }
+    if k != p.n_slots()
+        || summed != u64::from(passes)
+        || !kernels.iter().all(|r| r.is_finite() && *r > 0.0)
+    {
+        return Err(StateError::Corrupt);
+    }
+    let pixels = p.n_slots() / p.params().samples_per_pixel as usize;
+    if n != pixels {
+        return Err(StateError::Corrupt);
+    }
+    p.set_independent(
+        kernels,
+        crate::PassSums {
+            passes: summed,
+            sums,
+        },
+        passes,
+    );
+    Ok(())
 }
 
 /// Bytes of a slot's record in [`write_photon_mapper`], with a spectrum.

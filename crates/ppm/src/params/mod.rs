@@ -23,17 +23,22 @@ pub enum Method {
     FreqPpm,
     /// SPPM with frequency-guided kernels.
     FreqSppm,
+    /// Pass-independent PPM (Knaus & Zwicker 2011) with per-slot kernels from a frequency
+    /// pilot: every pass is an image of its own, so passes can be split into work units and
+    /// merged exactly.
+    Appm,
     /// Unidirectional path tracing with next-event estimation and MIS: the reference.
     Path,
 }
 
 impl Method {
     /// Every method, in the order reports list them.
-    pub const ALL: [Method; 5] = [
+    pub const ALL: [Method; 6] = [
         Method::Ppm,
         Method::Sppm,
         Method::FreqPpm,
         Method::FreqSppm,
+        Method::Appm,
         Method::Path,
     ];
 
@@ -45,6 +50,7 @@ impl Method {
             Method::Sppm => "sppm",
             Method::FreqPpm => "freq",
             Method::FreqSppm => "freq-sppm",
+            Method::Appm => "appm",
             Method::Path => "path",
         }
     }
@@ -70,7 +76,13 @@ impl Method {
     /// Whether hitpoints are re-traced every pass (SPPM).
     #[must_use]
     pub fn is_stochastic(self) -> bool {
-        matches!(self, Method::Sppm | Method::FreqSppm)
+        matches!(self, Method::Sppm | Method::FreqSppm | Method::Appm)
+    }
+
+    /// Whether passes are independent images, summed exactly (`appm`).
+    #[must_use]
+    pub fn is_pass_independent(self) -> bool {
+        matches!(self, Method::Appm)
     }
 }
 
@@ -179,6 +191,20 @@ pub enum ParamError {
         value: String,
         /// What is wrong with it, e.g. `is not a number`.
         problem: String,
+    },
+    /// Kernels were given to a method whose passes are not independent.
+    #[error("{method} does not render independent passes (only appm does)")]
+    NotPassIndependent {
+        /// The method asked for.
+        method: Method,
+    },
+    /// The kernels of a pass-independent render are not one positive radius per slot.
+    #[error("the kernels hold {found} radii for {expected} hitpoint slots, or one is not positive")]
+    BadKernels {
+        /// Hitpoint slots of the film.
+        expected: usize,
+        /// Radii given.
+        found: usize,
     },
     /// The film has no pixels or more than the renderer can index.
     #[error(

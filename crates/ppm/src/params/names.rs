@@ -74,6 +74,10 @@ pub const PARAMS: &[Param] = &[
                 ),
                 ("freq-sppm", "SPPM with frequency-guided kernels"),
                 (
+                    "appm",
+                    "Pass-independent PPM (Knaus & Zwicker 2011), kernels from a frequency pilot: passes split into work units (fppm plan/unit/merge) and merge exactly",
+                ),
+                (
                     "path",
                     "Path tracing with next-event estimation: the reference",
                 ),
