@@ -12,7 +12,7 @@ use ppm::{PassStats, Renderer, StateHeader};
 
 use crate::args::{RenderArgs, ResumeArgs};
 use crate::duration;
-use crate::settings::{self, Budget, Job, Note};
+use crate::settings::{self, Budget, Job};
 use crate::{DEFAULT_SCENE_NAME, Outcome, usage};
 
 /// Set by the Ctrl-C handler; the loop stops after the current pass.
@@ -97,7 +97,7 @@ fn check_memory(job: &Job) -> anyhow::Result<()> {
 }
 
 /// Runs `f` in a rayon pool of `threads` threads, or in the global pool.
-fn in_pool<R: Send>(
+pub(crate) fn in_pool<R: Send>(
     threads: Option<usize>,
     f: impl FnOnce() -> anyhow::Result<R> + Send,
 ) -> anyhow::Result<R> {
@@ -302,20 +302,7 @@ fn write_checkpoint(
     path: &Path,
     elapsed: Duration,
 ) -> anyhow::Result<()> {
-    let film = job.description.film;
-    let note = Note {
-        scene: job.scene_path.clone(),
-        width: film.width,
-        height: film.height,
-        exr: settings::absolute(&job.outputs.exr),
-        png: settings::absolute(&job.outputs.png),
-        aovs: job.outputs.aovs.clone(),
-        exposure: job.outputs.tonemap.exposure,
-        tonemap: job.outputs.tonemap.curve,
-        passes: job.budget.passes,
-        time_seconds: job.budget.time.map(|t| t.as_secs_f64()),
-        render_seconds: job.earlier_seconds + elapsed.as_secs_f64(),
-    };
+    let note = settings::note_for(job, job.earlier_seconds + elapsed.as_secs_f64());
     let note = serde_json::to_string(&note)
         .context("internal error: cannot encode the checkpoint note")?;
     let bytes = renderer.save_state(&note);

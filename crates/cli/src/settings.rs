@@ -332,6 +332,24 @@ fn has_extension(path: &Path, extension: &str) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case(extension))
 }
 
+/// The note of a checkpoint (or plan) of `job` after `render_seconds` of rendering.
+pub(crate) fn note_for(job: &Job, render_seconds: f64) -> Note {
+    let film = job.description.film;
+    Note {
+        scene: job.scene_path.clone(),
+        width: film.width,
+        height: film.height,
+        exr: absolute(&job.outputs.exr),
+        png: absolute(&job.outputs.png),
+        aovs: job.outputs.aovs.clone(),
+        exposure: job.outputs.tonemap.exposure,
+        tonemap: job.outputs.tonemap.curve,
+        passes: job.budget.passes,
+        time_seconds: job.budget.time.map(|t| t.as_secs_f64()),
+        render_seconds,
+    }
+}
+
 /// The absolute form of a path (the file need not exist).
 pub(crate) fn absolute(path: &Path) -> PathBuf {
     std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf())

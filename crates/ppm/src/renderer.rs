@@ -147,6 +147,16 @@ impl<'s> Renderer<'s> {
         }
     }
 
+    /// The kernels r₀ of a pass-independent render (`appm`), once the pilot has run (or they
+    /// were given); `None` for the other methods.
+    #[must_use]
+    pub fn kernels(&self) -> Option<&[f64]> {
+        match &self.engine {
+            Engine::Photons(p) => p.kernels(),
+            Engine::Path(_) => None,
+        }
+    }
+
     /// The scene being rendered.
     #[must_use]
     pub fn scene(&self) -> &'s Scene {

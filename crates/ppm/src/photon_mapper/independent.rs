@@ -249,3 +249,134 @@ mod tests {
         assert!(!forward.add(&PassSums::new(3)));
     }
 }
+
+/// The magic of a work unit's part file.
+const PART_MAGIC: &[u8; 8] = b"FPPMPART";
+/// Version of the part layout.
+const PART_VERSION: u32 = 1;
+
+/// Why a part file could not be read.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum PartError {
+    /// Not a part file, or one of another version.
+    #[error("not an fppm work-unit part (or one of another version)")]
+    NotAPart,
+    /// The part belongs to another plan.
+    #[error("the part was rendered for another plan")]
+    OtherPlan,
+    /// Truncated, corrupt, or sized for another film.
+    #[error("the part is truncated or corrupt")]
+    Corrupt,
+}
+
+/// What a work unit hands back: its passes' exact sums, tied to its plan.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Part {
+    /// Fingerprint of the plan the unit rendered (any hash of the plan file the caller likes).
+    pub plan: u64,
+    /// The unit's index in the plan.
+    pub unit: u32,
+    /// First pass rendered (0-based).
+    pub first_pass: u32,
+    /// The sums of its passes (`sums.passes` of them, from `first_pass` on).
+    pub sums: PassSums,
+}
+
+impl Part {
+    /// The fingerprint of a plan file's bytes, which ties parts to their plan.
+    #[must_use]
+    pub fn plan_fingerprint(plan: &[u8]) -> u64 {
+        crate::state::fnv1a(crate::state::FNV_OFFSET, plan)
+    }
+
+    /// The part as bytes: a small header, the sums zstd-compressed, a checksum.
+    #[must_use]
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut body = Vec::with_capacity(self.sums.sums.len() * 48);
+        for s in &self.sums.sums {
+            for v in s {
+                body.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        let compressed = zstd::bulk::compress(&body, 1)
+            .unwrap_or_else(|e| unreachable!("zstd cannot compress a part held in memory: {e}"));
+        let mut out = Vec::with_capacity(compressed.len() + 64);
+        out.extend_from_slice(PART_MAGIC);
+        out.extend_from_slice(&PART_VERSION.to_le_bytes());
+        out.extend_from_slice(&self.plan.to_le_bytes());
+        out.extend_from_slice(&self.unit.to_le_bytes());
+        out.extend_from_slice(&self.first_pass.to_le_bytes());
+        out.extend_from_slice(&self.sums.passes.to_le_bytes());
+        out.extend_from_slice(&(self.sums.sums.len() as u64).to_le_bytes());
+        out.extend_from_slice(&compressed);
+        let checksum = crate::state::fnv1a(crate::state::FNV_OFFSET, &out);
+        out.extend_from_slice(&checksum.to_le_bytes());
+        out
+    }
+
+    /// Reads a part of the plan `plan` for a film of `pixels` pixels.
+    ///
+    /// # Errors
+    ///
+    /// [`PartError`] if the bytes are not a part, belong to another plan, or are corrupt.
+    pub fn from_bytes(bytes: &[u8], plan: u64, pixels: usize) -> Result<Self, PartError> {
+        const HEADER: usize = 8 + 4 + 8 + 4 + 4 + 8 + 8;
+        if bytes.len() < HEADER + 8
+            || &bytes[..8] != PART_MAGIC
+            || bytes[8..12] != PART_VERSION.to_le_bytes()
+        {
+            return Err(PartError::NotAPart);
+        }
+        let (payload, checksum) = bytes.split_at(bytes.len() - 8);
+        let stored = u64::from_le_bytes(checksum.try_into().map_err(|_| PartError::Corrupt)?);
+        if crate::state::fnv1a(crate::state::FNV_OFFSET, payload) != stored {
+            return Err(PartError::Corrupt);
+        }
+        let u64_at = |at: usize| {
+            payload
+                .get(at..at + 8)
+                .and_then(|b| b.try_into().ok())
+                .map(u64::from_le_bytes)
+                .ok_or(PartError::Corrupt)
+        };
+        let u32_at = |at: usize| {
+            payload
+                .get(at..at + 4)
+                .and_then(|b| b.try_into().ok())
+                .map(u32::from_le_bytes)
+                .ok_or(PartError::Corrupt)
+        };
+        if u64_at(12)? != plan {
+            return Err(PartError::OtherPlan);
+        }
+        let unit = u32_at(20)?;
+        let first_pass = u32_at(24)?;
+        let passes = u64_at(28)?;
+        if u64_at(36)? != pixels as u64 {
+            return Err(PartError::Corrupt);
+        }
+        let length = pixels.checked_mul(48).ok_or(PartError::Corrupt)?;
+        let body =
+            zstd::bulk::decompress(&payload[HEADER..], length).map_err(|_| PartError::Corrupt)?;
+        if body.len() != length {
+            return Err(PartError::Corrupt);
+        }
+        let sums = body
+            .chunks_exact(48)
+            .map(|pixel| {
+                let mut s = [0i128; 3];
+                for (c, bytes) in pixel.chunks_exact(16).enumerate() {
+                    s[c] = i128::from_le_bytes(bytes.try_into().unwrap_or([0; 16]));
+                }
+                s
+            })
+            .collect();
+        Ok(Self {
+            plan,
+            unit,
+            first_pass,
+            sums: PassSums { passes, sums },
+        })
+    }
+}

@@ -30,8 +30,8 @@ use rayon::prelude::*;
 use spectrum::Caps;
 
 pub(crate) use self::frequency::SlotFrequency;
-pub use self::independent::PassSums;
 pub(crate) use self::independent::pilot_kernels;
+pub use self::independent::{Part, PartError, PassSums};
 pub use self::stats::{MemoryEstimate, MemoryUse, PassStats, PassTimings};
 use self::{frequency::FrequencyDeposits, index::Index, photon_pass::PhotonPass};
 use crate::params::{ParamError, RenderParams};
