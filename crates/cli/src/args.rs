@@ -57,7 +57,8 @@ pub(crate) enum Command {
     ///
     /// The scene is reloaded from the path stored in the checkpoint. With --passes N the render
     /// continues to N passes in total, and the image is bit-for-bit that of an uninterrupted
-    /// N-pass run. The checkpoint file is updated after every pass.
+    /// N-pass run. The checkpoint file is updated during the render as `render --checkpoint`
+    /// does, and at exit.
     Resume(ResumeArgs),
     /// Compare two EXR images: RMSE, relative MSE and mean ratio of their RGB channels.
     Diff(DiffArgs),
@@ -68,12 +69,81 @@ pub(crate) enum Command {
         #[arg(value_name = "SCENE")]
         scene: Option<PathBuf>,
     },
+    /// Cut a pass-independent render (--method appm) into work units: runs the frequency
+    /// pilot once and writes JOB/plan.fppm.
+    ///
+    /// Each unit is then rendered by `fppm unit JOB --index I` (on any machine that sees JOB
+    /// and the scene, e.g. as a Slurm array task), and `fppm merge JOB` sums the parts. The
+    /// merged image is bit for bit that of `fppm render SCENE --method appm --passes N`, for
+    /// any number of units and any order of completion.
+    Plan(PlanArgs),
+    /// Render one work unit of a plan into JOB/unit-I.part.
+    Unit(UnitArgs),
+    /// Sum the parts of a plan into the image (EXR and PNG).
+    Merge(MergeArgs),
     /// Print a built-in scene as TOML: `fppm scene default > default.toml`.
     Scene {
         /// Which built-in scene.
         #[arg(value_enum)]
         name: BuiltinScene,
     },
+}
+
+/// `fppm plan`.
+#[derive(Debug, Args)]
+pub(crate) struct PlanArgs {
+    /// The scene file.
+    #[arg(value_name = "SCENE")]
+    pub(crate) scene: PathBuf,
+    /// The job folder (created if needed): the plan, then the units' parts, go there.
+    #[arg(short = 'o', long = "job", value_name = "JOB")]
+    pub(crate) job: PathBuf,
+    /// Passes of the whole render.
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    pub(crate) passes: Option<i64>,
+    /// Number of work units (each renders a contiguous share of the passes).
+    #[arg(long, value_name = "K", allow_negative_numbers = true)]
+    pub(crate) units: i64,
+    #[command(flatten)]
+    pub(crate) params: ParamArgs,
+    /// Film width in pixels (overrides the scene; alone, keeps the scene's aspect ratio).
+    #[arg(long, value_name = "PIXELS", help_heading = "Image")]
+    pub(crate) width: Option<u32>,
+    /// Film height in pixels (overrides the scene; alone, keeps the scene's aspect ratio).
+    #[arg(long, value_name = "PIXELS", help_heading = "Image")]
+    pub(crate) height: Option<u32>,
+    #[command(flatten)]
+    pub(crate) run: RunArgs,
+}
+
+/// `fppm unit`.
+#[derive(Debug, Args)]
+pub(crate) struct UnitArgs {
+    /// The job folder written by `fppm plan`.
+    #[arg(value_name = "JOB")]
+    pub(crate) job: PathBuf,
+    /// Which unit, from 0 [default: $SLURM_ARRAY_TASK_ID, else $JOB_COMPLETION_INDEX].
+    #[arg(long, value_name = "I", allow_negative_numbers = true)]
+    pub(crate) index: Option<i64>,
+    #[command(flatten)]
+    pub(crate) run: RunArgs,
+}
+
+/// `fppm merge`.
+#[derive(Debug, Args)]
+pub(crate) struct MergeArgs {
+    /// The job folder written by `fppm plan`, with the units' parts.
+    #[arg(value_name = "JOB")]
+    pub(crate) job: PathBuf,
+    #[command(flatten)]
+    pub(crate) output: OutputArgs,
+    /// Write the image of the parts that are there (the mean of their passes) and list the
+    /// missing units, instead of refusing.
+    #[arg(long)]
+    pub(crate) partial: bool,
+    /// Print nothing but errors and warnings.
+    #[arg(short, long)]
+    pub(crate) quiet: bool,
 }
 
 /// Built-in scenes.
@@ -107,7 +177,8 @@ pub(crate) struct RenderArgs {
         help_heading = "Output"
     )]
     pub(crate) aov: Vec<AovArg>,
-    /// Save the exact render state to this file after every pass and at exit (see `fppm resume`).
+    /// Save the exact render state to this file (zstd-compressed) after the first pass, then as
+    /// often as keeps writing under about 5 % of the render time, and at exit (see `fppm resume`).
     #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub(crate) checkpoint: Option<PathBuf>,
     #[command(flatten)]
@@ -231,6 +302,10 @@ pub(crate) struct RunArgs {
     /// Print one JSON object per pass and a final summary object on stdout.
     #[arg(long)]
     pub(crate) json: bool,
+    /// Refuse a render whose estimated memory exceeds this, e.g. 8G, 512M or none [default: 80 %
+    /// of physical memory].
+    #[arg(long, value_name = "SIZE")]
+    pub(crate) max_memory: Option<String>,
 }
 
 /// `fppm resume`.

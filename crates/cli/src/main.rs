@@ -16,9 +16,11 @@
 mod args;
 mod diff;
 mod duration;
+mod memory;
 mod output;
 mod render;
 mod settings;
+mod units;
 
 use std::io::Write;
 use std::path::Path;
@@ -90,6 +92,9 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Some(Command::Resume(args)) => render::resume(&args),
         Some(Command::Diff(args)) => diff::diff(&args),
         Some(Command::Info { scene }) => info(scene.as_deref()),
+        Some(Command::Plan(args)) => units::plan(args),
+        Some(Command::Unit(args)) => units::unit(&args),
+        Some(Command::Merge(args)) => units::merge(&args),
         Some(Command::Scene { name: _ }) => {
             print_stdout(DEFAULT_SCENE)?;
             Ok(Outcome::Done)

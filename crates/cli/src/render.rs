@@ -12,7 +12,7 @@ use ppm::{PassStats, Renderer, StateHeader};
 
 use crate::args::{RenderArgs, ResumeArgs};
 use crate::duration;
-use crate::settings::{self, Budget, Job, Note};
+use crate::settings::{self, Budget, Job};
 use crate::{DEFAULT_SCENE_NAME, Outcome, usage};
 
 /// Set by the Ctrl-C handler; the loop stops after the current pass.
@@ -21,6 +21,7 @@ static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 /// `fppm render` (and `fppm` alone, with `scene = None`).
 pub(crate) fn render(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Result<Outcome> {
     let job = settings::render_job(scene, args)?;
+    check_memory(&job)?;
     let scene = geometry::Scene::new(job.description.clone())?;
     in_pool(job.run.threads, || {
         let renderer = Renderer::new(&scene, job.params)
@@ -66,6 +67,7 @@ pub(crate) fn resume(args: &ResumeArgs) -> anyhow::Result<Outcome> {
         run,
         earlier_seconds: note.render_seconds,
     };
+    check_memory(&job)?;
     let scene = geometry::Scene::new(job.description.clone())?;
     in_pool(job.run.threads, || {
         let renderer = Renderer::restore(&scene, &bytes)
@@ -83,8 +85,19 @@ pub(crate) fn resume(args: &ResumeArgs) -> anyhow::Result<Outcome> {
     })
 }
 
+/// Refuses a job whose estimated memory exceeds `--max-memory` (or its default).
+fn check_memory(job: &Job) -> anyhow::Result<()> {
+    let film = job.description.film;
+    job.run.max_memory.check(
+        film.width,
+        film.height,
+        &job.params,
+        job.checkpoint.is_some(),
+    )
+}
+
 /// Runs `f` in a rayon pool of `threads` threads, or in the global pool.
-fn in_pool<R: Send>(
+pub(crate) fn in_pool<R: Send>(
     threads: Option<usize>,
     f: impl FnOnce() -> anyhow::Result<R> + Send,
 ) -> anyhow::Result<R> {
@@ -105,6 +118,7 @@ fn drive(job: &Job, mut renderer: Renderer<'_>) -> anyhow::Result<Outcome> {
     let first_pass = renderer.passes();
     let mut progress = Progress::new(job, first_pass);
     let mut last_write = Instant::now();
+    let mut checkpoints = CheckpointPace::default();
     loop {
         if INTERRUPTED.load(Ordering::SeqCst) {
             break;
@@ -117,8 +131,12 @@ fn drive(job: &Job, mut renderer: Renderer<'_>) -> anyhow::Result<Outcome> {
         let stats = renderer.iterate();
         let elapsed = start.elapsed();
         progress.pass(&renderer, &stats, elapsed);
-        if let Some(checkpoint) = &job.checkpoint {
+        if let Some(checkpoint) = &job.checkpoint
+            && checkpoints.due()
+        {
+            let clock = Instant::now();
             write_checkpoint(job, &renderer, checkpoint, elapsed)?;
+            checkpoints.written(clock.elapsed());
         }
         if let Some(every) = job.run.snapshot_every
             && last_write.elapsed() >= every
@@ -145,6 +163,7 @@ fn drive(job: &Job, mut renderer: Renderer<'_>) -> anyhow::Result<Outcome> {
             "interrupted": interrupted,
             "passes": renderer.passes(),
             "photons_emitted": renderer.photons_emitted(),
+            "non_finite": progress.non_finite,
             "seconds": elapsed.as_secs_f64(),
             "total_seconds": seconds,
             "exr": job.outputs.exr,
@@ -157,6 +176,12 @@ fn drive(job: &Job, mut renderer: Renderer<'_>) -> anyhow::Result<Outcome> {
         let (width, height) = renderer.resolution();
         if interrupted {
             eprintln!("fppm: interrupted after pass {}", renderer.passes());
+        }
+        if progress.non_finite > 0 {
+            eprintln!(
+                "fppm: warning: {} NaN or infinite values were dropped before entering the image (per pass: `non_finite` in --json)",
+                progress.non_finite
+            );
         }
         eprintln!(
             "wrote {} ({width}x{height}, {} passes, {} photons, {})",
@@ -179,6 +204,28 @@ fn drive(job: &Job, mut renderer: Renderer<'_>) -> anyhow::Result<Outcome> {
     } else {
         Outcome::Done
     })
+}
+
+/// When to write the checkpoint during a render: after the first pass, then whenever the time
+/// since the last write is at least [`CheckpointPace::RATIO`] times what that write took, so
+/// that writing takes at most about 5 % of the render however large the state and however short
+/// the passes. A kill loses at most those passes; `fppm resume` redoes them bit for bit.
+#[derive(Default)]
+struct CheckpointPace {
+    last: Option<(Instant, Duration)>,
+}
+
+impl CheckpointPace {
+    const RATIO: u32 = 20;
+
+    fn due(&self) -> bool {
+        self.last
+            .is_none_or(|(at, took)| at.elapsed() >= took * Self::RATIO)
+    }
+
+    fn written(&mut self, took: Duration) {
+        self.last = Some((Instant::now(), took));
+    }
 }
 
 /// The first Ctrl-C asks the loop to stop after the current pass; a second one exits at once
@@ -255,20 +302,7 @@ fn write_checkpoint(
     path: &Path,
     elapsed: Duration,
 ) -> anyhow::Result<()> {
-    let film = job.description.film;
-    let note = Note {
-        scene: job.scene_path.clone(),
-        width: film.width,
-        height: film.height,
-        exr: settings::absolute(&job.outputs.exr),
-        png: settings::absolute(&job.outputs.png),
-        aovs: job.outputs.aovs.clone(),
-        exposure: job.outputs.tonemap.exposure,
-        tonemap: job.outputs.tonemap.curve,
-        passes: job.budget.passes,
-        time_seconds: job.budget.time.map(|t| t.as_secs_f64()),
-        render_seconds: job.earlier_seconds + elapsed.as_secs_f64(),
-    };
+    let note = settings::note_for(job, job.earlier_seconds + elapsed.as_secs_f64());
     let note = serde_json::to_string(&note)
         .context("internal error: cannot encode the checkpoint note")?;
     let bytes = renderer.save_state(&note);
@@ -298,6 +332,8 @@ struct Progress {
     quiet: bool,
     json: bool,
     first_pass: u32,
+    /// NaN or infinite values dropped over the passes of this run.
+    non_finite: u64,
 }
 
 impl Progress {
@@ -320,11 +356,13 @@ impl Progress {
             quiet,
             json: job.run.json,
             first_pass,
+            non_finite: 0,
         }
     }
 
     fn pass(&mut self, renderer: &Renderer<'_>, stats: &PassStats, elapsed: Duration) {
         let passes = renderer.passes();
+        self.non_finite += stats.non_finite;
         if self.json {
             let line = serde_json::json!({
                 "event": "pass",
@@ -341,6 +379,7 @@ impl Progress {
                 "max_radius": finite_or_null(stats.max_radius),
                 "frequency_held": finite_or_null(stats.frequency_held),
                 "photons_stored": stats.photons_stored,
+                "non_finite": stats.non_finite,
                 "timings": {
                     "camera": stats.timings.camera,
                     "index": stats.timings.index,

@@ -58,6 +58,7 @@ pub(crate) struct RunSettings {
     pub(crate) snapshot_every: Option<Duration>,
     pub(crate) quiet: bool,
     pub(crate) json: bool,
+    pub(crate) max_memory: crate::memory::Limit,
 }
 
 /// What a checkpoint's note records so that `fppm resume` can go on: stored as JSON.
@@ -201,6 +202,7 @@ pub(crate) fn run_settings(run: &RunArgs) -> anyhow::Result<RunSettings> {
         snapshot_every: run.snapshot_every,
         quiet: run.quiet,
         json: run.json,
+        max_memory: crate::memory::Limit::from_flag(run.max_memory.as_deref())?,
     })
 }
 
@@ -328,6 +330,24 @@ fn param_message(e: &ParamError) -> String {
 fn has_extension(path: &Path, extension: &str) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case(extension))
+}
+
+/// The note of a checkpoint (or plan) of `job` after `render_seconds` of rendering.
+pub(crate) fn note_for(job: &Job, render_seconds: f64) -> Note {
+    let film = job.description.film;
+    Note {
+        scene: job.scene_path.clone(),
+        width: film.width,
+        height: film.height,
+        exr: absolute(&job.outputs.exr),
+        png: absolute(&job.outputs.png),
+        aovs: job.outputs.aovs.clone(),
+        exposure: job.outputs.tonemap.exposure,
+        tonemap: job.outputs.tonemap.curve,
+        passes: job.budget.passes,
+        time_seconds: job.budget.time.map(|t| t.as_secs_f64()),
+        render_seconds,
+    }
 }
 
 /// The absolute form of a path (the file need not exist).

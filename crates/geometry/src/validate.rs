@@ -109,8 +109,15 @@ impl Powered {
     }
 }
 
-/// The emitters, if some light or emitter has positive (finite) power.
+/// The emitters, if some light or emitter has positive (finite) power and none has a power
+/// beyond what 32-bit floats hold (its photons would carry infinite flux).
 pub(crate) fn emitters(emitters: Emitters) -> Result<Powered, Invalid> {
+    if let Some(i) = emitters.weights().iter().position(|w| w.is_infinite()) {
+        return Err(Invalid::value(
+            format!("emitter {i}"),
+            "has a power beyond the range of 32-bit floats (emission × area too large)",
+        ));
+    }
     let distribution = Distribution1D::new(&emitters.weights()).ok_or(Invalid::NoPower)?;
     Ok(Powered {
         emitters,

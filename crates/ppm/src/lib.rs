@@ -49,7 +49,8 @@ mod update;
 
 pub use crate::params::{Method, PARAMS, Param, ParamError, ParamKind, RenderParams, param};
 pub use crate::photon_mapper::{
-    MemoryUse, PassStats, PassTimings, auto_initial_radius, bytes_per_hitpoint,
+    MemoryEstimate, MemoryUse, Part, PartError, PassStats, PassSums, PassTimings,
+    auto_initial_radius, bytes_per_hitpoint,
 };
 pub use crate::pointwise::{pointwise_reference, pointwise_reference_paths};
 pub use crate::renderer::{Aov, Renderer};

@@ -12,8 +12,6 @@ use crate::rng::Sampler;
 
 /// Pixels per parallel work item; fixed so the work split does not depend on the thread count.
 const PIXEL_CHUNK: usize = 256;
-/// Path depth from which Russian roulette may end a path.
-const ROULETTE_DEPTH: u32 = 3;
 
 /// Progressive path tracing: every pass adds `samples_per_pixel` paths to every pixel.
 pub(crate) struct PathTracer<'s> {
@@ -39,32 +37,40 @@ impl<'s> PathTracer<'s> {
     }
 
     /// Adds one pass of `samples_per_pixel` paths per pixel; returns the number of paths.
-    pub(crate) fn iterate(&mut self) -> u64 {
+    pub(crate) fn iterate(&mut self) -> (u64, u64) {
         let pass = self.passes;
         let spp = self.params.samples_per_pixel;
         let this = &*self;
-        let samples: Vec<[f64; 3]> = (0..this.sum.len())
+        let samples: Vec<([f64; 3], u64)> = (0..this.sum.len())
             .into_par_iter()
             .with_min_len(PIXEL_CHUNK)
             .map(|pixel| {
                 let mut total = [0.0f64; 3];
+                let mut non_finite = 0;
                 for s in 0..spp {
                     let index = pixel as u64 * u64::from(spp) + u64::from(s);
                     let l = this.trace(pixel as u32, Sampler::new(this.params.seed, pass, index));
+                    // A NaN or infinite sample would stay in the pixel forever.
+                    if !l.is_finite() {
+                        non_finite += 1;
+                        continue;
+                    }
                     total[0] += f64::from(l.x);
                     total[1] += f64::from(l.y);
                     total[2] += f64::from(l.z);
                 }
-                total
+                (total, non_finite)
             })
             .collect();
-        for (sum, sample) in self.sum.iter_mut().zip(samples) {
+        let mut non_finite = 0;
+        for (sum, (sample, dropped)) in self.sum.iter_mut().zip(samples) {
+            non_finite += dropped;
             for c in 0..3 {
                 sum[c] += sample[c];
             }
         }
         self.passes += 1;
-        self.sum.len() as u64 * u64::from(spp)
+        (self.sum.len() as u64 * u64::from(spp), non_finite)
     }
 
     /// The mean radiance per pixel.
@@ -116,7 +122,7 @@ impl<'s> PathTracer<'s> {
                 break;
             };
             beta *= sample.weight;
-            if depth + 1 >= ROULETTE_DEPTH {
+            if depth + 1 >= self.params.rr_depth {
                 let survive = beta.max_element().min(1.0);
                 if survive <= 0.0 || u_roulette >= survive {
                     break;

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use crate::params::{Method, ParamError, RenderParams};
 use crate::path::PathTracer;
-use crate::photon_mapper::{MemoryUse, PassStats, PhotonMapper};
+use crate::photon_mapper::{MemoryUse, PassStats, PassSums, PhotonMapper};
 
 /// A progressive render in progress: create it, call [`Renderer::iterate`] as often as the
 /// budget allows, read [`Renderer::image`] (and [`Renderer::aov`]) at any time, and save or
@@ -86,6 +86,77 @@ impl<'s> Renderer<'s> {
         Ok(Self { scene, engine })
     }
 
+    /// The kernels r₀ of a pass-independent render (`appm`): the radius of each hitpoint slot
+    /// in its first pass, from the frequency pilot (`freq_pilot` passes of freq-sppm). A plan
+    /// computes them once, so that every work unit gathers with the same kernels.
+    ///
+    /// # Errors
+    ///
+    /// [`ParamError`] if a parameter is outside its domain or the film is too large.
+    pub fn pass_independent_kernels(
+        scene: &Scene,
+        params: RenderParams,
+    ) -> Result<Vec<f64>, ParamError> {
+        params.validate()?;
+        PhotonMapper::new(scene, params)?;
+        Ok(crate::photon_mapper::pilot_kernels(scene, params))
+    }
+
+    /// A pass-independent render (`params.method` must be `appm`) with the given kernels (from
+    /// [`Renderer::pass_independent_kernels`]), whose next pass is `first_pass` (0-based): a
+    /// work unit renders its passes and hands back [`Renderer::pass_sums`].
+    ///
+    /// # Errors
+    ///
+    /// [`ParamError`] if the method is not pass-independent, a parameter is outside its
+    /// domain, or the kernels are not one positive finite radius per hitpoint slot.
+    pub fn with_kernels(
+        scene: &'s Scene,
+        params: RenderParams,
+        kernels: Vec<f64>,
+        first_pass: u32,
+    ) -> Result<Self, ParamError> {
+        if !params.method.is_pass_independent() {
+            return Err(ParamError::NotPassIndependent {
+                method: params.method,
+            });
+        }
+        let mut mapper = PhotonMapper::new(scene, params)?;
+        if kernels.len() != mapper.n_slots() || !kernels.iter().all(|r| r.is_finite() && *r > 0.0) {
+            return Err(ParamError::BadKernels {
+                expected: mapper.n_slots(),
+                found: kernels.len(),
+            });
+        }
+        let film = scene.description().film;
+        let pixels = film.width as usize * film.height as usize;
+        mapper.set_independent(kernels, PassSums::new(pixels), first_pass);
+        Ok(Self {
+            scene,
+            engine: Engine::Photons(Box::new(mapper)),
+        })
+    }
+
+    /// The exact sums of the pass images of a pass-independent render (`appm`) so far; `None`
+    /// for the other methods, or before the first pass.
+    #[must_use]
+    pub fn pass_sums(&self) -> Option<&PassSums> {
+        match &self.engine {
+            Engine::Photons(p) => p.pass_sums(),
+            Engine::Path(_) => None,
+        }
+    }
+
+    /// The kernels r₀ of a pass-independent render (`appm`), once the pilot has run (or they
+    /// were given); `None` for the other methods.
+    #[must_use]
+    pub fn kernels(&self) -> Option<&[f64]> {
+        match &self.engine {
+            Engine::Photons(p) => p.kernels(),
+            Engine::Path(_) => None,
+        }
+    }
+
     /// The scene being rendered.
     #[must_use]
     pub fn scene(&self) -> &'s Scene {
@@ -133,9 +204,10 @@ impl<'s> Renderer<'s> {
             Engine::Path(p) => {
                 let pass = p.passes;
                 let clock = std::time::Instant::now();
-                let paths = p.iterate();
+                let (paths, non_finite) = p.iterate();
                 let mut stats = PassStats::empty(pass);
                 stats.camera_paths = paths;
+                stats.non_finite = non_finite;
                 stats.timings.camera = clock.elapsed().as_secs_f64();
                 stats
             }

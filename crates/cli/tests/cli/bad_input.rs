@@ -450,3 +450,70 @@ fn bad_textures_name_the_image() {
         &["scene.toml", "tex.png"],
     );
 }
+
+/// Absurd sizes are refused from the estimate, before anything is allocated: at once, with how
+/// much the render would need and which flag to lower.
+#[test]
+fn absurd_sizes_are_refused_at_once_with_the_flag_to_lower() {
+    let cases: [(&str, &[&str], &[&str]); 5] = [
+        (
+            "huge_film",
+            &["--width", "16384", "--height", "16384", "--spp", "1024"],
+            &[
+                "needs about",
+                "TiB",
+                "--width/--height or --spp",
+                "--max-memory",
+            ],
+        ),
+        (
+            "huge_photon_pass",
+            &["--photons-per-pass", "4000M"],
+            &["needs about", "TiB", "lower --photons-per-pass"],
+        ),
+        (
+            "photons_beyond_u32",
+            &["--photons-per-pass", "10G"],
+            &[
+                "--photons-per-pass 10G",
+                "too large",
+                "TiB of photon buffers",
+            ],
+        ),
+        (
+            "small_limit",
+            &["--max-memory", "1M"],
+            &["needs about", "more than the limit of 1.0 MiB"],
+        ),
+        (
+            "bad_limit",
+            &["--max-memory", "lots"],
+            &["--max-memory lots", "not a size"],
+        ),
+    ];
+    for (name, flags, needles) in cases {
+        let dir = temp_dir(name);
+        let clock = std::time::Instant::now();
+        check_in(
+            &dir,
+            &[&["render", CORNELL, "--passes", "1"], flags].concat(),
+            2,
+            needles,
+            &[],
+        );
+        // Generous for a loaded machine: allocating what these ask for would take minutes, or
+        // be killed.
+        assert!(
+            clock.elapsed() < std::time::Duration::from_secs(5),
+            "{name} took {:?}",
+            clock.elapsed()
+        );
+    }
+    // A limit the render fits in lets it run.
+    let dir = temp_dir("limit_that_fits");
+    fppm(
+        &dir,
+        &[&["render", CORNELL, "--max-memory", "2G"], TINY].concat(),
+    )
+    .ok();
+}

@@ -278,9 +278,11 @@ fn json_prints_one_object_per_pass_and_a_summary() {
         assert_eq!(line["photons_traced"], 4000);
         assert!(line["elapsed_seconds"].as_f64().unwrap() > 0.0);
         assert!(line["mean_radius"].as_f64().unwrap() > 0.0);
+        assert_eq!(line["non_finite"], 0);
     }
     let summary = &lines[3];
     assert_eq!(summary["event"], "done");
+    assert_eq!(summary["non_finite"], 0);
     assert_eq!(summary["passes"], 3);
     assert_eq!(summary["photons_emitted"], 12000);
     assert_eq!(summary["interrupted"], false);
@@ -391,4 +393,84 @@ fn snapshots_rewrite_the_outputs_during_the_render() {
 fn image_size(path: &std::path::Path) -> (u32, u32) {
     let img = image::open(path).unwrap();
     (img.width(), img.height())
+}
+
+/// A scene whose photons overflow f32 (huge emission, a nearly smooth glossy sphere): the
+/// dropped values are reported per pass and in the summary, with one warning, and the image is
+/// finite.
+#[test]
+fn dropped_non_finite_values_are_reported() {
+    let dir = temp_dir("non_finite");
+    let scene = r#"
+format = 1
+[camera]
+position = [0.0, 1.0, 3.0]
+look_at = [0.0, 1.0, 0.0]
+fov_y = 40.0
+[film]
+width = 16
+height = 16
+[materials.white]
+type = "diffuse"
+albedo = [0.8, 0.8, 0.8]
+[materials.shiny]
+type = "glossy"
+reflectance = [0.9, 0.9, 0.9]
+roughness = 1e-12
+[materials.lamp]
+type = "diffuse"
+albedo = [0.0, 0.0, 0.0]
+emission = [1e37, 1e37, 1e37]
+[[shapes]]
+type = "quad"
+corner = [-1.0, 0.0, 1.0]
+edge1 = [2.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, -2.0]
+material = "white"
+[[shapes]]
+type = "quad"
+corner = [-1.0, 1.99, -1.0]
+edge1 = [2.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, 2.0]
+material = "lamp"
+[[shapes]]
+type = "sphere"
+center = [0.0, 0.5, 0.0]
+radius = 0.4
+material = "shiny"
+"#;
+    std::fs::write(dir.join("hot.toml"), scene).unwrap();
+    let run = fppm(
+        &dir,
+        &[
+            "render",
+            "hot.toml",
+            "--photons-per-pass",
+            "5000",
+            "--passes",
+            "2",
+            "--json",
+        ],
+    )
+    .ok();
+    let lines: Vec<serde_json::Value> = run
+        .stdout
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let per_pass: u64 = lines[..2]
+        .iter()
+        .map(|l| l["non_finite"].as_u64().unwrap())
+        .sum();
+    assert!(per_pass > 0, "{}", run.stdout);
+    assert_eq!(lines[2]["non_finite"], per_pass);
+    assert!(
+        run.stderr.contains(&format!(
+            "warning: {per_pass} NaN or infinite values were dropped"
+        )),
+        "{}",
+        run.stderr
+    );
+    let image = read_exr(&dir.join("fppm.exr"));
+    assert!(image.rgb().iter().all(|v| v.is_finite()));
 }

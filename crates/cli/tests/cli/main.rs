@@ -10,6 +10,7 @@ mod bad_input;
 mod commands;
 mod flags;
 mod resume;
+mod units;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -214,3 +214,71 @@ fn ctrl_c_stops_after_the_pass_writes_everything_and_exits_130() {
         (passes + 1).to_string()
     );
 }
+
+/// `kill -9` in the middle of a render leaves the last checkpoint written (the writes are
+/// atomic, and spaced out so that they take little of the render): resuming it gives bit for bit
+/// the image of an uninterrupted render.
+#[test]
+fn kill_9_then_resume_gives_the_uninterrupted_image() {
+    let dir = temp_dir("kill_9");
+    let common = [
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--photons-per-pass",
+        "20000",
+        "--seed",
+        "3",
+    ];
+    let log = temp_dir("kill_9_log").join("stderr.txt");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_fppm"))
+        .args(["render", CORNELL])
+        .args(common)
+        .args(["--passes", "100000", "--checkpoint", "s.fppm", "--json"])
+        .current_dir(&dir)
+        .stdout(Stdio::piped())
+        .stderr(std::fs::File::create(&log).unwrap())
+        .spawn()
+        .unwrap();
+    let mut stdout = BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    let mut seen = 0;
+    for _ in 0..6 {
+        line.clear();
+        stdout.read_line(&mut line).unwrap();
+        let pass: serde_json::Value = serde_json::from_str(&line).unwrap();
+        seen = pass["passes"].as_u64().unwrap();
+    }
+    child.kill().unwrap();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), None, "killed by a signal");
+    assert!(
+        files(&dir).contains(&"s.fppm".to_owned()),
+        "{:?}",
+        files(&dir)
+    );
+    // Well past the kill, whatever pass the checkpoint holds.
+    let target = (seen + 40).to_string();
+    fppm(
+        &dir,
+        &["resume", "s.fppm", "--passes", &target, "-o", "resumed.exr"],
+    )
+    .ok();
+    fppm(
+        &dir,
+        &[
+            &["render", CORNELL][..],
+            &common,
+            &["--passes", &target, "-o", "full.exr"],
+        ]
+        .concat(),
+    )
+    .ok();
+    let (full, resumed) = (
+        read_exr(&dir.join("full.exr")),
+        read_exr(&dir.join("resumed.exr")),
+    );
+    assert_eq!(resumed.metadata["fppm.passes"], target);
+    assert_eq!(bits(&full), bits(&resumed));
+}

@@ -133,6 +133,8 @@ const EDITS: &[(&str, &str, &[&str])] = &[
         "albedo = \"white\"",
         &[
             "WrongType {",
+            "line: Some(10)",
+            "column: Some(1)",
             "table: \"[materials.white]\"",
             "key: \"albedo\"",
         ],
@@ -140,7 +142,43 @@ const EDITS: &[(&str, &str, &[&str])] = &[
     (
         "albedo = [0.8, 0.8, 0.8]",
         "albedo = [0.8, 0.8]",
-        &["WrongType {"],
+        &[
+            "WrongType {",
+            "line: Some(10)",
+            "table: \"[materials.white]\"",
+            "key: \"albedo\"",
+        ],
+    ),
+    // The same value twice in a table: the key at fault, not the first with that value.
+    (
+        "emission = [17.0, 12.0, 4.0]",
+        "emission = [0.0, 0.0]",
+        &[
+            "WrongType {",
+            "line: Some(15)",
+            "table: \"[materials.lamp]\"",
+            "key: \"emission\"",
+        ],
+    ),
+    (
+        "radius = 1.0",
+        "radius = \"big\"",
+        &[
+            "WrongType {",
+            "line: Some(20)",
+            "table: \"[[shapes]] #1\"",
+            "key: \"radius\"",
+        ],
+    ),
+    (
+        "edge2 = [0.0, 0.0, 0.4]",
+        "edge2 = true",
+        &[
+            "WrongType {",
+            "line: Some(27)",
+            "table: \"[[shapes]] #2\"",
+            "key: \"edge2\"",
+        ],
     ),
     (
         "fov_y = 39.3\n",

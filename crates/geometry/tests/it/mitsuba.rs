@@ -384,11 +384,13 @@ fn version_0_6_names_are_upgraded() {
         .replace("name=\"to_world\"", "name=\"toWorld\"")
         .replace(
             "<sensor type=\"perspective\">",
-            "<integrator type=\"path\"><integer name=\"maxDepth\" value=\"4\"/></integrator>\n    <sensor type=\"perspective\">",
+            "<integrator type=\"path\"><integer name=\"maxDepth\" value=\"4\"/><integer name=\"rrDepth\" value=\"7\"/></integrator>\n    <sensor type=\"perspective\">",
         );
     let path = fixture("mitsuba_v06", &[("scene.xml", &old)]);
     let scene = load(&path).unwrap();
     assert_eq!(scene.render.get("max_depth"), Some("3"));
+    // Both renderers apply the roulette from the rr_depth-th bounce on: carried as is.
+    assert_eq!(scene.render.get("rr_depth"), Some("7"));
     assert_eq!(scene.camera.position, glam::Vec3::new(0.0, 0.0, 4.0));
 }
 
@@ -502,5 +504,66 @@ fn spectral_eta_k_match_mitsuba() {
     assert!(
         (reflectance - expected).abs().max_element() < 1e-4,
         "{reflectance} vs {expected}"
+    );
+}
+
+/// `shapegroup` and `instance`: a group of one unit rectangle (its corners at x, y = ±1 in
+/// Mitsuba's convention), shifted inside the group by +1 in z, placed twice: translated by
+/// x = +5, and scaled by 2 then translated by y = −5. Mitsuba applies the member's `to_world`
+/// first, then the instance's; the corners follow by hand.
+#[test]
+fn instances_place_their_group_with_the_group_transform_first() {
+    let group = r#"<shape type="shapegroup" id="g">
+        <shape type="rectangle">
+            <ref id="white"/>
+            <transform name="to_world"><translate z="1"/></transform>
+        </shape>
+    </shape>
+    <shape type="instance">
+        <ref id="g"/>
+        <transform name="to_world"><translate x="5"/></transform>
+    </shape>
+    <shape type="instance">
+        <ref id="g"/>
+        <transform name="to_world"><scale value="2"/><translate y="-5"/></transform>
+    </shape>
+    <shape type="rectangle">"#;
+    let (scene, _) = load_edited("mitsuba_instances", "<shape type=\"rectangle\">", group);
+    let scene = scene.unwrap();
+    // The base rectangle, and two placed copies of the group's.
+    assert_eq!(scene.triangles.len(), 6);
+    let corners = |lo: [f32; 3], hi: [f32; 3]| {
+        scene.triangles.iter().any(|t| {
+            let min = t
+                .positions
+                .iter()
+                .fold(glam::Vec3::INFINITY, |a, &p| a.min(p));
+            let max = t
+                .positions
+                .iter()
+                .fold(glam::Vec3::NEG_INFINITY, |a, &p| a.max(p));
+            (min - glam::Vec3::from(lo)).abs().max_element() < 1e-5
+                && (max - glam::Vec3::from(hi)).abs().max_element() < 1e-5
+        })
+    };
+    // x in [4, 6], y in [−1, 1], z = 1.
+    assert!(corners([4.0, -1.0, 1.0], [6.0, 1.0, 1.0]));
+    // Scaled by 2 about the origin after the shift (z = 2), then y − 5: x in [−2, 2],
+    // y in [−7, −3].
+    assert!(corners([-2.0, -7.0, 2.0], [2.0, -3.0, 2.0]));
+    // Only the base scene's one material: the group's member shares it.
+    assert_eq!(scene.materials.len(), 1);
+}
+
+#[test]
+fn an_instance_of_what_is_not_a_shapegroup_is_refused() {
+    let bad = r#"<shape type="instance"><ref id="white"/></shape>
+    <shape type="rectangle">"#;
+    let (err, path) = load_edited("mitsuba_bad_instance", "<shape type=\"rectangle\">", bad);
+    let err = err.unwrap_err();
+    assert_names_file(&err, &path);
+    assert!(
+        err.to_string().contains("must refer to a shapegroup"),
+        "{err}"
     );
 }

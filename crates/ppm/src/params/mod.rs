@@ -23,17 +23,22 @@ pub enum Method {
     FreqPpm,
     /// SPPM with frequency-guided kernels.
     FreqSppm,
+    /// Pass-independent PPM (Knaus & Zwicker 2011) with per-slot kernels from a frequency
+    /// pilot: every pass is an image of its own, so passes can be split into work units and
+    /// merged exactly.
+    Appm,
     /// Unidirectional path tracing with next-event estimation and MIS: the reference.
     Path,
 }
 
 impl Method {
     /// Every method, in the order reports list them.
-    pub const ALL: [Method; 5] = [
+    pub const ALL: [Method; 6] = [
         Method::Ppm,
         Method::Sppm,
         Method::FreqPpm,
         Method::FreqSppm,
+        Method::Appm,
         Method::Path,
     ];
 
@@ -45,6 +50,7 @@ impl Method {
             Method::Sppm => "sppm",
             Method::FreqPpm => "freq",
             Method::FreqSppm => "freq-sppm",
+            Method::Appm => "appm",
             Method::Path => "path",
         }
     }
@@ -70,7 +76,13 @@ impl Method {
     /// Whether hitpoints are re-traced every pass (SPPM).
     #[must_use]
     pub fn is_stochastic(self) -> bool {
-        matches!(self, Method::Sppm | Method::FreqSppm)
+        matches!(self, Method::Sppm | Method::FreqSppm | Method::Appm)
+    }
+
+    /// Whether passes are independent images, summed exactly (`appm`).
+    #[must_use]
+    pub fn is_pass_independent(self) -> bool {
+        matches!(self, Method::Appm)
     }
 }
 
@@ -100,6 +112,11 @@ pub struct RenderParams {
     /// scattering and the camera path's specular bounces; the path tracer the bounces before
     /// an emitter is hit or sampled.
     pub max_depth: u32,
+    /// The bounce from which Russian roulette may end a path (a photon's, or the path
+    /// tracer's), ≥ 1: the first `rr_depth − 1` bounces always continue. Unbiased whatever the
+    /// value; smaller values end dim paths sooner (faster passes, more noise per path). The
+    /// Mitsuba importer carries the integrator's `rr_depth` here.
+    pub rr_depth: u32,
     /// Hitpoint slots per pixel (jittered; ≥ 1); for the path tracer, paths per pixel per pass.
     pub samples_per_pixel: u32,
     /// Seed of every random number.
@@ -175,6 +192,20 @@ pub enum ParamError {
         /// What is wrong with it, e.g. `is not a number`.
         problem: String,
     },
+    /// Kernels were given to a method whose passes are not independent.
+    #[error("{method} does not render independent passes (only appm does)")]
+    NotPassIndependent {
+        /// The method asked for.
+        method: Method,
+    },
+    /// The kernels of a pass-independent render are not one positive radius per slot.
+    #[error("the kernels hold {found} radii for {expected} hitpoint slots, or one is not positive")]
+    BadKernels {
+        /// Hitpoint slots of the film.
+        expected: usize,
+        /// Radii given.
+        found: usize,
+    },
     /// The film has no pixels or more than the renderer can index.
     #[error(
         "film of {width}x{height} pixels with {samples_per_pixel} samples per pixel is too large"
@@ -216,6 +247,7 @@ impl RenderParams {
             alpha: 0.7,
             initial_radius: None,
             max_depth: 1024,
+            rr_depth: 3,
             samples_per_pixel: 1,
             seed: 0,
             freq_fraction: 0.1,
@@ -258,6 +290,9 @@ impl RenderParams {
         }
         if self.max_depth == 0 || self.max_depth > 1024 {
             return Err(out("max_depth", self.max_depth, "[1, 1024]"));
+        }
+        if self.rr_depth == 0 || self.rr_depth > 1024 {
+            return Err(out("rr_depth", self.rr_depth, "[1, 1024]"));
         }
         if self.samples_per_pixel == 0 || self.samples_per_pixel > 1024 {
             return Err(out("spp", self.samples_per_pixel, "[1, 1024]"));

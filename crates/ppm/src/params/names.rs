@@ -74,6 +74,10 @@ pub const PARAMS: &[Param] = &[
                 ),
                 ("freq-sppm", "SPPM with frequency-guided kernels"),
                 (
+                    "appm",
+                    "Pass-independent PPM (Knaus & Zwicker 2011), kernels from a frequency pilot: passes split into work units (fppm plan/unit/merge) and merge exactly",
+                ),
+                (
                     "path",
                     "Path tracing with next-event estimation: the reference",
                 ),
@@ -102,8 +106,14 @@ pub const PARAMS: &[Param] = &[
             if n <= 0 {
                 return Err("must be positive".to_owned());
             }
-            p.photons_per_pass =
-                u32::try_from(n).map_err(|_| format!("is too large (at most {})", u32::MAX))?;
+            p.photons_per_pass = u32::try_from(n).map_err(|_| {
+                format!(
+                    "is too large: a pass of {n} photons would need about {:.1} TiB of photon buffers (at most {} photons per pass)",
+                    crate::MemoryEstimate::photon_bytes(u64::try_from(n).unwrap_or(0)) as f64
+                        / (1u64 << 40) as f64,
+                    u32::MAX
+                )
+            })?;
             Ok(())
         },
     },
@@ -309,6 +319,20 @@ pub const PARAMS: &[Param] = &[
         },
     },
     Param {
+        name: "rr_depth",
+        flag: "rr-depth",
+        help: "The bounce from which Russian roulette may end a path, in [1, 1024] [default: scene, else 3]; unbiased whatever the value",
+        kind: ParamKind::Value {
+            value_name: "N",
+            choices: &[],
+        },
+        get: |p| p.rr_depth.to_string(),
+        set: |p, v| {
+            p.rr_depth = parse_small(v)?;
+            Ok(())
+        },
+    },
+    Param {
         name: "spp",
         flag: "spp",
         help: "Hitpoints per pixel (paths per pixel per pass for --method path), in [1, 1024] [default: 1]",
@@ -449,13 +473,15 @@ fn parse_small(text: &str) -> Result<u32, String> {
     u32::try_from(n).map_err(|_| "is outside [1, 1024]".to_owned())
 }
 
-/// A whole number written as 200000, 200_000, 200k or 2M.
+/// A whole number written as 200000, 200_000, 200k, 2M or 1G.
 fn parse_count(text: &str) -> Result<i64, String> {
     let cleaned: String = text.chars().filter(|&c| c != '_').collect();
     let (digits, factor) = if let Some(d) = cleaned.strip_suffix(['k', 'K']) {
         (d, 1_000)
     } else if let Some(d) = cleaned.strip_suffix('M') {
         (d, 1_000_000)
+    } else if let Some(d) = cleaned.strip_suffix('G') {
+        (d, 1_000_000_000)
     } else {
         (cleaned.as_str(), 1)
     };
@@ -463,7 +489,7 @@ fn parse_count(text: &str) -> Result<i64, String> {
         .parse::<i64>()
         .ok()
         .and_then(|n| n.checked_mul(factor))
-        .ok_or_else(|| "is not a whole number such as 200000, 200_000, 200k or 2M".to_owned())
+        .ok_or_else(|| "is not a whole number such as 200000, 200_000, 200k, 2M or 1G".to_owned())
 }
 
 #[cfg(test)]
@@ -517,10 +543,16 @@ mod tests {
             ("200_000", 200_000),
             ("200k", 200_000),
             ("2M", 2_000_000),
+            ("2G", 2_000_000_000),
         ] {
             assert_eq!(parse_count(text), Ok(n));
         }
-        assert!(parse_count("2G").is_err());
+        assert!(parse_count("2T").is_err());
+        let mut p = RenderParams::preview();
+        let Err(ParamError::Unreadable { problem, .. }) = p.set("photons_per_pass", "10G") else {
+            panic!("10G photons per pass accepted");
+        };
+        assert!(problem.contains("TiB of photon buffers"), "{problem}");
         let mut p = RenderParams::preview();
         assert!(matches!(
             p.set("photons_per_pass", "0"),

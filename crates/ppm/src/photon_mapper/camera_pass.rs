@@ -41,6 +41,8 @@ struct CameraSample {
     /// Emission seen along the path (and direct lighting), already weighted by 1/spp.
     direct: Rgb,
     visible: Option<VisiblePoint>,
+    /// Values dropped for being NaN or infinite: the direct sum, the visible point's weight.
+    non_finite: u64,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -63,8 +65,9 @@ impl PhotonMapper<'_> {
     /// directly (and the direct lighting, if enabled) is always accumulated, so that emitters
     /// seen through a pixel are antialiased progressively even by PPM; the visible points
     /// replace the slots' only when `update_hitpoints` (the first pass, and every SPPM pass):
-    /// otherwise only the emission sums are updated, in place.
-    pub(super) fn camera_pass(&mut self, update_hitpoints: bool) {
+    /// otherwise only the emission sums are updated, in place. Returns how many values were
+    /// dropped for being NaN or infinite.
+    pub(super) fn camera_pass(&mut self, update_hitpoints: bool) -> u64 {
         let setup = &self.setup;
         let spp = setup.params.samples_per_pixel;
         let n_slots = setup.width as usize * setup.height as usize * spp as usize;
@@ -73,18 +76,21 @@ impl PhotonMapper<'_> {
         let pass = self.pass;
         if !update_hitpoints && !first {
             // Only the directly seen emission changes: accumulate it in place, in parallel.
-            self.direct
+            let non_finite = self
+                .direct
                 .par_iter_mut()
                 .enumerate()
                 .with_min_len(SLOT_CHUNK)
-                .for_each(|(slot, sum)| {
+                .map(|(slot, sum)| {
                     let sample = setup.trace_camera_path(slot as u32, pass);
                     for (c, sum) in sum.iter_mut().enumerate() {
                         *sum += f64::from(sample.direct[c]);
                     }
-                });
+                    sample.non_finite
+                })
+                .sum();
             self.camera_passes += 1;
-            return;
+            return non_finite;
         }
         let traced: Vec<CameraSample> = (0..n_slots)
             .into_par_iter()
@@ -96,7 +102,9 @@ impl PhotonMapper<'_> {
             self.direct = vec![[0.0; 3]; n_slots];
             self.photon_bounces = vec![NO_VISIBLE_POINT; n_slots];
         }
+        let mut non_finite = 0;
         for (slot, sample) in traced.into_iter().enumerate() {
+            non_finite += sample.non_finite;
             for c in 0..3 {
                 self.direct[slot][c] += f64::from(sample.direct[c]);
             }
@@ -135,6 +143,7 @@ impl PhotonMapper<'_> {
             }
         }
         self.camera_passes += 1;
+        non_finite
     }
 
     /// The camera path of `slot` in `pass` through specular bounces to its first non-specular
@@ -149,7 +158,8 @@ impl Setup<'_> {
         let weight_scale = 1.0 / self.params.samples_per_pixel as f32;
         let chain = self.camera_chain(slot, pass);
         let mut direct = chain.direct;
-        let visible = chain.end.map(|mut end| {
+        let mut non_finite = 0;
+        let visible = chain.end.and_then(|mut end| {
             let hit = &end.hit;
             if self.params.direct_lighting
                 && let Some(bsdf) = self.scene.bsdf(hit)
@@ -157,8 +167,13 @@ impl Setup<'_> {
                 direct += end.throughput
                     * self.direct_lighting(hit, &bsdf, end.outgoing, &mut end.sampler);
             }
+            // A NaN or infinite weight would spread into every photon this point gathers.
+            if !end.throughput.is_finite() {
+                non_finite += 1;
+                return None;
+            }
             let mu = end.outgoing.dot(hit.shading_normal).abs();
-            VisiblePoint {
+            Some(VisiblePoint {
                 position: hit.position,
                 shading_normal: hit.shading_normal,
                 geometric_normal: hit.geometric_normal,
@@ -170,11 +185,17 @@ impl Setup<'_> {
                 normal_distance: hit.t * mu,
                 mu_o: mu,
                 bounces: end.bounces,
-            }
+            })
         });
+        let mut direct = direct * weight_scale;
+        if !direct.is_finite() {
+            non_finite += 1;
+            direct = Rgb::ZERO;
+        }
         CameraSample {
-            direct: direct * weight_scale,
+            direct,
             visible,
+            non_finite,
         }
     }
 

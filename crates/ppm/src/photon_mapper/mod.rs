@@ -13,6 +13,7 @@
 
 mod camera_pass;
 mod frequency;
+mod independent;
 mod index;
 mod photon_pass;
 mod stats;
@@ -29,7 +30,9 @@ use rayon::prelude::*;
 use spectrum::Caps;
 
 pub(crate) use self::frequency::SlotFrequency;
-pub use self::stats::{MemoryUse, PassStats, PassTimings};
+pub(crate) use self::independent::pilot_kernels;
+pub use self::independent::{Part, PartError, PassSums};
+pub use self::stats::{MemoryEstimate, MemoryUse, PassStats, PassTimings};
 use self::{frequency::FrequencyDeposits, index::Index, photon_pass::PhotonPass};
 use crate::params::{ParamError, RenderParams};
 use crate::renderer::Aov;
@@ -74,6 +77,9 @@ pub(crate) struct PhotonMapper<'s> {
     photons: PhotonPass,
     /// The frequency deposits' buffers.
     frequency: FrequencyDeposits,
+    /// The pass-independent estimator's kernels and sums (`appm` only; set before its first
+    /// pass).
+    independent: Option<independent::Independent>,
 }
 
 /// `photon_bounces` of a slot without a visible point (budgets are below `max_depth` ≤ 1024).
@@ -162,6 +168,7 @@ impl<'s> PhotonMapper<'s> {
             index: Index::default(),
             photons: PhotonPass::default(),
             frequency: FrequencyDeposits::default(),
+            independent: None,
         })
     }
 
@@ -268,7 +275,13 @@ impl<'s> PhotonMapper<'s> {
         let clock = Instant::now();
         let stochastic = self.setup.params.method.is_stochastic();
         let retrace = self.slots.is_empty() || stochastic;
-        self.camera_pass(retrace);
+        if self.setup.params.method.is_pass_independent() && self.independent.is_none() {
+            let kernels = independent::pilot_kernels(self.setup.scene, self.setup.params);
+            let pixels = self.setup.width as usize * self.setup.height as usize;
+            self.set_independent(kernels, PassSums::new(pixels), self.pass);
+        }
+        stats.non_finite += self.camera_pass(retrace);
+        self.schedule_radii();
         let grow = self.setup.params.growth_pass() == Some(self.pass);
         if grow {
             self.grow_kernels();
@@ -284,7 +297,11 @@ impl<'s> PhotonMapper<'s> {
         let index = clock.elapsed().as_secs_f64() - camera;
         self.photon_pass(&mut stats);
         let photons_done = clock.elapsed().as_secs_f64();
-        self.update_hitpoints(&mut stats);
+        if self.independent.is_some() {
+            self.add_pass_image(&mut stats);
+        } else {
+            self.update_hitpoints(&mut stats);
+        }
         let timings = &mut stats.timings;
         timings.camera = camera;
         timings.index = index;
@@ -300,6 +317,9 @@ impl<'s> PhotonMapper<'s> {
     pub(crate) fn image(&self) -> Vec<[f32; 3]> {
         let spp = self.setup.params.samples_per_pixel as usize;
         let n_pixels = self.setup.width as usize * self.setup.height as usize;
+        if let Some(sums) = self.pass_sums() {
+            return sums.image();
+        }
         let mut image = vec![[0.0f32; 3]; n_pixels];
         if self.slots.is_empty() {
             return image;

@@ -2,6 +2,7 @@
 //! in Morton order and gathered into the hitpoints with `photon::gather_with`, which sums every
 //! hitpoint's contributions in photon order whatever the thread count.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 use geometry::{Bsdf, MaterialKind, Rgb};
@@ -99,6 +100,7 @@ impl PhotonMapper<'_> {
             });
         self.n_emitted += n;
         let frequency_photons = buffers.traced.iter().map(|c| c.frequency_photons).sum();
+        stats.non_finite += buffers.traced.iter().map(|c| c.non_finite).sum::<u64>();
         let trace_seconds = clock.elapsed().as_secs_f64();
         let uses_frequency = setup.params.method.uses_frequency();
         let frequency_clock = Instant::now();
@@ -132,6 +134,9 @@ impl PhotonMapper<'_> {
 
         let slots = &self.slots;
         let photon_bounces = &self.photon_bounces;
+        // Fluxes dropped for being NaN or infinite (a BSDF value at a grazing angle, say):
+        // rare, so an atomic counter costs nothing on the common path.
+        let non_finite_fluxes = AtomicU64::new(0);
         let flux = |photon: &Photon, entry: u32| {
             let slot = grid_slots[entry as usize] as usize;
             // Whether the photon, which the grid reported for `slot` (so it lies within the
@@ -156,7 +161,13 @@ impl PhotonMapper<'_> {
                     }
                     kind => Bsdf::from_normal(kind, normal, true).eval(outgoing, photon.incoming),
                 };
-                Some(f * photon.power * slots.weight()[slot])
+                let flux = f * photon.power * slots.weight()[slot];
+                if flux.is_finite() {
+                    Some(flux)
+                } else {
+                    non_finite_fluxes.fetch_add(1, Ordering::Relaxed);
+                    None
+                }
             })?
         };
         let add = |acc: &mut (u32, [f64; 3]), flux: Rgb| {
@@ -189,6 +200,7 @@ impl PhotonMapper<'_> {
             None
         };
         stats.photons_stored = buffers.sorted.len() as u64;
+        stats.non_finite += non_finite_fluxes.load(Ordering::Relaxed);
         for &(m, _) in &buffers.per_entry {
             stats.photons_deposited += u64::from(m);
             stats.hitpoints_hit += u64::from(m > 0);

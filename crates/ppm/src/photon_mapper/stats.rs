@@ -29,6 +29,12 @@ pub struct PassStats {
     pub frequency_held: f64,
     /// Photons stored on non-specular surfaces this pass: the gather queries.
     pub photons_stored: u64,
+    /// Values dropped this pass because they were NaN or infinite where they would have entered
+    /// a sum: photon powers (the path ends), photon–hitpoint fluxes, directly seen emission and
+    /// camera weights (the visible point is dropped), path-tracer samples. Zero in a healthy
+    /// scene; frequency spectra never need it (their coefficients are clamped into the caps,
+    /// NaN included, when they are made).
+    pub non_finite: u64,
     /// Wall-clock time of each phase (the only field that differs between identical runs).
     pub timings: PassTimings,
 }
@@ -71,6 +77,7 @@ impl PassStats {
             max_radius: 0.0,
             frequency_held: 0.0,
             photons_stored: 0,
+            non_finite: 0,
             timings: PassTimings::default(),
         }
     }
@@ -114,5 +121,88 @@ impl MemoryUse {
     #[must_use]
     pub fn total(&self) -> usize {
         self.persistent() + self.pass_hitpoint_buffers + self.pass_photon_buffers
+    }
+}
+
+/// What a render will hold, in bytes, estimated from the film size and the parameters before
+/// anything is allocated ([`MemoryEstimate::of`]), so that an absurd request is refused at
+/// once instead of swapping or being killed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MemoryEstimate {
+    /// Hitpoint slots with their grid and per-pass buffers (photon mappers), or the per-pixel
+    /// sums (path tracer). Set by the film size and `--spp`.
+    pub hitpoints: u64,
+    /// The photon buffers of a pass. Set by `--photons-per-pass`.
+    pub photons: u64,
+    /// The output image with its AOVs, as written.
+    pub film: u64,
+    /// A checkpoint while it is being written: the encoded state and its compressed copy.
+    pub checkpoint: u64,
+}
+
+/// Photon-buffer bytes per photon emitted in a pass: the stored photons (traced, Morton-sorted,
+/// their keys) and the gather's photon–hitpoint pairs. Measured 250–1,360 bytes on a caustic,
+/// a Cornell box and an indirectly lit room (0.7–4.8 stored photons per emitted one; see
+/// docs/reliability.md); the estimate takes the upper end, as deep paths store more.
+const PHOTON_BYTES: u64 = 1536;
+/// Hash-grid bytes per hitpoint slot (cells and entries; measured 35–40).
+const GRID_BYTES_PER_SLOT: u64 = 48;
+/// Per-pass buffers per slot: M and Φ per grid entry and the slot's entry (36 bytes), plus a
+/// frequency estimate per entry for the frequency-guided methods (32 more).
+const PASS_BYTES_PER_SLOT: u64 = 36;
+const FREQUENCY_PASS_BYTES_PER_SLOT: u64 = 32;
+/// Output bytes per pixel: the image, its copy in the EXR writer, the PNG, and up to ten AOV
+/// channels.
+const FILM_BYTES_PER_PIXEL: u64 = 12 + 12 + 4 + 40;
+/// Checkpoint bytes per slot while writing: the encoded record (at most 188) and its
+/// compressed copy (about a third).
+const CHECKPOINT_BYTES_PER_SLOT: u64 = 256;
+
+impl MemoryEstimate {
+    /// The estimate for a `width × height` film rendered with `params`.
+    #[must_use]
+    pub fn of(width: u32, height: u32, params: &crate::RenderParams) -> Self {
+        let pixels = u64::from(width) * u64::from(height);
+        let film = pixels.saturating_mul(FILM_BYTES_PER_PIXEL);
+        if !params.method.is_photon_mapper() {
+            let sums = pixels.saturating_mul(24);
+            return Self {
+                hitpoints: sums,
+                photons: 0,
+                film,
+                checkpoint: sums,
+            };
+        }
+        let slots = pixels.saturating_mul(u64::from(params.samples_per_pixel));
+        let per_slot = super::bytes_per_hitpoint() as u64
+            + GRID_BYTES_PER_SLOT
+            + PASS_BYTES_PER_SLOT
+            + if params.method.uses_frequency() {
+                FREQUENCY_PASS_BYTES_PER_SLOT
+            } else {
+                0
+            };
+        Self {
+            hitpoints: slots.saturating_mul(per_slot),
+            photons: Self::photon_bytes(u64::from(params.photons_per_pass)),
+            film,
+            checkpoint: slots.saturating_mul(CHECKPOINT_BYTES_PER_SLOT),
+        }
+    }
+
+    /// Photon-buffer bytes of a pass of `photons` photons.
+    #[must_use]
+    pub fn photon_bytes(photons: u64) -> u64 {
+        photons.saturating_mul(PHOTON_BYTES)
+    }
+
+    /// Everything, with or without a checkpoint being written.
+    #[must_use]
+    pub fn total(&self, with_checkpoint: bool) -> u64 {
+        let checkpoint = if with_checkpoint { self.checkpoint } else { 0 };
+        self.hitpoints
+            .saturating_add(self.photons)
+            .saturating_add(self.film)
+            .saturating_add(checkpoint)
     }
 }

@@ -9,9 +9,6 @@ use super::Setup;
 use super::frequency::{FrequencyPhoton, arrived, scatter_spectrum};
 use crate::rng::Sampler;
 
-/// Path depth from which Russian roulette may end a photon path.
-const ROULETTE_DEPTH: u32 = 3;
-
 /// Photons of one chunk, in trace order.
 #[derive(Default)]
 pub(super) struct TracedPhotons {
@@ -19,6 +16,8 @@ pub(super) struct TracedPhotons {
     /// The frequency records of the chunk's frequency photons, in trace order.
     pub(super) frequency: Vec<FrequencyPhoton>,
     pub(super) frequency_photons: u64,
+    /// Photon paths ended because their power became NaN or infinite.
+    pub(super) non_finite: u64,
 }
 
 impl TracedPhotons {
@@ -27,6 +26,7 @@ impl TracedPhotons {
         self.photons.clear();
         self.frequency.clear();
         self.frequency_photons = 0;
+        self.non_finite = 0;
     }
 }
 
@@ -59,6 +59,10 @@ impl Setup<'_> {
             return;
         };
         let mut power = emission.power;
+        if !power.is_finite() {
+            out.non_finite += 1;
+            return;
+        }
         let mut ray = emission.ray();
         let mut spectrum = self.start_spectrum(index, emission.emitter);
         if spectrum.is_some() {
@@ -115,7 +119,7 @@ impl Setup<'_> {
             // leaves out there), so the roulette runs before the direction is drawn and a killed
             // photon costs no BSDF sample; elsewhere it needs the sampled weight. Either way q
             // is fixed before `u_roulette` is compared with it: unbiased.
-            let roulette = depth + 1 >= ROULETTE_DEPTH;
+            let roulette = depth + 1 >= self.params.rr_depth;
             let kill_probability = |scattered: Rgb| {
                 let ratio = luminance(scattered) / luminance(power).max(f32::MIN_POSITIVE);
                 (1.0 - ratio).max(0.0)
@@ -148,7 +152,11 @@ impl Setup<'_> {
                 None => 1.0,
             };
             power = new_power / survive;
-            if power == Rgb::ZERO || !power.is_finite() {
+            if !power.is_finite() {
+                out.non_finite += 1;
+                break;
+            }
+            if power == Rgb::ZERO {
                 break;
             }
             if let Some(s) = here {

@@ -57,3 +57,46 @@ fn converge_to_the_path_tracer(name: &str) {
         );
     }
 }
+
+/// Russian roulette from the first bounce or from the eighth changes the noise, not the image:
+/// means agree with the default's within 1 % for the path tracer and a photon mapper, and
+/// earlier roulette ends more paths (fewer photons stored per pass).
+#[test]
+fn the_roulette_depth_changes_noise_not_the_mean() {
+    let scene = cornell("CornellBox-Original.obj", 24, 24);
+    let mut reference = params(Method::Path, 1);
+    reference.samples_per_pixel = 128;
+    let reference_mean = mean(&render(&scene, reference, 4));
+    for rr_depth in [1, 8] {
+        let mut path = reference;
+        path.rr_depth = rr_depth;
+        let ratio = mean(&render(&scene, path, 4)) / reference_mean;
+        assert!(
+            (ratio - 1.0).abs() < 0.01,
+            "path, rr_depth {rr_depth}: {ratio}"
+        );
+    }
+    let stored = |rr_depth: u32| {
+        let mut p = params(Method::Sppm, 20_000);
+        p.rr_depth = rr_depth;
+        p.samples_per_pixel = 4;
+        p.initial_radius = Some(0.04);
+        let mut renderer = ppm::Renderer::new(&scene, p).unwrap();
+        let stored: u64 = (0..32).map(|_| renderer.iterate().photons_stored).sum();
+        (mean(&renderer.image()), stored)
+    };
+    let (default_mean, default_stored) = stored(3);
+    for rr_depth in [1, 8] {
+        let (m, n) = stored(rr_depth);
+        let ratio = m / default_mean;
+        assert!(
+            (ratio - 1.0).abs() < 0.01,
+            "sppm, rr_depth {rr_depth}: {ratio}"
+        );
+        assert_eq!(
+            n < default_stored,
+            rr_depth < 3,
+            "sppm, rr_depth {rr_depth}: {n} photons stored, {default_stored} by default"
+        );
+    }
+}

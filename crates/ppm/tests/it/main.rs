@@ -14,5 +14,7 @@ mod checkpoint;
 mod determinism;
 mod frequency;
 mod kernels;
+mod memory;
+mod non_finite;
 mod statistics;
 mod support;

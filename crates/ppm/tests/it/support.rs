@@ -59,5 +59,10 @@ pub(crate) fn rmse(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
 }
 
 /// The methods that trace photons.
-pub(crate) const PHOTON_METHODS: [Method; 4] =
-    [Method::Ppm, Method::Sppm, Method::FreqPpm, Method::FreqSppm];
+pub(crate) const PHOTON_METHODS: [Method; 5] = [
+    Method::Ppm,
+    Method::Sppm,
+    Method::FreqPpm,
+    Method::FreqSppm,
+    Method::Appm,
+];

@@ -11,7 +11,7 @@
 //! - colours given by a texture stand in as a constant (`Importer::texture_standin`); environment
 //!   emitters are skipped with a warning ([`super::import::environment_light_standin`]);
 //! - the integrator's `max_depth` (longest path in segments, Mitsuba's convention) becomes
-//!   fppm's `max_depth` (scattering events) minus one.
+//!   fppm's `max_depth` (scattering events) minus one; its `rr_depth` is carried as is.
 
 mod bsdfs;
 mod emitters;

@@ -144,10 +144,16 @@ impl<'a> Importer<'a> {
                 )),
             }
         }
-        if let Some(rr) = self.integer(node, "rr_depth")? {
-            self.builder.warn(format!(
-                "{label}: rr_depth {rr} is not carried; fppm's Russian roulette starts at its own depth (unbiased either way)"
-            ));
+        // Mitsuba's `depth >= rr_depth` test runs at the rr_depth-th BSDF sample: fppm's
+        // `rr_depth` counts bounces the same way.
+        match self.integer(node, "rr_depth")? {
+            Some(rr) if rr >= 1 => {
+                render.set("rr_depth", u32::try_from(rr).unwrap_or(u32::MAX).min(1024));
+            }
+            Some(rr) => self.builder.warn(format!(
+                "{label}: rr_depth {rr} is not a bounce; fppm's default is used"
+            )),
+            None => {}
         }
         if self.boolean(node, "hide_emitters")? == Some(true) {
             self.builder

@@ -44,9 +44,29 @@ impl<'a> Importer<'a> {
         Ok(None)
     }
 
+    /// A shape at the top level of the scene.
     pub(super) fn shape(&mut self, node: &'a Node, index: usize) -> Result<(), LoadError> {
+        self.placed_shape(node, index, DMat4::IDENTITY, 0)
+    }
+
+    /// A shape whose `to_world` is applied after `parent` (an instance's, or the identity);
+    /// `depth`: instances it is nested in.
+    fn placed_shape(
+        &mut self,
+        node: &'a Node,
+        index: usize,
+        parent: DMat4,
+        depth: usize,
+    ) -> Result<(), LoadError> {
         let label = node.label();
         let ty = node.attr("type").unwrap_or("");
+        match ty {
+            // A declaration: its shapes appear where instances place them.
+            "shapegroup" if depth == 0 => return Ok(()),
+            "shapegroup" => return Err(self.err(node, "a shapegroup cannot be nested")),
+            "instance" => return self.instance(node, index, parent, depth),
+            _ => {}
+        }
         let bsdf = match self.shape_bsdf(node)? {
             Some(b) => self.bsdf(b)?,
             None => ConvertedBsdf {
@@ -78,7 +98,7 @@ impl<'a> Importer<'a> {
             emission,
             textures: None,
         });
-        let to_world = self.transform(node, "to_world")?;
+        let to_world = parent * self.transform(node, "to_world")?;
         let m = to_world.as_mat4();
         let flip = self.boolean(node, "flip_normals")?.unwrap_or(false);
         let face_normals = self.boolean(node, "face_normals")?.unwrap_or(false);
@@ -164,11 +184,6 @@ impl<'a> Importer<'a> {
                 import::cylinder(&mut self.builder, p0, p1, radius, m, material, emissive);
                 return Ok(());
             }
-            "shapegroup" | "instance" => {
-                self.builder
-                    .warn(format!("{label}: instancing is not supported; skipped"));
-                return Ok(());
-            }
             other => {
                 return Err(self.err(node, format!("shape type \"{other}\" is not supported")));
             }
@@ -178,6 +193,47 @@ impl<'a> Importer<'a> {
             mesh.flip();
         }
         self.builder.mesh(&mesh, m, material);
+        Ok(())
+    }
+}
+
+impl<'a> Importer<'a> {
+    /// `<shape type="instance">`: the shapes of the `<shapegroup>` it refers to, each placed by
+    /// its own `to_world` and then the instance's (Mitsuba's order), flattened into triangles.
+    fn instance(
+        &mut self,
+        node: &'a Node,
+        index: usize,
+        parent: DMat4,
+        depth: usize,
+    ) -> Result<(), LoadError> {
+        /// Deeper nesting than any real scene, so that a group that instances itself (through
+        /// refs) ends with an error instead of a stack overflow.
+        const MAX_DEPTH: usize = 16;
+        if depth >= MAX_DEPTH {
+            return Err(self.err(
+                node,
+                "instances nest too deeply (does a group instance itself?)",
+            ));
+        }
+        let refs: Vec<&Node> = node.children.iter().filter(|c| c.tag == "ref").collect();
+        let [reference] = refs.as_slice() else {
+            return Err(self.err(node, "an instance needs exactly one <ref> to a shapegroup"));
+        };
+        let group = self.deref(reference)?;
+        if group.tag != "shape" || group.attr("type") != Some("shapegroup") {
+            return Err(self.err(reference, "an instance must refer to a shapegroup"));
+        }
+        let to_world = parent * self.transform(node, "to_world")?;
+        for child in &group.children {
+            match child.tag.as_str() {
+                "shape" if child.attr("type") == Some("shapegroup") => {
+                    return Err(self.err(child, "a shapegroup cannot be nested"));
+                }
+                "shape" => self.placed_shape(child, index, to_world, depth + 1)?,
+                _ => {}
+            }
+        }
         Ok(())
     }
 }

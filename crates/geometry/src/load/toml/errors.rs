@@ -3,6 +3,7 @@
 //! variant it is (from serde's error kinds: unknown field, missing field, unknown variant,
 //! invalid type).
 
+use super::schema::{LightToml, MaterialToml, ShapeToml};
 use crate::error::LoadError;
 use std::ops::Range;
 use std::path::Path;
@@ -133,76 +134,52 @@ impl Spans {
     }
 }
 
-/// Byte offset of the end of the line holding `offset`.
-pub(super) fn end_of_line(text: &str, offset: usize) -> usize {
-    let offset = offset.min(text.len());
-    text.get(offset..)
-        .and_then(|rest| rest.find('\n'))
-        .map_or(text.len(), |i| offset + i)
-}
-
-/// Strips a `#` comment (good enough for header lines).
-pub(super) fn uncomment(line: &str) -> &str {
-    line.split('#').next().unwrap_or(line).trim()
-}
-
-/// The lines of the table whose header (or any line) holds `offset`, with 0-based indices:
-/// from the table's header line to the line before the next header.
-pub(super) fn section(text: &str, offset: usize) -> Vec<(usize, &str)> {
-    let first = text
-        .get(..end_of_line(text, offset))
-        .unwrap_or(text)
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| l.trim_start().starts_with('['))
-        .map(|(i, _)| i)
-        .last()
-        .unwrap_or(0);
-    text.lines()
-        .enumerate()
-        .skip(first)
-        .take_while(|(i, l)| *i == first || !l.trim_start().starts_with('['))
-        .collect()
-}
-
-/// For `invalid type: string "white", …` inside a table that serde buffered (an internally
-/// tagged enum: `[materials.*]`, `[[shapes]]`, `[[lights]]`), whose error spans the whole
-/// table: the key whose value is written `"white"`. Serde names neither the key nor the span
-/// there, so this one case still reads the message.
-pub(super) fn find_key_by_value(
-    text: &str,
-    offset: usize,
-    message: &str,
-) -> Option<(String, u32, u32)> {
-    let matches: Box<dyn Fn(&str) -> bool> = if let Some(rest) =
-        message.strip_prefix("invalid length ")
+/// For a wrong value inside a table that serde buffered (an internally tagged enum:
+/// `[materials.*]`, `[[shapes]]`, `[[lights]]`), whose error spans the whole table (for an
+/// array of tables, the whole array) and names no key: the table and the key at fault. The
+/// table is the first of its kind that does not read on its own; the key is found by reading it
+/// again without each of its keys in turn: the key whose absence makes the table read, or fail
+/// differently, is the one.
+fn culprit(text: &str, table: &str) -> Option<(String, String)> {
+    let doc: ::toml::Table = text.parse().ok()?;
+    if let Some(name) = table
+        .strip_prefix("[materials.")
+        .and_then(|n| n.strip_suffix(']'))
     {
-        // `invalid length 2, expected an array of length 3`: an array of 2 elements.
-        let n: usize = rest.split(',').next()?.trim().parse().ok()?;
-        Box::new(move |v: &str| {
-            v.strip_prefix('[')
-                .and_then(|v| v.strip_suffix(']'))
-                .is_some_and(|inner| inner.split(',').filter(|e| !e.trim().is_empty()).count() == n)
-        })
-    } else {
-        let rest = message.strip_prefix("invalid type: ")?;
-        let literal = if let Some(r) = rest.strip_prefix("string ") {
-            r.split(", expected").next()?.to_owned()
-        } else {
-            let (_, r) = rest.split_once('`')?;
-            r.split('`').next()?.to_owned()
-        };
-        Box::new(move |v: &str| v == literal)
+        let value = doc.get("materials")?.as_table()?.get(name)?.clone();
+        return Some((table.to_owned(), culprit_in::<MaterialToml>(value)?));
+    }
+    let in_list = |list: &str, key: fn(::toml::Value) -> Option<String>| {
+        let items = doc.get(list)?.as_array()?;
+        items
+            .iter()
+            .enumerate()
+            .find_map(|(i, item)| key(item.clone()).map(|k| (format!("[[{list}]] #{}", i + 1), k)))
     };
-    section(text, offset).into_iter().find_map(|(i, l)| {
-        let (k, v) = l.split_once('=')?;
-        matches(uncomment(v)).then(|| {
-            (
-                k.trim().to_owned(),
-                to_u32(i + 1),
-                to_u32(l.len() - l.trim_start().len() + 1),
-            )
-        })
+    if table.starts_with("[[shapes]]") {
+        in_list("shapes", culprit_in::<ShapeToml>)
+    } else if table.starts_with("[[lights]]") {
+        in_list("lights", culprit_in::<LightToml>)
+    } else {
+        None
+    }
+}
+
+fn culprit_in<T: serde::de::DeserializeOwned>(value: ::toml::Value) -> Option<String> {
+    let ::toml::Value::Table(table) = value else {
+        return None;
+    };
+    let baseline = T::deserialize(::toml::Value::Table(table.clone()))
+        .err()?
+        .to_string();
+    table.keys().filter(|k| *k != "type").find_map(|key| {
+        let mut without = table.clone();
+        without.remove(key);
+        match T::deserialize(::toml::Value::Table(without)) {
+            Ok(_) => Some(key.clone()),
+            Err(e) if e.to_string() != baseline => Some(key.clone()),
+            Err(_) => None,
+        }
     })
 }
 
@@ -218,7 +195,7 @@ pub(super) fn schema_error(path: &Path, text: &str, e: &::toml::de::Error) -> Lo
         None => (None, None),
     };
     let spans = Spans::new(text);
-    let table = match (offset, &spans) {
+    let mut table = match (offset, &spans) {
         (Some(o), Some(spans)) => spans.table_at(o),
         _ => "the scene".to_owned(),
     };
@@ -284,8 +261,13 @@ pub(super) fn schema_error(path: &Path, text: &str, e: &::toml::de::Error) -> Lo
                 let (line, column) = at(start);
                 (key, line, column)
             }
-            None => match offset.and_then(|o| find_key_by_value(text, o, &message)) {
-                Some((key, l, c)) => (key, Some(l), Some(c)),
+            None => match culprit(text, &table) {
+                Some((in_table, key)) => {
+                    let start = spans.as_ref().and_then(|s| s.find_key(&in_table, &key));
+                    let (line, column) = start.map_or((line, column), at);
+                    table = in_table;
+                    (key, line, column)
+                }
                 None => (String::new(), line, column),
             },
         };

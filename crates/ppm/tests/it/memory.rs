@@ -1,0 +1,77 @@
+//! The memory estimate made before a render starts covers what the render then holds.
+
+use std::path::Path;
+
+use ppm::{MemoryEstimate, Method, Renderer};
+
+use crate::support::params;
+
+fn repo_scene(name: &str, width: u32, height: u32) -> geometry::Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name);
+    let mut description = geometry::load(&path).unwrap();
+    description.film = geometry::Film { width, height };
+    geometry::Scene::new(description).unwrap()
+}
+
+/// On a caustic, a box and an indirectly lit room, for the classical and the frequency-guided
+/// methods, the estimate of the hitpoint and photon memory is at least what the render holds
+/// after a few passes (measured from the buffers' capacities) and not absurdly more.
+#[test]
+fn the_estimate_covers_what_a_render_holds() {
+    for name in [
+        "bunny-box.toml",
+        "peers/ring-caustic.toml",
+        "peers/room-indirect.toml",
+    ] {
+        let scene = repo_scene(name, 48, 40);
+        for method in [Method::Ppm, Method::Sppm, Method::FreqSppm] {
+            let params = params(method, 20_000);
+            let mut renderer = Renderer::new(&scene, params).unwrap();
+            for _ in 0..3 {
+                renderer.iterate();
+            }
+            let held = renderer.memory().unwrap();
+            let estimate = MemoryEstimate::of(48, 40, &params);
+            let held_slots = held.persistent() + held.pass_hitpoint_buffers;
+            assert!(
+                held_slots as u64 <= estimate.hitpoints,
+                "{name} {method}: hitpoints hold {held_slots} B, estimated {}",
+                estimate.hitpoints
+            );
+            assert!(
+                held.pass_photon_buffers as u64 <= estimate.photons,
+                "{name} {method}: photon buffers hold {} B, estimated {}",
+                held.pass_photon_buffers,
+                estimate.photons
+            );
+            let total = held.total() as u64;
+            let estimated = estimate.hitpoints + estimate.photons;
+            assert!(
+                estimated <= 8 * total,
+                "{name} {method}: estimated {estimated} B for {total} B held"
+            );
+        }
+    }
+}
+
+/// The estimate grows with what the flags ask for, part by part.
+#[test]
+fn the_estimate_follows_the_flags() {
+    let mut p = params(Method::FreqSppm, 100_000);
+    let base = MemoryEstimate::of(100, 100, &p);
+    p.samples_per_pixel = 4;
+    let spp = MemoryEstimate::of(100, 100, &p);
+    assert_eq!(spp.hitpoints, 4 * base.hitpoints);
+    assert_eq!(spp.photons, base.photons);
+    p.photons_per_pass = 1_000_000;
+    assert_eq!(MemoryEstimate::of(100, 100, &p).photons, 10 * base.photons);
+    let path = params(Method::Path, 100_000);
+    let path = MemoryEstimate::of(100, 100, &path);
+    assert_eq!((path.photons, path.hitpoints), (0, 100 * 100 * 24));
+    // No overflow on the largest films and photon counts.
+    p.samples_per_pixel = 1024;
+    p.photons_per_pass = u32::MAX;
+    assert!(MemoryEstimate::of(u32::MAX, u32::MAX, &p).total(true) == u64::MAX);
+}
