@@ -86,6 +86,9 @@ pub struct MaterialSummary {
     /// Cylinders using the material (left out of snapshots when zero).
     #[serde(skip_serializing_if = "is_zero")]
     pub cylinders: usize,
+    /// What its textures modulate (`color`, `emission`, `normal`, `alpha`; left out when none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub textures: Vec<&'static str>,
 }
 
 fn is_zero(n: &usize) -> bool {
@@ -213,6 +216,11 @@ impl SceneDescription {
                     triangles: 0,
                     spheres: 0,
                     cylinders: 0,
+                    textures: m
+                        .textures
+                        .as_deref()
+                        .map(crate::texture::MaterialTextures::uses)
+                        .unwrap_or_default(),
                 }
             })
             .collect();
@@ -335,6 +343,9 @@ impl fmt::Display for SceneSummary {
             }
             if m.emission != Vec3::ZERO {
                 write!(f, " emission {}", Show3(m.emission))?;
+            }
+            if !m.textures.is_empty() {
+                write!(f, " textured ({})", m.textures.join(", "))?;
             }
             write!(f, " ({} triangles, {} spheres", m.triangles, m.spheres)?;
             if m.cylinders > 0 {

@@ -304,6 +304,20 @@ impl MaterialTextures {
             && self.alpha.is_none()
     }
 
+    /// What the textures modulate, for reports: `color`, `emission`, `normal`, `alpha` (an
+    /// alpha without a texture is a constant cut-out and counts too).
+    pub fn uses(&self) -> Vec<&'static str> {
+        [
+            (self.color.is_some(), "color"),
+            (self.emission.is_some(), "emission"),
+            (self.normal.is_some(), "normal"),
+            (self.alpha.is_some(), "alpha"),
+        ]
+        .into_iter()
+        .filter_map(|(used, name)| used.then_some(name))
+        .collect()
+    }
+
     /// Every texture reference, for reports.
     pub fn references(&self) -> impl Iterator<Item = &TextureRef> {
         self.color
