@@ -354,7 +354,7 @@ fn ensure_venv(root: &Path) -> Result<PathBuf> {
 }
 
 /// Builds the release `fppm` binary and returns its path.
-fn build_fppm(root: &Path) -> Result<PathBuf> {
+pub(crate) fn build_fppm(root: &Path) -> Result<PathBuf> {
     let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned()))
         .args(["build", "--release", "-p", "cli", "--quiet"])
         .current_dir(root)

@@ -104,6 +104,10 @@ pub(crate) struct PlanArgs {
     /// Number of work units (each renders a contiguous share of the passes).
     #[arg(long, value_name = "K", allow_negative_numbers = true)]
     pub(crate) units: i64,
+    /// Also write JOB/submit.sh: a Slurm array job of the K units and a merge job that runs
+    /// after them (`sh JOB/submit.sh` submits both with sbatch).
+    #[arg(long)]
+    pub(crate) slurm: bool,
     #[command(flatten)]
     pub(crate) params: ParamArgs,
     /// Film width in pixels (overrides the scene; alone, keeps the scene's aspect ratio).
