@@ -14,11 +14,12 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 
 pub(crate) const HELP: &str = "\
-cargo xtask farm-test [--units K] [--passes N]
+cargo xtask farm-test [--units K] [--passes N] [--size PIXELS] [--photons N]
 
 Starts a one-node Slurm cluster on this machine (installing slurm-wlm and munge with apt-get if
 they are missing; needs root), renders a Cornell box as K work units (default 4) of N passes in
-all (default 16) through `fppm plan --slurm`, and checks that the merged image is bit for bit
+all (default 16) through `fppm plan --slurm` (a square film of --size pixels, default 48, and
+--photons per pass, default 20000), and checks that the merged image is bit for bit
 the one-process `fppm render --method appm` image. Stops the daemons it started.";
 
 /// The scene of the test, read in place from the shared scenes.
@@ -29,6 +30,8 @@ const TIMEOUT: Duration = Duration::from_secs(300);
 pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
     let mut units = 4u32;
     let mut passes = 16u32;
+    let mut size = 48u32;
+    let mut photons = 20_000u32;
     let mut it = args.iter();
     while let Some(flag) = it.next() {
         let mut value = |name: &str| -> Result<u32> {
@@ -40,6 +43,8 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         match flag.as_str() {
             "--units" => units = value("--units")?,
             "--passes" => passes = value("--passes")?,
+            "--size" => size = value("--size")?,
+            "--photons" => photons = value("--photons")?,
             other => bail!("farm-test: unknown flag {other}\n\n{HELP}"),
         }
     }
@@ -54,22 +59,45 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
     let mut daemons = Daemons::default();
     let result = (|| -> Result<bool> {
         let conf = daemons.start(&dir)?;
-        job(root, &fppm, &dir, &conf, units, passes)
+        let size = Size {
+            units,
+            passes,
+            pixels: size,
+            photons,
+        };
+        job(root, &fppm, &dir, &conf, size)
     })();
     daemons.stop();
     result
 }
 
+/// The job's size.
+#[derive(Clone, Copy)]
+struct Size {
+    units: u32,
+    passes: u32,
+    /// Side of the square film.
+    pixels: u32,
+    photons: u32,
+}
+
 /// Runs the job on the cluster and compares it with one process.
-fn job(root: &Path, fppm: &Path, dir: &Path, conf: &Path, units: u32, passes: u32) -> Result<bool> {
+fn job(root: &Path, fppm: &Path, dir: &Path, conf: &Path, size: Size) -> Result<bool> {
+    let Size {
+        units,
+        passes,
+        pixels,
+        photons,
+    } = size;
     let scene = root.join(SCENE);
+    let (pixels, photons) = (pixels.to_string(), photons.to_string());
     let film = [
         "--width",
-        "48",
+        pixels.as_str(),
         "--height",
-        "48",
+        pixels.as_str(),
         "--photons-per-pass",
-        "20000",
+        photons.as_str(),
     ];
     let job = dir.join("job");
     let passes = passes.to_string();
