@@ -186,7 +186,9 @@ impl MemoryEstimate {
             };
         // appm: each slot's kernel, and each pixel's exact sums (3 × i128).
         let independent = if method.is_pass_independent() {
-            slots.saturating_mul(8).saturating_add(pixels.saturating_mul(48))
+            slots
+                .saturating_mul(8)
+                .saturating_add(pixels.saturating_mul(48))
         } else {
             0
         };
