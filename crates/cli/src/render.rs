@@ -45,7 +45,7 @@ pub(crate) fn resume(args: &ResumeArgs) -> anyhow::Result<Outcome> {
     settings::check_aovs(&outputs.aovs, header.params.method)?;
     settings::check_outputs(&outputs, Some(path))?;
 
-    let mut description = settings::load_scene(note.scene.as_deref())?;
+    let mut description = settings::load_scene(note.scene.as_deref(), note.env.as_deref())?;
     settings::apply_film(&mut description, (Some(note.width), Some(note.height)));
     let budget = match (passes, args.time) {
         (None, None) => Budget {
@@ -58,6 +58,7 @@ pub(crate) fn resume(args: &ResumeArgs) -> anyhow::Result<Outcome> {
     };
     let job = Job {
         scene_path: note.scene.clone(),
+        env_path: note.env.clone(),
         description,
         params: header.params,
         budget,
@@ -258,6 +259,7 @@ fn write_checkpoint(
     let film = job.description.film;
     let note = Note {
         scene: job.scene_path.clone(),
+        env: job.env_path.clone(),
         width: film.width,
         height: film.height,
         exr: settings::absolute(&job.outputs.exr),

@@ -307,6 +307,7 @@ impl Builder {
             spheres: self.spheres,
             cylinders: self.cylinders,
             lights: self.lights,
+            environment: None,
             render,
             notes: LoadNotes {
                 degenerate_triangles: self.degenerate_triangles,
