@@ -500,3 +500,7 @@ impl EnvironmentLight {
         Some((origin, -s.direction, flux, s.angle))
     }
 }
+
+#[cfg(test)]
+#[path = "environment_tests.rs"]
+mod tests;
