@@ -313,10 +313,15 @@ pub(crate) fn environment(env: &Environment) -> Result<(), Invalid> {
             format!("must be finite and >= 0, got {}", env.scale),
         ));
     }
-    if !env.rotate.is_finite() {
+    let r = env.to_world;
+    let orthonormal = (r.transpose() * r - glam::Mat3::IDENTITY)
+        .to_cols_array()
+        .iter()
+        .all(|e| e.abs() < 1e-3);
+    if !(r.is_finite() && orthonormal && (r.determinant() - 1.0).abs() < 1e-3) {
         return Err(Invalid::value(
-            "environment rotate",
-            format!("must be finite, got {}", fmt_vec(env.rotate)),
+            "environment to_world",
+            format!("must be a rotation, got {r}"),
         ));
     }
     match &env.radiance {

@@ -473,7 +473,7 @@ pub fn scene_fingerprint(d: &SceneDescription) -> u64 {
     if let Some(env) = &d.environment {
         w.u32(3);
         w.f32(env.scale);
-        env.rotate.to_array().iter().for_each(|&c| w.f32(c));
+        env.to_world.to_cols_array().iter().for_each(|&c| w.f32(c));
         match &env.radiance {
             EnvironmentRadiance::Constant(c) => {
                 w.u32(0);

@@ -6,8 +6,8 @@
 //! d = (sin φ sin θ, cos θ, −cos φ sin θ) looks at u = φ / 2π (from the image's left edge) and
 //! v = θ / π (from its top row). The top row is the sky straight up, the centre column looks
 //! toward +z, the left and right edges toward −z, a quarter of the width toward +x.
-//! `rotate = [x, y, z]` (degrees about x, then y, then z, as a shape transform) turns that frame
-//! into world space.
+//! [`Environment::to_world`] turns that frame into world space (the TOML `rotate = [x, y, z]`:
+//! degrees about x, then y, then z, as a shape transform; Mitsuba's `to_world`).
 //!
 //! Radiance is the texel's, nearest texel: columns cover u ∈ [x/W, (x+1)/W) as Mitsuba's texel
 //! centres do, rows v ∈ [y/H, (y+1)/H). Mitsuba interpolates bilinearly and puts its first and
@@ -38,8 +38,8 @@ pub struct Environment {
     pub radiance: EnvironmentRadiance,
     /// Factor on the radiance (≥ 0).
     pub scale: f32,
-    /// Rotation of the map's frame into world space: degrees about x, then y, then z.
-    pub rotate: Vec3,
+    /// Rotation from the map's frame into world space (orthonormal, determinant 1).
+    pub to_world: Mat3,
 }
 
 /// The radiance of an [`Environment`].
@@ -172,16 +172,15 @@ impl Environment {
             Self {
                 radiance: EnvironmentRadiance::Map(Arc::new(map)),
                 scale: 1.0,
-                rotate: Vec3::ZERO,
+                to_world: Mat3::IDENTITY,
             },
             negative,
         ))
     }
 
-    /// Rotation from the map's frame to world space.
+    /// The rotation of `rotate = [x, y, z]`: degrees about x, then y, then z (Rz·Ry·Rx).
     #[must_use]
-    pub fn to_world(&self) -> Mat3 {
-        let r = self.rotate;
+    pub fn rotation_degrees(r: Vec3) -> Mat3 {
         Mat3::from_rotation_z(r.z.to_radians())
             * Mat3::from_rotation_y(r.y.to_radians())
             * Mat3::from_rotation_x(r.x.to_radians())
@@ -219,7 +218,10 @@ impl Environment {
             }
             EnvironmentRadiance::Map(m) => format!(
                 "{} ({}×{}, {:.1} MB)",
-                m.path.display(),
+                m.path.file_name().map_or_else(
+                    || m.path.display().to_string(),
+                    |n| n.to_string_lossy().into()
+                ),
                 m.width,
                 m.height,
                 (m.texels.len() * std::mem::size_of::<Rgb>()) as f64 / 1e6
@@ -228,9 +230,17 @@ impl Environment {
         if self.scale != 1.0 {
             text.push_str(&format!(", scale {}", self.scale));
         }
-        if self.rotate != Vec3::ZERO {
-            let r = self.rotate;
-            text.push_str(&format!(", rotate [{}, {}, {}]", r.x, r.y, r.z));
+        if self.to_world != Mat3::IDENTITY {
+            // Rounded first, so that −0.0001 shows as 0.
+            let show = |v: Vec3| {
+                let r = (v * 1000.0).round() / 1000.0 + Vec3::ZERO;
+                format!("[{}, {}, {}]", r.x, r.y, r.z)
+            };
+            text.push_str(&format!(
+                ", rotated (up {}, centre {})",
+                show(self.to_world * Vec3::Y),
+                show(self.to_world * Vec3::Z)
+            ));
         }
         text
     }
@@ -424,7 +434,7 @@ pub(crate) struct EnvironmentLight {
 impl EnvironmentLight {
     /// `None` when the environment emits nothing.
     pub(crate) fn new(env: &Environment, bounds: Aabb) -> Option<Self> {
-        let to_world = env.to_world();
+        let to_world = env.to_world;
         let radiance = match &env.radiance {
             EnvironmentRadiance::Constant(c) => Radiance::Constant(*c * env.scale),
             EnvironmentRadiance::Map(map) => Radiance::Map(MapSampler::new(map, env.scale)?),

@@ -37,7 +37,7 @@ fn environment(rotate: Vec3, scale: f32) -> Environment {
     Environment {
         radiance: EnvironmentRadiance::Map(Arc::new(test_map())),
         scale,
-        rotate,
+        to_world: Environment::rotation_degrees(rotate),
     }
 }
 
@@ -156,7 +156,7 @@ fn pdf_integrates_to_one_and_radiance_to_the_power() {
     let constant = Environment {
         radiance: EnvironmentRadiance::Constant(Vec3::new(1.0, 2.0, 3.0)),
         scale: 0.5,
-        rotate: Vec3::ZERO,
+        to_world: glam::Mat3::IDENTITY,
     };
     let want = 4.0 * std::f32::consts::PI * Vec3::new(0.5, 1.0, 1.5);
     assert!((constant.integrated_radiance() - want).abs().max_element() < 1e-5);

@@ -305,10 +305,23 @@ fn lying_ply_header() {
 
 #[test]
 fn infinite_light_only_is_a_clear_error() {
+    // A constant sky alone lights the scene.
+    let (scene, _) = load_edited(
+        "pbrt_infinite_constant",
+        "LightSource \"point\" \"rgb I\" [ 5 5 5 ] \"point3 from\" [ 0 0 3 ]",
+        "LightSource \"infinite\" \"rgb L\" [ 1 2 3 ] \"float scale\" 2",
+    );
+    let env = scene.unwrap().environment.unwrap();
+    assert_eq!(
+        env.radiance,
+        geometry::EnvironmentRadiance::Constant(glam::Vec3::new(1.0, 2.0, 3.0))
+    );
+    assert_eq!(env.scale, 2.0);
+    // An image map is not read yet: alone, it is a clear error.
     let (err, path) = load_edited(
         "pbrt_infinite",
         "LightSource \"point\" \"rgb I\" [ 5 5 5 ] \"point3 from\" [ 0 0 3 ]",
-        "LightSource \"infinite\" \"rgb L\" [ 1 1 1 ]",
+        "LightSource \"infinite\" \"string filename\" \"sky.exr\"",
     );
     let err = err.unwrap_err();
     assert!(matches!(err, LoadError::NoSupportedEmitter { .. }), "{err}");

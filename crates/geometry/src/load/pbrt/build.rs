@@ -188,6 +188,26 @@ impl Parser {
                         irradiance: l,
                     });
                 }
+                // A constant sky; pbrt's image maps (equal-area octahedral) stand in as nothing.
+                "infinite" if p.get("filename").is_none() => {
+                    let l = self.colour(&p, "L", em)?.unwrap_or(Rgb::ONE);
+                    if p.get("illuminance").is_some() {
+                        builder.warn(
+                            "LightSource \"infinite\": \"illuminance\" is ignored; L × scale is used",
+                        );
+                    }
+                    let env = crate::Environment {
+                        radiance: crate::EnvironmentRadiance::Constant(l),
+                        scale,
+                        to_world: glam::Mat3::IDENTITY,
+                    };
+                    let file = self.files[light.loc.file].display().to_string();
+                    import::set_environment(
+                        &mut builder,
+                        &format!("LightSource \"infinite\" ({file}:{})", light.loc.line),
+                        env,
+                    );
+                }
                 "infinite" => {
                     let file = self.files[light.loc.file].display().to_string();
                     import::environment_light_standin(

@@ -484,7 +484,7 @@ impl Converter<'_> {
                         self.colour(&key("radiance"), radiance)?,
                     ),
                     scale: 1.0,
-                    rotate: Vec3::ZERO,
+                    to_world: glam::Mat3::IDENTITY,
                 },
                 0,
             ),
@@ -505,7 +505,8 @@ impl Converter<'_> {
             env.scale = scale;
         }
         if let Some(rotate) = rotate {
-            env.rotate = self.finite(&key("rotate"), rotate)?;
+            env.to_world =
+                crate::Environment::rotation_degrees(self.finite(&key("rotate"), rotate)?);
         }
         Ok((env, negative))
     }
