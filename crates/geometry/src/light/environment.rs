@@ -102,8 +102,12 @@ impl EnvironmentMap {
             }
         };
         let bytes = crate::load::read_bytes(path)?;
-        let (width, height, rgb) = decode_hdr_image(&bytes, format)
-            .map_err(|e| bad(format!("cannot decode image: {}", lower_first(&e))))?;
+        let (width, height, rgb) = decode_hdr_image(&bytes, format).map_err(|e| {
+            bad(format!(
+                "cannot decode image: {}",
+                crate::error::lower_first(&e)
+            ))
+        })?;
         if width == 0 || height == 0 {
             return Err(bad(format!("image has zero size ({width}×{height})")));
         }
@@ -154,10 +158,6 @@ fn decode_hdr_image(
     let image = image::load_from_memory_with_format(bytes, format).map_err(|e| e.to_string())?;
     let rgb = image.into_rgb32f();
     Ok((rgb.width(), rgb.height(), rgb.into_raw()))
-}
-
-fn lower_first(message: &str) -> String {
-    crate::error::lower_first(message)
 }
 
 impl Environment {
