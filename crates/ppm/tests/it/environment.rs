@@ -136,3 +136,119 @@ fn environment_lit_images_are_bit_identical_for_1_and_3_threads() {
         assert!(one.iter().flatten().all(|c| c.is_finite() && *c >= 0.0));
     }
 }
+
+/// A 64 × 32 map: a bright 3 × 2-texel sun at θ ≈ 58°, a colour gradient elsewhere, built in
+/// code (texels row-major, top row first).
+fn sun_map() -> geometry::EnvironmentMap {
+    let (w, h) = (64u32, 32u32);
+    let texels = (0..h)
+        .flat_map(|y| {
+            (0..w).map(move |x| {
+                if (10..12).contains(&y) && (40..43).contains(&x) {
+                    glam::Vec3::new(300.0, 250.0, 200.0)
+                } else {
+                    glam::Vec3::new(0.2 + x as f32 / 64.0, 0.5, 0.1 + y as f32 / 32.0)
+                }
+            })
+        })
+        .collect();
+    geometry::EnvironmentMap {
+        path: "sun.exr".into(),
+        width: w,
+        height: h,
+        texels,
+    }
+}
+
+/// The irradiance on an upward surface under `map` (unrotated, +y up), per channel, summed
+/// texel by texel in closed form: a texel of rows θ₀..θ₁ gives L·(2π/W)·(sin²θ₁ − sin²θ₀)/2
+/// over the upper hemisphere.
+fn upward_irradiance(map: &geometry::EnvironmentMap) -> [f64; 3] {
+    let (w, h) = (map.width as usize, map.height as usize);
+    let mut e = [0.0f64; 3];
+    for y in 0..h / 2 {
+        let t0 = std::f64::consts::PI * y as f64 / h as f64;
+        let t1 = std::f64::consts::PI * (y + 1) as f64 / h as f64;
+        let weight =
+            2.0 * std::f64::consts::PI / w as f64 * (t1.sin().powi(2) - t0.sin().powi(2)) / 2.0;
+        for x in 0..w {
+            let l = map.texels[y * w + x];
+            for (c, e) in e.iter_mut().enumerate() {
+                *e += f64::from(l[c]) * weight;
+            }
+        }
+    }
+    e
+}
+
+/// A grey floor seen from straight above under a map with a sun: its radiance is
+/// albedo/π × the irradiance summed over the texels, for the path tracer (light sampling and
+/// BSDF sampling of the sky, MIS-weighted) and for every photon mapper (photons from the
+/// sky's disc).
+#[test]
+fn floor_under_a_sun_map_matches_the_texel_sum() {
+    let map = sun_map();
+    let e = upward_irradiance(&map);
+    let albedo = 0.5;
+    let want: Vec<f64> = e
+        .iter()
+        .map(|e| albedo * e / std::f64::consts::PI)
+        .collect();
+    let toml = r#"
+format = 1
+[camera]
+position = [0.0, 3.0, 0.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, -1.0]
+fov_y = 10.0
+[film]
+width = 8
+height = 8
+[materials.grey]
+type = "diffuse"
+albedo = [0.5, 0.5, 0.5]
+[[shapes]]
+type = "quad"
+corner = [-1.0, 0.0, 1.0]
+edge1 = [2.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, -2.0]
+material = "grey"
+[[lights]]
+type = "environment"
+radiance = [1.0, 1.0, 1.0]
+"#;
+    let mut description =
+        geometry::load_toml_str(toml, std::path::Path::new("floor.toml")).unwrap();
+    description.environment = Some(geometry::Environment {
+        radiance: geometry::EnvironmentRadiance::Map(std::sync::Arc::new(map)),
+        scale: 1.0,
+        to_world: glam::Mat3::IDENTITY,
+    });
+    let scene = geometry::Scene::new(description).unwrap();
+    let channel_means = |image: &[[f32; 3]]| {
+        let mut m = [0.0f64; 3];
+        for p in image {
+            for c in 0..3 {
+                m[c] += f64::from(p[c]) / image.len() as f64;
+            }
+        }
+        m
+    };
+    let mut p = params(Method::Path, 1);
+    p.samples_per_pixel = 64;
+    let mut runs = vec![(Method::Path, render(&scene, p, 4))];
+    for method in PHOTON_METHODS {
+        runs.push((method, render(&scene, params(method, 100_000), 8)));
+    }
+    for (method, image) in runs {
+        let got = channel_means(&image);
+        for c in 0..3 {
+            assert!(
+                (got[c] / want[c] - 1.0).abs() < 0.01,
+                "{method}: channel {c} {} against {}",
+                got[c],
+                want[c]
+            );
+        }
+    }
+}
