@@ -84,6 +84,48 @@ impl EnvironmentMap {
     /// another extension, cannot be decoded, has zero size, is not 2:1, holds a NaN or infinite
     /// texel, or is black everywhere.
     pub fn load(path: &Path) -> Result<(Self, usize), LoadError> {
+        Self::read(path, false)
+    }
+
+    /// Reads a square equal-area octahedral map (pbrt-v4's `infinite` light, `.exr` or `.hdr`)
+    /// and resamples it, nearest texel as pbrt looks it up, into an equirectangular map of
+    /// twice its side in height, so that the map's frame is pbrt's light frame with its x axis
+    /// negated when `mirror_x` (for a light transform with a reflection: see
+    /// `load/pbrt/build.rs`).
+    ///
+    /// # Errors
+    /// As [`EnvironmentMap::load`], with "not square" in place of "not 2:1".
+    pub(crate) fn load_equal_area(path: &Path, mirror_x: bool) -> Result<(Self, usize), LoadError> {
+        let (square, negative) = Self::read(path, true)?;
+        let n = square.width as usize;
+        let (w, h) = (4 * n, 2 * n);
+        let mut texels = Vec::with_capacity(w * h);
+        for y in 0..h {
+            for x in 0..w {
+                let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+                let (mut d, _) = uv_to_direction(uv);
+                if mirror_x {
+                    d.x = -d.x;
+                }
+                let st = equal_area_sphere_to_square(d);
+                let i = ((st.x * n as f32) as usize).min(n - 1);
+                let j = ((st.y * n as f32) as usize).min(n - 1);
+                texels.push(square.texels[j * n + i]);
+            }
+        }
+        Ok((
+            Self {
+                path: square.path,
+                width: w as u32,
+                height: h as u32,
+                texels,
+            },
+            negative,
+        ))
+    }
+
+    /// Decodes `path` and checks it: 2:1, or square when `square`.
+    fn read(path: &Path, square: bool) -> Result<(Self, usize), LoadError> {
         let bad = |message: String| LoadError::EnvironmentMap {
             path: path.to_path_buf(),
             message,
@@ -111,10 +153,18 @@ impl EnvironmentMap {
         if width == 0 || height == 0 {
             return Err(bad(format!("image has zero size ({width}×{height})")));
         }
-        if width != 2 * height {
-            return Err(bad(format!(
-                "image is {width}×{height}, not 2:1 (an equirectangular map is twice as wide as high)"
-            )));
+        if !(if square {
+            width == height
+        } else {
+            width == 2 * height
+        }) {
+            return Err(bad(if square {
+                format!("image is {width}×{height}, not square (an equal-area octahedral map)")
+            } else {
+                format!(
+                    "image is {width}×{height}, not 2:1 (an equirectangular map is twice as wide as high)"
+                )
+            }));
         }
         let mut negative = 0;
         let mut texels = Vec::with_capacity(rgb.len() / 3);
@@ -244,6 +294,29 @@ impl Environment {
         }
         text
     }
+}
+
+/// pbrt-v4's `EqualAreaSphereToSquare` (Clarberg 2008; `src/pbrt/util/math.cpp`) with the
+/// exact arctangent in place of its polynomial: the point of [0, 1]² of a unit direction, +z at
+/// the centre, −z at the corners, +x at the middle of the right edge, +y at the middle of the
+/// bottom edge (rows counted from the top of the image).
+fn equal_area_sphere_to_square(d: Vec3) -> Vec2 {
+    let (x, y, z) = (d.x.abs(), d.y.abs(), d.z.abs());
+    let r = (1.0 - z).max(0.0).sqrt();
+    let (a, b) = (x.max(y), x.min(y));
+    let b = if a == 0.0 { 0.0 } else { b / a };
+    let mut phi = b.atan() * (2.0 / PI);
+    if x < y {
+        phi = 1.0 - phi;
+    }
+    let mut v = phi * r;
+    let mut u = r - v;
+    if d.z < 0.0 {
+        std::mem::swap(&mut u, &mut v);
+        u = 1.0 - u;
+        v = 1.0 - v;
+    }
+    Vec2::new(0.5 * (u.copysign(d.x) + 1.0), 0.5 * (v.copysign(d.y) + 1.0))
 }
 
 /// Solid angle of row `y` of `h` rows: 2π (cos θ₀ − cos θ₁).

@@ -288,3 +288,46 @@ fn photons_start_outside_and_carry_the_power() {
         "{mean} vs {want}"
     );
 }
+
+/// pbrt's octahedral mapping is equal-area: uniform directions fill the square's cells evenly,
+/// and its landmarks are where pbrt puts them.
+#[test]
+fn equal_area_square_is_equal_area() {
+    let n = 8;
+    let mut counts = vec![0u32; n * n];
+    let mut rng = Rng::new(17);
+    let samples = 256_000;
+    for _ in 0..samples {
+        let st = equal_area_sphere_to_square(uniform_sphere(rng.vec2()));
+        let i = ((st.x * n as f32) as usize).min(n - 1);
+        let j = ((st.y * n as f32) as usize).min(n - 1);
+        counts[j * n + i] += 1;
+    }
+    let expected = f64::from(samples) / (n * n) as f64;
+    let chi2: f64 = counts
+        .iter()
+        .map(|&c| (f64::from(c) - expected).powi(2) / expected)
+        .sum();
+    let dof = (n * n - 1) as f64;
+    assert!(chi2 < dof + 5.0 * (2.0 * dof).sqrt(), "χ² {chi2:.1}");
+    let close = |a: Vec2, b: Vec2| (a - b).length() < 1e-6;
+    assert!(close(
+        equal_area_sphere_to_square(Vec3::Z),
+        Vec2::splat(0.5)
+    ));
+    assert!(close(
+        equal_area_sphere_to_square(Vec3::X),
+        Vec2::new(1.0, 0.5)
+    ));
+    assert!(close(
+        equal_area_sphere_to_square(Vec3::Y),
+        Vec2::new(0.5, 1.0)
+    ));
+    let corner = equal_area_sphere_to_square(-Vec3::Z);
+    assert!(
+        close(corner, Vec2::ZERO)
+            || close(corner, Vec2::ONE)
+            || close(corner, Vec2::new(1.0, 0.0))
+            || close(corner, Vec2::new(0.0, 1.0))
+    );
+}
