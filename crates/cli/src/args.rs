@@ -68,6 +68,9 @@ pub(crate) enum Command {
         /// The scene file.
         #[arg(value_name = "SCENE")]
         scene: Option<PathBuf>,
+        /// Add this environment map (.exr or .hdr), as `fppm render --env` does.
+        #[arg(long, value_name = "FILE")]
+        env: Option<PathBuf>,
     },
     /// Cut a pass-independent render (--method appm) into work units: runs the frequency
     /// pilot once and writes JOB/plan.fppm.
@@ -116,6 +119,9 @@ pub(crate) struct PlanArgs {
     /// Film height in pixels (overrides the scene; alone, keeps the scene's aspect ratio).
     #[arg(long, value_name = "PIXELS", help_heading = "Image")]
     pub(crate) height: Option<u32>,
+    /// Light the scene with this equirectangular environment map (as for `fppm render`).
+    #[arg(long, value_name = "FILE", help_heading = "Image")]
+    pub(crate) env: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) run: RunArgs,
 }
@@ -170,6 +176,10 @@ pub(crate) struct RenderArgs {
     /// Film height in pixels (overrides the scene; alone, keeps the scene's aspect ratio).
     #[arg(long, value_name = "PIXELS", help_heading = "Image")]
     pub(crate) height: Option<u32>,
+    /// Light the scene with this equirectangular environment map (.exr or .hdr, Mitsuba's
+    /// orientation: +y up), replacing the scene's own environment if it has one.
+    #[arg(long, value_name = "FILE", help_heading = "Image")]
+    pub(crate) env: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) output: OutputArgs,
     /// Auxiliary outputs written as extra EXR channels, comma separated.

@@ -69,6 +69,7 @@ pub(crate) fn plan(args: PlanArgs) -> anyhow::Result<Outcome> {
         },
         width: args.width,
         height: args.height,
+        env: args.env,
         output: OutputArgs {
             exr: None,
             png: None,
@@ -184,7 +185,8 @@ fn read_plan(job: &Path) -> anyhow::Result<(Vec<u8>, StateHeader, PlanNote)> {
 
 /// The scene of a plan, with the plan's film.
 fn plan_scene(note: &PlanNote) -> anyhow::Result<geometry::Scene> {
-    let mut description = settings::load_scene(note.render.scene.as_deref())?;
+    let mut description =
+        settings::load_scene(note.render.scene.as_deref(), note.render.env.as_deref())?;
     settings::apply_film(
         &mut description,
         (Some(note.render.width), Some(note.render.height)),
@@ -380,6 +382,7 @@ mod tests {
         PlanNote {
             render: Note {
                 scene: None,
+                env: None,
                 width: 1,
                 height: 1,
                 exr: PathBuf::new(),
