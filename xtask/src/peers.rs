@@ -354,7 +354,7 @@ fn ensure_venv(root: &Path) -> Result<PathBuf> {
 }
 
 /// Builds the release `fppm` binary and returns its path.
-fn build_fppm(root: &Path) -> Result<PathBuf> {
+pub(crate) fn build_fppm(root: &Path) -> Result<PathBuf> {
     let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned()))
         .args(["build", "--release", "-p", "cli", "--quiet"])
         .current_dir(root)
@@ -412,9 +412,10 @@ fn run_mitsuba(
 /// `perspective` sensor with `fov_axis = y` and a box-filtered `hdrfilm`; a diffuse colour
 /// texture (with albedo 1) is a `bitmap` reflectance (sRGB-decoded by Mitsuba for 8-bit files,
 /// bilinear, with the same wrap mode), a cut-out a `mask` BSDF with the alpha as opacity
-/// (`raw`); the integrator is
-/// `$integrator` with unlimited depth. Glossy materials and lights other than emissive surfaces
-/// and point lights are refused: the peer scenes do not use them.
+/// (`raw`); the integrator is `$integrator` with unlimited depth; the environment is Mitsuba's
+/// `constant` or `envmap` ([`environment_emitter`]). Glossy materials and lights other than
+/// emissive surfaces, point lights and the environment are refused: the peer scenes do not use
+/// them.
 pub(crate) fn write_mitsuba(
     description: &geometry::SceneDescription,
     dir: &Path,
@@ -617,10 +618,47 @@ pub(crate) fn write_mitsuba(
             ref other => bail!("light {other:?} is not exported"),
         }
     }
+    if let Some(env) = &description.environment {
+        writeln!(xml, "  {}", environment_emitter(env))?;
+    }
     writeln!(xml, "</scene>")?;
     let path = dir.join("scene.xml");
     std::fs::write(&path, xml)?;
     Ok(path)
+}
+
+/// The environment as a Mitsuba emitter: `constant` (scale folded into the radiance) or
+/// `envmap` of the same file (absolute path), `scale`, and the rotation as its `to_world`
+/// matrix. Both read the map in Mitsuba's orientation (`geometry::Environment`).
+fn environment_emitter(env: &geometry::Environment) -> String {
+    match &env.radiance {
+        geometry::EnvironmentRadiance::Constant(c) => {
+            let c = *c * env.scale;
+            format!(
+                "<emitter type=\"constant\"><rgb name=\"radiance\" value=\"{}, {}, {}\"/></emitter>",
+                c.x, c.y, c.z
+            )
+        }
+        geometry::EnvironmentRadiance::Map(map) => {
+            let path = std::path::absolute(&map.path).unwrap_or_else(|_| map.path.clone());
+            // Mitsuba's `matrix` is row-major.
+            let m = env.to_world.transpose().to_cols_array();
+            format!(
+                "<emitter type=\"envmap\"><string name=\"filename\" value=\"{}\"/><float name=\"scale\" value=\"{}\"/><transform name=\"to_world\"><matrix value=\"{} {} {} 0 {} {} {} 0 {} {} {} 0 0 0 0 1\"/></transform></emitter>",
+                path.display(),
+                env.scale,
+                m[0],
+                m[1],
+                m[2],
+                m[3],
+                m[4],
+                m[5],
+                m[6],
+                m[7],
+                m[8]
+            )
+        }
+    }
 }
 
 /// An open cylinder's kept arc as an ASCII PLY of `segments` quads with exact outward normals,

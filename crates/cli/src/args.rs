@@ -68,6 +68,9 @@ pub(crate) enum Command {
         /// The scene file.
         #[arg(value_name = "SCENE")]
         scene: Option<PathBuf>,
+        /// Add this environment map (.exr or .hdr), as `fppm render --env` does.
+        #[arg(long, value_name = "FILE")]
+        env: Option<PathBuf>,
     },
     /// Cut a pass-independent render (--method appm) into work units: runs the frequency
     /// pilot once and writes JOB/plan.fppm.
@@ -104,6 +107,10 @@ pub(crate) struct PlanArgs {
     /// Number of work units (each renders a contiguous share of the passes).
     #[arg(long, value_name = "K", allow_negative_numbers = true)]
     pub(crate) units: i64,
+    /// Also write JOB/submit.sh: a Slurm array job of the K units and a merge job that runs
+    /// after them (`sh JOB/submit.sh` submits both with sbatch).
+    #[arg(long)]
+    pub(crate) slurm: bool,
     #[command(flatten)]
     pub(crate) params: ParamArgs,
     /// Film width in pixels (overrides the scene; alone, keeps the scene's aspect ratio).
@@ -112,6 +119,9 @@ pub(crate) struct PlanArgs {
     /// Film height in pixels (overrides the scene; alone, keeps the scene's aspect ratio).
     #[arg(long, value_name = "PIXELS", help_heading = "Image")]
     pub(crate) height: Option<u32>,
+    /// Light the scene with this equirectangular environment map (as for `fppm render`).
+    #[arg(long, value_name = "FILE", help_heading = "Image")]
+    pub(crate) env: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) run: RunArgs,
 }
@@ -166,6 +176,10 @@ pub(crate) struct RenderArgs {
     /// Film height in pixels (overrides the scene; alone, keeps the scene's aspect ratio).
     #[arg(long, value_name = "PIXELS", help_heading = "Image")]
     pub(crate) height: Option<u32>,
+    /// Light the scene with this equirectangular environment map (.exr or .hdr, Mitsuba's
+    /// orientation: +y up), replacing the scene's own environment if it has one.
+    #[arg(long, value_name = "FILE", help_heading = "Image")]
+    pub(crate) env: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) output: OutputArgs,
     /// Auxiliary outputs written as extra EXR channels, comma separated.

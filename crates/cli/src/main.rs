@@ -91,7 +91,7 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Some(Command::Render { scene, args }) => render::render(Some(&scene), &args),
         Some(Command::Resume(args)) => render::resume(&args),
         Some(Command::Diff(args)) => diff::diff(&args),
-        Some(Command::Info { scene }) => info(scene.as_deref()),
+        Some(Command::Info { scene, env }) => info(scene.as_deref(), env),
         Some(Command::Plan(args)) => units::plan(args),
         Some(Command::Unit(args)) => units::unit(&args),
         Some(Command::Merge(args)) => units::merge(&args),
@@ -103,8 +103,11 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
 }
 
 /// `fppm info [SCENE]`: what was loaded, without rendering.
-fn info(scene: Option<&Path>) -> anyhow::Result<Outcome> {
-    let options = geometry::LoadOptions::allow_no_emitter();
+fn info(scene: Option<&Path>, env: Option<std::path::PathBuf>) -> anyhow::Result<Outcome> {
+    let options = geometry::LoadOptions {
+        environment: env,
+        ..geometry::LoadOptions::allow_no_emitter()
+    };
     let description = match scene {
         Some(path) => geometry::load_with(path, &options)?,
         None => {

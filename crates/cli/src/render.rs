@@ -46,7 +46,7 @@ pub(crate) fn resume(args: &ResumeArgs) -> anyhow::Result<Outcome> {
     settings::check_aovs(&outputs.aovs, header.params.method)?;
     settings::check_outputs(&outputs, Some(path))?;
 
-    let mut description = settings::load_scene(note.scene.as_deref())?;
+    let mut description = settings::load_scene(note.scene.as_deref(), note.env.as_deref())?;
     settings::apply_film(&mut description, (Some(note.width), Some(note.height)));
     let budget = match (passes, args.time) {
         (None, None) => Budget {
@@ -59,6 +59,7 @@ pub(crate) fn resume(args: &ResumeArgs) -> anyhow::Result<Outcome> {
     };
     let job = Job {
         scene_path: note.scene.clone(),
+        env_path: note.env.clone(),
         description,
         params: header.params,
         budget,

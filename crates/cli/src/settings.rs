@@ -24,6 +24,8 @@ pub(crate) const DEFAULT_EXR: &str = "fppm.exr";
 pub(crate) struct Job {
     /// Where the scene came from (`None`: the built-in default scene).
     pub(crate) scene_path: Option<PathBuf>,
+    /// The `--env` map, absolute.
+    pub(crate) env_path: Option<PathBuf>,
     /// The loaded scene, with the film overrides applied.
     pub(crate) description: SceneDescription,
     pub(crate) params: RenderParams,
@@ -66,6 +68,9 @@ pub(crate) struct RunSettings {
 pub(crate) struct Note {
     /// Absolute scene path; `None` for the built-in default scene.
     pub(crate) scene: Option<PathBuf>,
+    /// Absolute `--env` path, if given (absent from the notes of renders without).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(crate) env: Option<PathBuf>,
     /// Film size the render was started with (after `--width`/`--height`).
     pub(crate) width: u32,
     pub(crate) height: u32,
@@ -104,7 +109,7 @@ pub(crate) fn render_job(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Res
     check_outputs(&outputs, args.checkpoint.as_deref())?;
 
     // The scene and its [render] defaults.
-    let mut description = load_scene(scene)?;
+    let mut description = load_scene(scene, args.env.as_deref())?;
     apply_film(&mut description, film);
     let defaults = description.render.clone();
     let source = description.source.clone();
@@ -127,6 +132,7 @@ pub(crate) fn render_job(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Res
     };
     Ok(Job {
         scene_path: scene.map(absolute),
+        env_path: args.env.as_deref().map(absolute),
         description,
         params,
         budget,
@@ -137,11 +143,20 @@ pub(crate) fn render_job(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Res
     })
 }
 
-/// The scene file, or the built-in default scene.
-pub(crate) fn load_scene(scene: Option<&Path>) -> anyhow::Result<SceneDescription> {
+/// The scene file, or the built-in default scene, lit by the environment map `env` if given.
+pub(crate) fn load_scene(
+    scene: Option<&Path>,
+    env: Option<&Path>,
+) -> anyhow::Result<SceneDescription> {
+    let options = geometry::LoadOptions {
+        environment: env.map(Path::to_path_buf),
+        ..geometry::LoadOptions::default()
+    };
     Ok(match scene {
-        Some(path) => geometry::load(path)?,
-        None => geometry::load_toml_str(DEFAULT_SCENE, Path::new(DEFAULT_SCENE_NAME))?,
+        Some(path) => geometry::load_with(path, &options)?,
+        None => {
+            geometry::load_toml_str_with(DEFAULT_SCENE, Path::new(DEFAULT_SCENE_NAME), &options)?
+        }
     })
 }
 
@@ -337,6 +352,7 @@ pub(crate) fn note_for(job: &Job, render_seconds: f64) -> Note {
     let film = job.description.film;
     Note {
         scene: job.scene_path.clone(),
+        env: job.env_path.clone(),
         width: film.width,
         height: film.height,
         exr: absolute(&job.outputs.exr),

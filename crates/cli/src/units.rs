@@ -69,6 +69,7 @@ pub(crate) fn plan(args: PlanArgs) -> anyhow::Result<Outcome> {
         },
         width: args.width,
         height: args.height,
+        env: args.env,
         output: OutputArgs {
             exr: None,
             png: None,
@@ -110,6 +111,20 @@ pub(crate) fn plan(args: PlanArgs) -> anyhow::Result<Outcome> {
     film::write_atomically(&path, |w| {
         std::io::Write::write_all(w, &bytes).map_err(|e| e.to_string())
     })?;
+    if args.slurm {
+        let script = slurm_script(&args.job, units)?;
+        let path = args.job.join("submit.sh");
+        film::write_atomically(&path, |w| {
+            std::io::Write::write_all(w, script.as_bytes()).map_err(|e| e.to_string())
+        })?;
+        if !job.run.quiet {
+            eprintln!(
+                "wrote {} (submit with: sh {})",
+                path.display(),
+                path.display()
+            );
+        }
+    }
     if !job.run.quiet {
         eprintln!(
             "wrote {} ({units} units of {passes} passes; pilot {:.1}s). Render each with `fppm unit {} --index I` (I from 0 to {}), then `fppm merge {}`",
@@ -121,6 +136,32 @@ pub(crate) fn plan(args: PlanArgs) -> anyhow::Result<Outcome> {
         );
     }
     Ok(Outcome::Done)
+}
+
+/// `JOB/submit.sh`: an `sbatch --array` job of the units, each on one CPU, and a merge job
+/// that starts when all of them have succeeded. Paths are absolute, so that the script can be
+/// run from anywhere on a cluster whose nodes see the same file system.
+fn slurm_script(job: &Path, units: u32) -> anyhow::Result<String> {
+    let fppm = std::env::current_exe().context("cannot find the fppm executable")?;
+    let job = settings::absolute(job);
+    let quote = |p: &Path| format!("'{}'", p.display().to_string().replace('\'', "'\\''"));
+    let (fppm, job_q) = (quote(&fppm), quote(&job));
+    let image = quote(&job.join("image.exr"));
+    Ok(format!(
+        "#!/bin/sh
+# Written by `fppm plan --slurm`: {units} work units as a Slurm array job, then the merge.
+# Each unit reads its index from SLURM_ARRAY_TASK_ID; a unit that fails or is lost can be
+# resubmitted alone (sbatch --array=I), and renders the same bytes again.
+set -e
+cd {job_q}
+units=$(sbatch --parsable --array=0-{last} --cpus-per-task=1 --job-name=fppm-units \
+  --output=unit-%a.log --wrap=\"{fppm} unit {job_q} --threads 1 --quiet\")
+merge=$(sbatch --parsable --dependency=afterok:${{units%%;*}} --job-name=fppm-merge \
+  --output=merge.log --wrap=\"{fppm} merge {job_q} -o {image}\")
+echo \"submitted units (job ${{units%%;*}}) and their merge (job ${{merge%%;*}}) into {image}\"
+",
+        last = units - 1,
+    ))
 }
 
 /// The plan of a job folder: its bytes, header and note.
@@ -144,7 +185,8 @@ fn read_plan(job: &Path) -> anyhow::Result<(Vec<u8>, StateHeader, PlanNote)> {
 
 /// The scene of a plan, with the plan's film.
 fn plan_scene(note: &PlanNote) -> anyhow::Result<geometry::Scene> {
-    let mut description = settings::load_scene(note.render.scene.as_deref())?;
+    let mut description =
+        settings::load_scene(note.render.scene.as_deref(), note.render.env.as_deref())?;
     settings::apply_film(
         &mut description,
         (Some(note.render.width), Some(note.render.height)),
@@ -340,6 +382,7 @@ mod tests {
         PlanNote {
             render: Note {
                 scene: None,
+                env: None,
                 width: 1,
                 height: 1,
                 exr: PathBuf::new(),

@@ -35,6 +35,9 @@ pub struct SceneDescription {
     pub cylinders: Vec<Cylinder>,
     /// Point, spot and directional lights (area emitters are emissive materials).
     pub lights: Vec<Light>,
+    /// The environment light, if any (an extension to scene format 1, see
+    /// `docs/scene-format-extensions.md`).
+    pub environment: Option<crate::Environment>,
     /// Optional render defaults from the `[render]` table; flags override them.
     pub render: RenderDefaults,
     /// What the loader skipped or had to guess, for `fppm info` and reports.

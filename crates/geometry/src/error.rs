@@ -260,6 +260,15 @@ pub enum LoadError {
         /// What is wrong, e.g. `texture has zero size (0x0)`.
         message: String,
     },
+    /// An environment map cannot be used: unsupported format, undecodable, zero size, not
+    /// 2:1, a non-finite texel, or black everywhere.
+    #[error("{}: invalid environment map: {message}", path.display())]
+    EnvironmentMap {
+        /// The image file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// An emissive material is used only by degenerate (zero-area) triangles.
     #[error("{}: emissive material {material:?} has zero area (all its triangles are degenerate)", path.display())]
     ZeroAreaEmitter {
@@ -334,6 +343,7 @@ impl LoadError {
             | Self::Pbrt { path, .. }
             | Self::MeshFile { path, .. }
             | Self::Texture { path, .. }
+            | Self::EnvironmentMap { path, .. }
             | Self::NoSupportedEmitter { path, .. } => path,
         }
     }

@@ -73,7 +73,10 @@ pub use description::{
 };
 pub use error::LoadError;
 pub use frame::Frame;
-pub use light::{EmissionSample, EmitterShape, LightSample, LightSampler};
+pub use light::{
+    EmissionSample, EmitterShape, Environment, EnvironmentMap, EnvironmentRadiance, LightSample,
+    LightSampler,
+};
 pub use load::{
     DEFAULT_ALBEDO, DEFAULT_FILM_HEIGHT, DEFAULT_FILM_WIDTH, FRAMED_FOV_Y_DEGREES, LoadOptions,
     MAX_FILM_SIDE, METALLIC_THRESHOLD, load, load_toml_str, load_toml_str_with, load_with,

@@ -27,6 +27,10 @@ pub struct SceneSummary {
     pub emissive_spheres: usize,
     /// Delta lights by kind.
     pub lights: LightCounts,
+    /// The environment light: its file, size and memory, or its constant radiance, with scale
+    /// and rotation (left out of snapshots when there is none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub environment: Option<String>,
     /// Every material, with its parameters and how much geometry uses it.
     pub materials: Vec<MaterialSummary>,
     /// The camera.
@@ -261,6 +265,7 @@ impl SceneDescription {
             emissive_triangles: self.triangles.iter().filter(|t| emits(t.material)).count(),
             emissive_spheres: self.spheres.iter().filter(|s| emits(s.material)).count(),
             lights,
+            environment: self.environment.as_ref().map(crate::Environment::describe),
             materials,
             camera: CameraSummary {
                 position: c.position,
@@ -290,6 +295,7 @@ impl SceneSummary {
             + self.lights.point
             + self.lights.spot
             + self.lights.directional
+            + usize::from(self.environment.is_some())
     }
 }
 
@@ -310,6 +316,9 @@ impl fmt::Display for SceneSummary {
             "lights     {} point, {} spot, {} directional",
             self.lights.point, self.lights.spot, self.lights.directional
         )?;
+        if let Some(env) = &self.environment {
+            writeln!(f, "environment {env}")?;
+        }
         let c = &self.camera;
         writeln!(
             f,

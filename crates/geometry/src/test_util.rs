@@ -79,6 +79,7 @@ pub(crate) fn description(
             height: 32,
         },
         materials: vec![diffuse(0.5, Vec3::ZERO), diffuse(0.0, Vec3::ONE)],
+        environment: None,
         triangles,
         spheres,
         cylinders: Vec::new(),

@@ -14,6 +14,7 @@ use glam::Vec3;
 use crate::description::{Cylinder, Light, Material, MaterialKind, SceneDescription};
 use crate::light::Emitters;
 use crate::sampling::Distribution1D;
+use crate::{Environment, EnvironmentRadiance};
 use crate::{LoadError, SceneError};
 
 /// One problem of a scene description.
@@ -303,7 +304,62 @@ fn cylinder(i: usize, c: &Cylinder, materials: &[Material]) -> Result<(), Invali
 /// Every check of a description: [`materials_and_lights`], then [`primitives`].
 pub(crate) fn description(d: &SceneDescription) -> Result<(), Invalid> {
     materials_and_lights(&d.materials, &d.lights)?;
+    if let Some(env) = &d.environment {
+        environment(env)?;
+    }
     primitives(d)
+}
+
+/// The environment light: a finite non-negative scale and rotation, a finite non-negative
+/// constant radiance, or a map of the size its texels say (finite, non-negative texels are
+/// checked when it is read, `EnvironmentMap::load`).
+pub(crate) fn environment(env: &Environment) -> Result<(), Invalid> {
+    if !(env.scale.is_finite() && env.scale >= 0.0) {
+        return Err(Invalid::value(
+            "environment scale",
+            format!("must be finite and >= 0, got {}", env.scale),
+        ));
+    }
+    let r = env.to_world;
+    let orthonormal = (r.transpose() * r - glam::Mat3::IDENTITY)
+        .to_cols_array()
+        .iter()
+        .all(|e| e.abs() < 1e-3);
+    if !(r.is_finite() && orthonormal && (r.determinant() - 1.0).abs() < 1e-3) {
+        return Err(Invalid::value(
+            "environment to_world",
+            format!("must be a rotation, got {r}"),
+        ));
+    }
+    match &env.radiance {
+        EnvironmentRadiance::Constant(c) => colour("environment radiance", *c),
+        EnvironmentRadiance::Map(map) => {
+            let (w, h) = (map.width as usize, map.height as usize);
+            if w == 0 || w != 2 * h || map.texels.len() != w * h {
+                return Err(Invalid::value(
+                    format!("environment map `{}`", map.path.display()),
+                    format!(
+                        "must be 2:1 with one texel per pixel, got {w}×{h} and {} texels",
+                        map.texels.len()
+                    ),
+                ));
+            }
+            match map
+                .texels
+                .iter()
+                .position(|t| !t.is_finite() || t.cmplt(Vec3::ZERO).any())
+            {
+                Some(i) => Err(Invalid::value(
+                    format!("environment map `{}`", map.path.display()),
+                    format!(
+                        "texel {i} is {} (must be finite and >= 0)",
+                        fmt_vec(map.texels[i])
+                    ),
+                )),
+                None => Ok(()),
+            }
+        }
+    }
 }
 
 /// Every material and light.

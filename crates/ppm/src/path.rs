@@ -85,7 +85,7 @@ impl<'s> PathTracer<'s> {
         let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
         let ray = self.scene.camera().generate_ray(film, sampler.next_2d());
         let Some(hit) = self.scene.intersect(&ray) else {
-            return Rgb::ZERO;
+            return self.scene.lights().environment_radiance(ray.direction);
         };
         self.scene.emitted(&hit) + self.scattered(hit, -ray.direction, 0, &mut sampler)
     }
@@ -134,6 +134,16 @@ impl<'s> PathTracer<'s> {
             }
             let ray = hit.spawn_ray(sample.incoming);
             let Some(next) = self.scene.intersect(&ray) else {
+                // The path escapes: it sees the environment, shared with light sampling as an
+                // emitter's emission is.
+                if lights.has_environment() {
+                    let weight = if sample.is_specular {
+                        1.0
+                    } else {
+                        power_heuristic(sample.pdf, lights.pdf_environment(ray.direction))
+                    };
+                    radiance += beta * lights.environment_radiance(ray.direction) * weight;
+                }
                 break;
             };
             let emitted = self.scene.emitted(&next);

@@ -9,7 +9,7 @@
 //! renderer whose next passes are bit-identical to those of the renderer that was saved; the
 //! hash grid is not stored (it is rebuilt, and gathers do not depend on its layout).
 
-use geometry::{Light, MaterialKind, Scene, SceneDescription};
+use geometry::{EnvironmentRadiance, Light, MaterialKind, Scene, SceneDescription};
 use glam::Vec3;
 use photon::{HitPoints, NewHitPoint};
 use spectrum::{FrequencyEstimate, MergePolicy, Spectrum};
@@ -614,6 +614,27 @@ pub fn scene_fingerprint(d: &SceneDescription) -> u64 {
                 [direction, irradiance]
                     .iter()
                     .for_each(|v| v.to_array().iter().for_each(|&c| w.f32(c)));
+            }
+        }
+    }
+    // Only a scene with an environment hashes one, so that the fingerprints of scenes
+    // without stay what they were.
+    if let Some(env) = &d.environment {
+        w.u32(3);
+        w.f32(env.scale);
+        env.to_world.to_cols_array().iter().for_each(|&c| w.f32(c));
+        match &env.radiance {
+            EnvironmentRadiance::Constant(c) => {
+                w.u32(0);
+                c.to_array().iter().for_each(|&c| w.f32(c));
+            }
+            EnvironmentRadiance::Map(map) => {
+                w.u32(1);
+                w.u32(map.width);
+                w.u32(map.height);
+                for t in &map.texels {
+                    t.to_array().iter().for_each(|&c| w.f32(c));
+                }
             }
         }
     }

@@ -517,3 +517,47 @@ fn absurd_sizes_are_refused_at_once_with_the_flag_to_lower() {
     )
     .ok();
 }
+
+/// `--env` with a bad map: exit 1, one line naming the map, nothing written.
+#[test]
+fn bad_environment_maps() {
+    let dir = temp_dir("bad_env");
+    check_in(
+        &dir,
+        &[&["render", CORNELL, "--env", "gone.exr"], TINY].concat(),
+        1,
+        &["gone.exr", "cannot read file"],
+        &[],
+    );
+    exr::prelude::write_rgb_file(dir.join("square.exr"), 8, 8, |_, _| {
+        (1.0f32, 1.0f32, 1.0f32)
+    })
+    .unwrap();
+    check_in(
+        &dir,
+        &[&["render", CORNELL, "--env", "square.exr"], TINY].concat(),
+        1,
+        &["square.exr", "invalid environment map", "not 2:1"],
+        &["square.exr"],
+    );
+    exr::prelude::write_rgb_file(dir.join("nan.exr"), 8, 4, |x, _| {
+        let v = if x == 1 { f32::NAN } else { 1.0 };
+        (v, v, v)
+    })
+    .unwrap();
+    check_in(
+        &dir,
+        &[&["render", CORNELL, "--env", "nan.exr"], TINY].concat(),
+        1,
+        &["nan.exr", "texel (1, 0) is not finite"],
+        &["nan.exr", "square.exr"],
+    );
+    std::fs::write(dir.join("sky.hdr"), "#?RADIANCE\ngarbage").unwrap();
+    check_in(
+        &dir,
+        &["info", CORNELL, "--env", "sky.hdr"],
+        1,
+        &["sky.hdr", "cannot decode"],
+        &["nan.exr", "sky.hdr", "square.exr"],
+    );
+}

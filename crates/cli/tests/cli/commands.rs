@@ -264,3 +264,69 @@ fn gltf_and_glb_scenes_render() {
     fppm(&dir, &["render", &dark, "-o", "box.exr"]).fails(1, &["Box.glb", "no emitter"]);
     assert_eq!(files(&dir), ["glb.exr", "glb.png", "gltf.exr", "gltf.png"]);
 }
+
+/// `--env` lights any scene: `info` lists the map, a render through the open front of the
+/// Cornell box sees it, and `resume` finds the map again from the checkpoint.
+#[test]
+fn env_flag_lights_a_scene_and_survives_resume() {
+    let dir = temp_dir("env_flag");
+    // A uniform grey sky of radiance 0.25, 16 × 8 texels.
+    exr::prelude::write_rgb_file(dir.join("sky.exr"), 16, 8, |_, _| {
+        (0.25f32, 0.25f32, 0.25f32)
+    })
+    .unwrap();
+    let info = fppm(&dir, &["info", CORNELL, "--env", "sky.exr"]).ok();
+    assert!(
+        info.stdout.contains("environment sky.exr (16×8"),
+        "{}",
+        info.stdout
+    );
+    let tiny = [
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--photons-per-pass",
+        "2000",
+    ];
+    let mut args = vec!["render", CORNELL, "--env", "sky.exr", "--method", "path"];
+    args.extend_from_slice(&tiny);
+    let plain: Vec<&str> = args
+        .iter()
+        .copied()
+        .filter(|&a| a != "--env" && a != "sky.exr")
+        .collect();
+    fppm(
+        &dir,
+        &[&plain[..], &["--passes", "2", "-o", "plain.exr"]].concat(),
+    )
+    .ok();
+    fppm(
+        &dir,
+        &[
+            &args[..],
+            &[
+                "--passes",
+                "2",
+                "--checkpoint",
+                "state.fppm",
+                "-o",
+                "lit.exr",
+            ],
+        ]
+        .concat(),
+    )
+    .ok();
+    let (plain, lit) = (
+        read_exr(&dir.join("plain.exr")),
+        read_exr(&dir.join("lit.exr")),
+    );
+    let sum = |e: &crate::Exr| e.rgb().iter().map(|&v| f64::from(v)).sum::<f64>();
+    assert!(sum(&lit) > sum(&plain) * 1.01, "the sky adds no light");
+    fppm(
+        &dir,
+        &["resume", "state.fppm", "--passes", "3", "-o", "more.exr"],
+    )
+    .ok();
+    assert!(dir.join("more.exr").exists());
+}

@@ -162,3 +162,40 @@ fn bad_plans_units_and_parts_get_one_line() {
         .fails(1, &["unit-0.part", "another plan"]);
     assert!(!dir.join("out.exr").exists());
 }
+
+/// A scheduler's retry renders the same bytes; a unit of a plan whose scene file changed since
+/// planning is refused.
+#[test]
+fn a_rerun_unit_gives_the_same_bytes_and_a_changed_scene_is_refused() {
+    let dir = temp_dir("units_rerun");
+    let scene = dir.join("box.obj");
+    std::fs::copy(CORNELL, &scene).unwrap();
+    let mtl = std::path::Path::new(CORNELL).with_extension("mtl");
+    std::fs::copy(&mtl, dir.join(mtl.file_name().unwrap())).unwrap();
+    fppm(
+        &dir,
+        &[
+            &[
+                "plan", "box.obj", "-o", "job", "--passes", "4", "--units", "2",
+            ][..],
+            FILM,
+        ]
+        .concat(),
+    )
+    .ok();
+    fppm(&dir, &["unit", "job", "--index", "1"]).ok();
+    let first = std::fs::read(dir.join("job/unit-1.part")).unwrap();
+    fppm(&dir, &["unit", "job", "--index", "1"]).ok();
+    assert_eq!(std::fs::read(dir.join("job/unit-1.part")).unwrap(), first);
+    // Move one vertex of the box: the plan no longer fits the scene.
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let line = text.lines().find(|l| l.starts_with("v ")).unwrap();
+    let moved: Vec<String> = line
+        .split_whitespace()
+        .skip(1)
+        .map(|x| (x.parse::<f64>().unwrap() + 0.01).to_string())
+        .collect();
+    let edited_line = format!("v {}", moved.join(" "));
+    std::fs::write(&scene, text.replacen(line, &edited_line, 1)).unwrap();
+    fppm(&dir, &["unit", "job", "--index", "0"]).fails(1, &["plan.fppm", "another scene"]);
+}

@@ -19,6 +19,7 @@ use glam::{Vec2, Vec3};
 pub fn load_triangles(path: &Path) -> SceneDescription {
     let options = geometry::LoadOptions {
         require_emitter: false,
+        ..Default::default()
     };
     let mut description = geometry::load_with(path, &options).unwrap();
     description.film = Film {

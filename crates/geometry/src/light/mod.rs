@@ -6,7 +6,9 @@
 //! - point: 4π·I;
 //! - spot: 2π·I·((1 − cos θ_start) + (cos θ_start − cos θ_cone)/2), exact for the smoothstep falloff;
 //! - directional: π·r²·E over the disc of radius r that covers the scene's bounding sphere;
-//! - area: π·L·A (a Lambertian emitter).
+//! - area: π·L·A (a Lambertian emitter);
+//! - environment: π·r²·∫L dω over the disc of radius r that covers the scene's bounding sphere
+//!   (`environment.rs`).
 //!
 //! Spot falloff (pbrt-v4): intensity × smoothstep(cos θ; cos θ_cone, cos θ_start), i.e. full inside
 //! `falloff_start`, zero outside `cone_angle`, a smoothstep in cos θ between.
@@ -26,11 +28,15 @@ use crate::{
     validate::Powered,
 };
 
+mod environment;
 #[cfg(test)]
 mod tests;
 mod textured;
 
 use textured::TexturedTriangle;
+
+use environment::EnvironmentLight;
+pub use environment::{Environment, EnvironmentMap, EnvironmentRadiance};
 
 /// What emitted a photon, for the frequency analysis of the emitted light field.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,6 +59,12 @@ pub enum EmitterShape {
     },
     /// A directional light (photons start on a disc covering the scene).
     Directional,
+    /// The environment (photons start on a disc covering the scene): a directional light of
+    /// the angular width of the texel the photon comes from.
+    Environment {
+        /// Angular width in radians: √(solid angle) of the texel, π for a constant sky.
+        angle: f32,
+    },
 }
 
 /// A direction toward a light for next-event estimation at a point.
@@ -63,7 +75,7 @@ pub enum EmitterShape {
 pub struct LightSample {
     /// Unit direction from the point toward the light.
     pub incoming: Vec3,
-    /// Distance to the sampled point on the light; ∞ for a directional light.
+    /// Distance to the sampled point on the light; ∞ for a directional or environment light.
     pub distance: f32,
     /// Incident radiance for area emitters; for delta lights the incident irradiance on a surface
     /// facing the light (I·falloff/d² or E).
@@ -150,6 +162,8 @@ enum Emitter {
         radius: f32,
         radiance: Rgb,
     },
+    /// The scene's environment, held by [`LightSampler::environment`].
+    Environment,
 }
 
 /// All emitters of a scene and the distribution that picks them by power.
@@ -164,6 +178,8 @@ pub struct LightSampler {
     sphere_emitter: Vec<u32>,
     /// The emission textures of textured triangle emitters.
     textured: Vec<TexturedTriangle>,
+    /// The environment light and its emitter index, if the scene has one.
+    environment: Option<(Box<EnvironmentLight>, usize)>,
 }
 
 /// The emitters of a valid description (see `crate::validate`) and their powers, before
@@ -175,11 +191,12 @@ pub(crate) struct Emitters {
     triangle_emitter: Vec<u32>,
     sphere_emitter: Vec<u32>,
     textured: Vec<TexturedTriangle>,
+    environment: Option<(Box<EnvironmentLight>, usize)>,
 }
 
 impl Emitters {
-    /// Collects the lights and the emissive triangles and spheres of `desc`; `bounds` sizes the
-    /// disc of directional lights.
+    /// Collects the lights, the emissive triangles and spheres and the environment of `desc`;
+    /// `bounds` sizes the disc of directional and environment lights.
     pub(crate) fn collect(desc: &SceneDescription, bounds: Aabb) -> Self {
         let mut emitters = Vec::new();
         for light in &desc.lights {
@@ -291,13 +308,30 @@ impl Emitters {
                 radiance,
             });
         }
-        let powers: Vec<Rgb> = emitters.iter().map(Emitter::power).collect();
+        let environment = desc
+            .environment
+            .as_ref()
+            .and_then(|env| EnvironmentLight::new(env, bounds))
+            .map(|light| {
+                emitters.push(Emitter::Environment);
+                (Box::new(light), emitters.len() - 1)
+            });
+        let powers: Vec<Rgb> = emitters
+            .iter()
+            .map(|e| match e {
+                Emitter::Environment => environment
+                    .as_ref()
+                    .map_or(Rgb::ZERO, |(light, _)| light.power()),
+                e => e.power(),
+            })
+            .collect();
         Self {
             emitters,
             powers,
             triangle_emitter,
             sphere_emitter,
             textured,
+            environment,
         }
     }
 
@@ -321,6 +355,7 @@ impl LightSampler {
                 triangle_emitter,
                 sphere_emitter,
                 textured,
+                environment,
             },
             distribution,
         ) = powered.into_parts();
@@ -331,6 +366,33 @@ impl LightSampler {
             triangle_emitter,
             sphere_emitter,
             textured,
+            environment,
+        }
+    }
+
+    /// Whether the scene has an environment light.
+    #[inline]
+    pub fn has_environment(&self) -> bool {
+        self.environment.is_some()
+    }
+
+    /// Radiance arriving from the environment along the unit world direction `direction`
+    /// (what a ray that escapes the scene sees); zero without an environment.
+    #[inline]
+    pub fn environment_radiance(&self, direction: Vec3) -> Rgb {
+        match &self.environment {
+            Some((light, _)) => light.eval(direction),
+            None => Rgb::ZERO,
+        }
+    }
+
+    /// Solid-angle density with which [`LightSampler::sample_direct`] draws the environment in
+    /// the unit world direction `direction` (for multiple importance sampling of escaped rays);
+    /// zero without an environment.
+    pub fn pdf_environment(&self, direction: Vec3) -> f32 {
+        match &self.environment {
+            Some((light, idx)) => self.distribution.pmf(*idx) * light.pdf(direction),
+            None => 0.0,
         }
     }
 
@@ -429,6 +491,18 @@ impl LightSampler {
                     radiance,
                     (n, 4.0 * PI * radius * radius),
                 )
+            }
+            Emitter::Environment => {
+                let (light, _) = self.environment.as_ref()?;
+                let s = light.sample(u)?;
+                let pdf = p_light * s.pdf;
+                return (pdf > 0.0 && pdf.is_finite()).then_some(LightSample {
+                    incoming: s.direction,
+                    distance: f32::INFINITY,
+                    radiance: s.radiance,
+                    pdf,
+                    is_delta: false,
+                });
             }
         };
         let (normal, area) = pdf_area_to_solid;
@@ -603,6 +677,18 @@ impl LightSampler {
                     origin_error: (8.0 * f32::EPSILON) * (origin.abs() + center.abs()),
                 }
             }
+            Emitter::Environment => {
+                let (light, _) = self.environment.as_ref()?;
+                let (origin, direction, power, angle) = light.sample_emission(u_pos, u_dir)?;
+                EmissionSample {
+                    origin,
+                    direction,
+                    power,
+                    normal: direction,
+                    emitter: EmitterShape::Environment { angle },
+                    origin_error: Vec3::ZERO,
+                }
+            }
         };
         let power = sample.power / p_light;
         (power.is_finite() && power.cmpgt(Rgb::ZERO).any())
@@ -627,6 +713,8 @@ impl Emitter {
             Emitter::Sphere {
                 radius, radiance, ..
             } => radiance * (PI * 4.0 * PI * radius * radius),
+            // Held by the sampler, which knows its power (`Emitters::collect`).
+            Emitter::Environment => Rgb::ZERO,
         }
     }
 }

@@ -156,6 +156,8 @@ pub(crate) struct Builder {
     degenerate_materials: HashSet<u32>,
     /// Emitters that were skipped (environment lights), for the no-emitter error.
     pub(crate) skipped_emitters: Vec<String>,
+    /// The environment light (the first the file defines).
+    pub(crate) environment: Option<crate::Environment>,
 }
 
 impl Builder {
@@ -293,6 +295,7 @@ impl Builder {
         if options.require_emitter
             && !has_area
             && self.lights.is_empty()
+            && self.environment.is_none()
             && !self.skipped_emitters.is_empty()
         {
             return Err(LoadError::NoSupportedEmitter {
@@ -308,6 +311,7 @@ impl Builder {
             spheres: self.spheres,
             cylinders: self.cylinders,
             lights: self.lights,
+            environment: self.environment,
             render,
             notes: LoadNotes {
                 degenerate_triangles: self.degenerate_triangles,
@@ -357,8 +361,37 @@ fn srgb_to_linear(v: f64) -> f64 {
     }
 }
 
-/// The stand-in for an environment light (Mitsuba `envmap`/`constant`, pbrt `infinite`):
-/// nothing, and a warning; the element is remembered for the no-emitter error.
+/// Sets the scene's environment light; a second one is dropped with a warning (fppm renders
+/// one environment).
+pub(crate) fn set_environment(builder: &mut Builder, element: &str, env: crate::Environment) {
+    if builder.environment.is_some() {
+        builder.warn(format!(
+            "{element}: a second environment light is ignored (fppm renders one)"
+        ));
+    } else {
+        builder.environment = Some(env);
+    }
+}
+
+/// The rotation of an affine transform whose linear part is a rotation times a uniform scale;
+/// `None` for anything else (a mirror, a shear, a non-uniform scale).
+pub(crate) fn rotation_part(m: glam::DMat4) -> Option<glam::Mat3> {
+    let linear = glam::DMat3::from_mat4(m);
+    let scale = linear.determinant().cbrt();
+    if !(scale.is_finite() && scale > 0.0) {
+        return None;
+    }
+    let r = linear * (1.0 / scale);
+    let off = (r.transpose() * r - glam::DMat3::IDENTITY)
+        .to_cols_array()
+        .iter()
+        .fold(0.0f64, |a, e| a.max(e.abs()));
+    (off < 1e-4).then(|| r.as_mat3())
+}
+
+/// The stand-in for an environment light fppm cannot render (Mitsuba `sunsky`, pbrt
+/// `infinite` with an image): nothing, and a warning; the element is remembered for the
+/// no-emitter error.
 pub(crate) fn environment_light_standin(builder: &mut Builder, element: &str) {
     builder.warn(format!(
         "{element}: environment lights are not supported yet; the scene is rendered without it"

@@ -31,6 +31,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
+use crate::Environment;
 use crate::description::{
     Camera, Cylinder, Film, Light, LoadNotes, Material, RenderDefaults, SceneDescription, Sphere,
     Triangle,
@@ -58,12 +59,16 @@ pub struct LoadOptions {
     /// Fail with [`LoadError::NoEmitter`] when nothing emits light (the default, and what
     /// [`load`] does). Turn it off to inspect a scene (`fppm info`) or to load a bare mesh.
     pub require_emitter: bool,
+    /// An environment map (`.exr` or `.hdr`) to light the scene with, replacing the scene's
+    /// own environment if it has one (the `--env` flag).
+    pub environment: Option<PathBuf>,
 }
 
 impl Default for LoadOptions {
     fn default() -> Self {
         Self {
             require_emitter: true,
+            environment: None,
         }
     }
 }
@@ -74,6 +79,7 @@ impl LoadOptions {
     pub fn allow_no_emitter() -> Self {
         Self {
             require_emitter: false,
+            environment: None,
         }
     }
 }
@@ -209,6 +215,7 @@ impl MeshData {
             spheres: Vec::new(),
             cylinders: Vec::new(),
             lights: self.lights,
+            environment: None,
             render: RenderDefaults::default(),
             notes: LoadNotes {
                 degenerate_triangles: self.degenerate_triangles,
@@ -270,6 +277,7 @@ pub(crate) struct SceneParts {
     pub(crate) spheres: Vec<Sphere>,
     pub(crate) cylinders: Vec<Cylinder>,
     pub(crate) lights: Vec<Light>,
+    pub(crate) environment: Option<Environment>,
     pub(crate) render: RenderDefaults,
     pub(crate) notes: LoadNotes,
     /// Material indices that lost at least one triangle as degenerate.
@@ -290,10 +298,30 @@ pub(crate) fn finish(
         spheres,
         cylinders,
         lights,
+        mut environment,
         render,
         mut notes,
         degenerate_materials,
     } = parts;
+    if let Some(file) = &options.environment {
+        let (env, negative) = Environment::from_file(file)?;
+        if negative > 0 {
+            notes.warnings.push(format!(
+                "{}: {negative} negative texels read as 0",
+                file.display()
+            ));
+        }
+        if environment.is_some() {
+            notes.warnings.push(format!(
+                "--env {} replaces the scene's environment",
+                file.display()
+            ));
+        }
+        environment = Some(env);
+    }
+    if let Some(env) = &environment {
+        validate::environment(env).map_err(|e| e.in_file(path))?;
+    }
     validate::materials_and_lights(&materials, &lights).map_err(|e| e.in_file(path))?;
     if triangles.is_empty() && spheres.is_empty() && cylinders.is_empty() {
         return Err(LoadError::EmptyScene {
@@ -332,7 +360,10 @@ pub(crate) fn finish(
     let has_delta_emitter = lights
         .iter()
         .any(|l| validate::light_power(l).max_element() > 0.0);
-    if options.require_emitter && !has_area_emitter && !has_delta_emitter {
+    let has_environment = environment
+        .as_ref()
+        .is_some_and(|env| env.integrated_radiance().max_element() > 0.0);
+    if options.require_emitter && !has_area_emitter && !has_delta_emitter && !has_environment {
         return Err(LoadError::NoEmitter {
             path: path.to_path_buf(),
         });
@@ -354,6 +385,7 @@ pub(crate) fn finish(
         spheres,
         cylinders,
         lights,
+        environment,
         render,
         notes,
     };

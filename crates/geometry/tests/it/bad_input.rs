@@ -264,6 +264,43 @@ const EDITS: &[(&str, &str, &[&str])] = &[
         "emission = [0.0, 0.0, 0.0]",
         &["NoEmitter {"],
     ),
+    // Environment lights (an extension, docs/scene-format-extensions.md).
+    (
+        "material = \"lamp\"\n",
+        "material = \"lamp\"\n[[lights]]\ntype = \"environment\"\nfile = \"sky.exr\"\nradiance = [1.0, 1.0, 1.0]\n",
+        &["InvalidValue {", "[[lights]] #1 file", "exactly one"],
+    ),
+    (
+        "material = \"lamp\"\n",
+        "material = \"lamp\"\n[[lights]]\ntype = \"environment\"\n",
+        &["InvalidValue {", "exactly one"],
+    ),
+    (
+        "material = \"lamp\"\n",
+        "material = \"lamp\"\n[[lights]]\ntype = \"environment\"\nradiance = [1.0, -1.0, 1.0]\n",
+        &["InvalidValue {", "radiance"],
+    ),
+    (
+        "material = \"lamp\"\n",
+        "material = \"lamp\"\n[[lights]]\ntype = \"environment\"\nradiance = [1.0, 1.0, 1.0]\nscale = -2.0\n",
+        &["InvalidValue {", "scale"],
+    ),
+    (
+        "material = \"lamp\"\n",
+        "material = \"lamp\"\n[[lights]]\ntype = \"environment\"\nradiance = [1.0, 1.0, 1.0]\nrotate = [0.0, nan, 0.0]\n",
+        &["InvalidValue {", "rotate"],
+    ),
+    (
+        "material = \"lamp\"\n",
+        "material = \"lamp\"\n[[lights]]\ntype = \"environment\"\nradiance = [1.0, 1.0, 1.0]\n\
+         [[lights]]\ntype = \"environment\"\nradiance = [2.0, 2.0, 2.0]\n",
+        &["InvalidValue {", "[[lights]] #2", "twice"],
+    ),
+    (
+        "material = \"lamp\"\n",
+        "material = \"lamp\"\n[[lights]]\ntype = \"environment\"\nradiance = [1.0, 1.0, 1.0]\nturn = 3.0\n",
+        &["UnknownKey {", "key: \"turn\""],
+    ),
 ];
 
 /// Files (name, text; the first is loaded) and what the error must be, as in [`EDITS`], and
@@ -627,4 +664,156 @@ fn bad_texture_files_name_the_image() {
         assert!(msg.contains(needle), "{test}: {msg}");
         assert!(!msg.contains('\n'), "{test}: {msg}");
     }
+}
+/// An OpenEXR file of `width` × `height` RGB texels from `texel(x, y)`.
+fn write_exr(path: &Path, width: usize, height: usize, texel: impl Fn(usize, usize) -> f32 + Sync) {
+    exr::prelude::write_rgb_file(path, width, height, |x, y| {
+        let t = texel(x, y);
+        (t, t, t)
+    })
+    .unwrap();
+}
+
+/// Test name, map file name, how to make it, fragments of the error.
+type BadMap = (
+    &'static str,
+    &'static str,
+    fn(&Path),
+    &'static [&'static str],
+);
+
+/// Bad environment maps: how each file is made, and what the error must be (as in [`EDITS`]).
+/// The scene (the valid `BASE` plus an environment light of that file) and `--env` must both
+/// fail with an error naming the map.
+const ENV_MAPS: &[BadMap] = &[
+    ("env_missing", "sky.exr", |_| {}, &["Io {"]),
+    (
+        "env_corrupt",
+        "sky.exr",
+        |p| std::fs::write(p, "not an exr file").unwrap(),
+        &["EnvironmentMap {", "cannot decode"],
+    ),
+    (
+        "env_truncated",
+        "sky.exr",
+        |p| {
+            write_exr(p, 16, 8, |_, _| 1.0);
+            let bytes = std::fs::read(p).unwrap();
+            std::fs::write(p, &bytes[..bytes.len() / 2]).unwrap();
+        },
+        &["EnvironmentMap {", "cannot decode"],
+    ),
+    (
+        "env_png",
+        "sky.png",
+        |p| std::fs::write(p, "png").unwrap(),
+        &["EnvironmentMap {", "unsupported image format"],
+    ),
+    (
+        "env_square",
+        "sky.exr",
+        |p| write_exr(p, 8, 8, |_, _| 1.0),
+        &["EnvironmentMap {", "8×8, not 2:1"],
+    ),
+    (
+        "env_zero_size",
+        "sky.hdr",
+        |p| std::fs::write(p, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 0 +X 0\n").unwrap(),
+        &["EnvironmentMap {"],
+    ),
+    (
+        "env_nan",
+        "sky.exr",
+        |p| {
+            write_exr(
+                p,
+                16,
+                8,
+                |x, y| if (x, y) == (3, 5) { f32::NAN } else { 1.0 },
+            )
+        },
+        &["EnvironmentMap {", "texel (3, 5) is not finite"],
+    ),
+    (
+        "env_inf",
+        "sky.exr",
+        |p| write_exr(p, 16, 8, |x, _| if x == 15 { f32::INFINITY } else { 1.0 }),
+        &["EnvironmentMap {", "texel (15, 0) is not finite"],
+    ),
+    (
+        "env_black",
+        "sky.exr",
+        |p| write_exr(p, 16, 8, |_, _| 0.0),
+        &["EnvironmentMap {", "black"],
+    ),
+];
+
+#[test]
+fn every_bad_environment_map_is_its_own_error() {
+    for (test, name, make, expect) in ENV_MAPS {
+        let dir = crate::temp_dir(test);
+        let map = dir.join(name);
+        make(&map);
+        let scene = dir.join("scene.toml");
+        std::fs::write(
+            &scene,
+            format!("{BASE}\n[[lights]]\ntype = \"environment\"\nfile = \"{name}\"\n"),
+        )
+        .unwrap();
+        let options = LoadOptions {
+            environment: Some(map.clone()),
+            ..Default::default()
+        };
+        let base = dir.join("base.toml");
+        std::fs::write(&base, BASE).unwrap();
+        for err in [
+            load(&scene).expect_err(test),
+            load_with(&base, &options).expect_err(test),
+        ] {
+            let debug = format!("{err:?}");
+            for fragment in *expect {
+                assert!(
+                    debug.contains(fragment),
+                    "{test}: {fragment} not in {debug}"
+                );
+            }
+            assert_names_file(&err, &map);
+        }
+    }
+}
+
+#[test]
+fn a_good_environment_map_loads_and_lights_a_scene_alone() {
+    let dir = crate::temp_dir("env_good");
+    write_exr(&dir.join("sky.exr"), 16, 8, |x, y| {
+        if x == 2 { -0.5 } else { (x + y) as f32 }
+    });
+    // No other emitter: the environment alone must do.
+    let scene = dir.join("scene.toml");
+    let without_lamp = BASE.replace("emission = [17.0, 12.0, 4.0]", "emission = [0.0, 0.0, 0.0]");
+    std::fs::write(
+        &scene,
+        format!("{without_lamp}\n[[lights]]\ntype = \"environment\"\nfile = \"sky.exr\"\nscale = 2.0\nrotate = [0.0, 90.0, 0.0]\n"),
+    )
+    .unwrap();
+    let description = load(&scene).unwrap();
+    let env = description.environment.as_ref().unwrap();
+    assert_eq!(env.scale, 2.0);
+    // 90° about y: the map's +z (its centre) looks toward world +x.
+    assert!((env.to_world * glam::Vec3::Z - glam::Vec3::X).length() < 1e-6);
+    let geometry::EnvironmentRadiance::Map(map) = &env.radiance else {
+        panic!("{env:?}");
+    };
+    assert_eq!((map.width, map.height), (16, 8));
+    // Row-major, top row first, as the file stores it; negative texels read as zero.
+    assert_eq!(map.texels[16 * 3 + 5], glam::Vec3::splat(8.0));
+    assert_eq!(map.texels[2], glam::Vec3::ZERO);
+    assert!(
+        description
+            .notes
+            .warnings
+            .iter()
+            .any(|w| w.contains("8 negative texels"))
+    );
+    geometry::Scene::new(description).unwrap();
 }

@@ -135,15 +135,16 @@ fn cornell_boxes_render_settings_follow_mitsuba() {
 }
 
 #[test]
-fn envmap_only_scene_is_a_clear_error_when_rendering() {
+fn envmap_only_scene_loads_with_its_environment() {
     let path = mitsuba("docs/scenes/shape_ply_bunny.xml");
-    let err = load(&path).unwrap_err();
-    assert!(matches!(err, LoadError::NoSupportedEmitter { .. }), "{err}");
-    assert!(
-        err.to_string().contains("<emitter type=\"envmap\""),
-        "{err}"
-    );
-    assert_names_file(&err, &path);
+    let scene = load(&path).unwrap();
+    let env = scene.environment.as_ref().unwrap();
+    let geometry::EnvironmentRadiance::Map(map) = &env.radiance else {
+        panic!("{env:?}");
+    };
+    assert!(map.path.ends_with("museum.exr"), "{}", map.path.display());
+    assert_eq!((map.width, map.height), (512, 256));
+    geometry::Scene::new(scene).unwrap();
 }
 
 /// A small valid scene: a rectangle lit by a point light, with a parameter.
@@ -326,11 +327,11 @@ fn no_emitter_at_all_is_an_error() {
     let (err, path) = load_edited(
         "mitsuba_no_emitter",
         "<emitter type=\"point\">",
-        "<emitter type=\"constant\">",
+        "<emitter type=\"sunsky\">",
     );
     let err = err.unwrap_err();
     assert!(matches!(err, LoadError::NoSupportedEmitter { .. }), "{err}");
-    assert_message(&err, &path, &["<emitter type=\"constant\">"]);
+    assert_message(&err, &path, &["<emitter type=\"sunsky\">"]);
 }
 
 #[test]

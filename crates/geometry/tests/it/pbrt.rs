@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use geometry::{LoadError, LoadOptions, load, load_with};
+use geometry::{LoadError, load};
 
 use crate::{assert_names_file, fixture, shared_scenes};
 
@@ -304,24 +304,78 @@ fn lying_ply_header() {
 }
 
 #[test]
-fn infinite_light_only_is_a_clear_error() {
-    let (err, path) = load_edited(
-        "pbrt_infinite",
+fn infinite_lights_constant_and_octahedral_map() {
+    // A constant sky alone lights the scene.
+    let (scene, _) = load_edited(
+        "pbrt_infinite_constant",
         "LightSource \"point\" \"rgb I\" [ 5 5 5 ] \"point3 from\" [ 0 0 3 ]",
-        "LightSource \"infinite\" \"rgb L\" [ 1 1 1 ]",
+        "LightSource \"infinite\" \"rgb L\" [ 1 2 3 ] \"float scale\" 2",
+    );
+    let env = scene.unwrap().environment.unwrap();
+    assert_eq!(
+        env.radiance,
+        geometry::EnvironmentRadiance::Constant(glam::Vec3::new(1.0, 2.0, 3.0))
+    );
+    assert_eq!(env.scale, 2.0);
+    // An equal-area octahedral map: written here with distinct texels where pbrt's
+    // `EqualAreaSphereToSquare` puts +z (the centre), +x (the middle of the right edge) and +y
+    // (the middle of the bottom edge), and found in the world where point lights placed along
+    // those axes of the light's frame end up (the same transform, by another route).
+    let dir = crate::temp_dir("pbrt_infinite_map");
+    exr::prelude::write_rgb_file(dir.join("sky.exr"), 8, 8, |i, j| {
+        let v = match (i, j) {
+            (3..=4, 3..=4) => 10.0f32,
+            (7, 3..=4) => 20.0,
+            (3..=4, 7) => 30.0,
+            _ => 1.0,
+        };
+        (v, v, v)
+    })
+    .unwrap();
+    let light = "LightSource \"point\" \"rgb I\" [ 5 5 5 ] \"point3 from\" [ 0 0 3 ]";
+    // A rotation, and a rotation with a mirror (the map is then resampled mirrored).
+    for transform in ["Rotate 30 0 1 0", "Rotate 30 0 1 0\nScale -2 2 2"] {
+        let scene = BASE.replacen(
+            light,
+            &format!(
+                "AttributeBegin\n{transform}\n\
+                 LightSource \"infinite\" \"string filename\" \"sky.exr\" \"float scale\" 2\n\
+                 LightSource \"point\" \"rgb I\" [ 1 1 1 ] \"point3 from\" [ 0 0 3 ]\n\
+                 LightSource \"point\" \"rgb I\" [ 1 1 1 ] \"point3 from\" [ 3 0 0 ]\n\
+                 LightSource \"point\" \"rgb I\" [ 1 1 1 ] \"point3 from\" [ 0 3 0 ]\n\
+                 AttributeEnd"
+            ),
+            1,
+        );
+        std::fs::write(dir.join("scene.pbrt"), scene).unwrap();
+        let description = load(&dir.join("scene.pbrt")).unwrap();
+        let positions: Vec<glam::Vec3> = description
+            .lights
+            .iter()
+            .map(|l| match *l {
+                geometry::Light::Point { position, .. } => position.normalize(),
+                ref other => panic!("{other:?}"),
+            })
+            .collect();
+        let scene = geometry::Scene::new(description).unwrap();
+        for (axis, want) in positions.iter().zip([10.0, 20.0, 30.0]) {
+            let got = scene.lights().environment_radiance(*axis);
+            assert_eq!(
+                got,
+                glam::Vec3::splat(2.0 * want),
+                "{transform}: toward {axis}"
+            );
+        }
+    }
+    // A missing map names itself.
+    let (err, _) = load_edited(
+        "pbrt_infinite_missing",
+        light,
+        "LightSource \"infinite\" \"string filename\" \"gone.exr\"",
     );
     let err = err.unwrap_err();
-    assert!(matches!(err, LoadError::NoSupportedEmitter { .. }), "{err}");
-    assert_message(&err, &path, &["LightSource \"infinite\""]);
-    // `fppm info` still reads it, with the warning.
-    let scene = load_with(&path, &LoadOptions::allow_no_emitter()).unwrap();
-    assert!(
-        scene
-            .notes
-            .warnings
-            .iter()
-            .any(|w| w.contains("environment lights are not supported yet"))
-    );
+    assert!(matches!(err, LoadError::Io { .. }), "{err}");
+    assert!(err.path().ends_with("gone.exr"), "{err}");
 }
 
 /// Graphics-state directives, with positions worked out by hand from pbrt-v4's file-format

@@ -213,6 +213,8 @@ impl Setup<'_> {
         // photon's, so it needs bounces < max_depth.
         for bounces in 0..=self.params.max_depth {
             let Some(hit) = self.scene.intersect(&ray) else {
+                // An escaped camera path sees the environment (zero without one).
+                direct += throughput * self.scene.lights().environment_radiance(ray.direction);
                 break;
             };
             direct += throughput * self.scene.emitted(&hit);

@@ -610,6 +610,8 @@ fn emitter_spectrum(shape: EmitterShape, caps: &Caps) -> Spectrum {
             falloff_start,
         } => Spectrum::spot_light_smoothstep(f64::from(falloff_start), f64::from(cone_angle), caps),
         EmitterShape::Directional => Spectrum::directional_light(caps),
+        // A directional light as wide as the texel it comes from.
+        EmitterShape::Environment { angle } => Spectrum::sun(f64::from(angle), caps),
     }
 }
 

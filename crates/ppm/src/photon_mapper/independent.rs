@@ -55,16 +55,20 @@ impl PassSums {
         let Some(passes) = self.passes.checked_add(other.passes) else {
             return false;
         };
-        let mut out = self.sums.clone();
-        for (a, b) in out.iter_mut().zip(&other.sums) {
+        // Check first, then add in place: nothing is added if anything would overflow.
+        let fits = self
+            .sums
+            .iter()
+            .zip(&other.sums)
+            .all(|(a, b)| (0..3).all(|c| a[c].checked_add(b[c]).is_some()));
+        if !fits {
+            return false;
+        }
+        for (a, b) in self.sums.iter_mut().zip(&other.sums) {
             for c in 0..3 {
-                match a[c].checked_add(b[c]) {
-                    Some(s) => a[c] = s,
-                    None => return false,
-                }
+                a[c] += b[c];
             }
         }
-        self.sums = out;
         self.passes = passes;
         true
     }

@@ -174,16 +174,26 @@ impl MemoryEstimate {
             };
         }
         let slots = pixels.saturating_mul(u64::from(params.samples_per_pixel));
+        let method = params.method;
         let per_slot = super::bytes_per_hitpoint() as u64
             + GRID_BYTES_PER_SLOT
             + PASS_BYTES_PER_SLOT
-            + if params.method.uses_frequency() {
+            + if method.uses_frequency() || method.is_pass_independent() {
+                // appm's pilot is a freq-sppm render.
                 FREQUENCY_PASS_BYTES_PER_SLOT
             } else {
                 0
             };
+        // appm: each slot's kernel, and each pixel's exact sums (3 × i128).
+        let independent = if method.is_pass_independent() {
+            slots
+                .saturating_mul(8)
+                .saturating_add(pixels.saturating_mul(48))
+        } else {
+            0
+        };
         Self {
-            hitpoints: slots.saturating_mul(per_slot),
+            hitpoints: slots.saturating_mul(per_slot).saturating_add(independent),
             photons: Self::photon_bytes(u64::from(params.photons_per_pass)),
             film,
             checkpoint: slots.saturating_mul(CHECKPOINT_BYTES_PER_SLOT),

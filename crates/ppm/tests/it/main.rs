@@ -12,6 +12,7 @@ mod agreement;
 mod analytic;
 mod checkpoint;
 mod determinism;
+mod environment;
 mod frequency;
 mod kernels;
 mod memory;

@@ -26,7 +26,7 @@ fn the_estimate_covers_what_a_render_holds() {
         "peers/room-indirect.toml",
     ] {
         let scene = repo_scene(name, 48, 40);
-        for method in [Method::Ppm, Method::Sppm, Method::FreqSppm] {
+        for method in [Method::Ppm, Method::Sppm, Method::FreqSppm, Method::Appm] {
             let params = params(method, 20_000);
             let mut renderer = Renderer::new(&scene, params).unwrap();
             for _ in 0..3 {

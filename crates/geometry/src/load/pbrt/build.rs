@@ -189,11 +189,65 @@ impl Parser {
                         irradiance: l,
                     });
                 }
-                "infinite" => {
+                // A constant sky.
+                "infinite" if p.get("filename").is_none() => {
+                    let l = self.colour(&p, "L", em)?.unwrap_or(Rgb::ONE);
+                    if p.get("illuminance").is_some() {
+                        builder.warn(
+                            "LightSource \"infinite\": \"illuminance\" is ignored; L × scale is used",
+                        );
+                    }
+                    let env = crate::Environment {
+                        radiance: crate::EnvironmentRadiance::Constant(l),
+                        scale,
+                        to_world: glam::Mat3::IDENTITY,
+                    };
                     let file = self.files[light.loc.file].display().to_string();
-                    import::environment_light_standin(
+                    import::set_environment(
                         &mut builder,
                         &format!("LightSource \"infinite\" ({file}:{})", light.loc.line),
+                        env,
+                    );
+                }
+                // An equal-area octahedral map, resampled to an equirectangular one whose
+                // frame is the light's (x negated if the light's transform mirrors, so that
+                // the frame's rotation stays a rotation).
+                "infinite" => {
+                    let name = self.str_param(&p, "filename")?.unwrap_or_default();
+                    let path = self.resolve(&name);
+                    if p.get("illuminance").is_some() {
+                        builder.warn(
+                            "LightSource \"infinite\": \"illuminance\" is ignored; the map × scale is used",
+                        );
+                    }
+                    let linear = glam::DMat3::from_mat4(ctm);
+                    let mirror = linear.determinant() < 0.0;
+                    let unmirrored = if mirror {
+                        linear * glam::DMat3::from_diagonal(DVec3::new(-1.0, 1.0, 1.0))
+                    } else {
+                        linear
+                    };
+                    let to_world = import::rotation_part(glam::DMat4::from_mat3(unmirrored))
+                        .ok_or_else(|| {
+                            self.err(
+                                light.loc,
+                                "the infinite light's transform must be a rotation (and a uniform scale)",
+                            )
+                        })?;
+                    let (map, negative) = crate::EnvironmentMap::load_equal_area(&path, mirror)?;
+                    if negative > 0 {
+                        builder.warn(format!("{name}: {negative} negative texels read as 0"));
+                    }
+                    let env = crate::Environment {
+                        radiance: crate::EnvironmentRadiance::Map(std::sync::Arc::new(map)),
+                        scale,
+                        to_world,
+                    };
+                    let file = self.files[light.loc.file].display().to_string();
+                    import::set_environment(
+                        &mut builder,
+                        &format!("LightSource \"infinite\" ({file}:{})", light.loc.line),
+                        env,
                     );
                 }
                 other => {

@@ -261,12 +261,35 @@ impl Converter<'_> {
             }
         }
 
-        let lights = file
-            .lights
-            .into_iter()
-            .enumerate()
-            .map(|(i, l)| self.light(&format!("[[lights]] #{}", i + 1), l))
-            .collect::<Result<Vec<_>, _>>()?;
+        let mut lights = Vec::with_capacity(file.lights.len());
+        let mut environment = None;
+        for (i, l) in file.lights.into_iter().enumerate() {
+            let context = format!("[[lights]] #{}", i + 1);
+            match l {
+                LightToml::Environment {
+                    file,
+                    radiance,
+                    scale,
+                    rotate,
+                } => {
+                    if environment.is_some() {
+                        return Err(self.invalid(
+                            format!("{context} type"),
+                            "\"environment\" appears twice (a scene has at most one environment)",
+                        ));
+                    }
+                    let (env, negative) =
+                        self.environment(&context, file, radiance, scale, rotate)?;
+                    if negative > 0 {
+                        acc.notes.warnings.push(format!(
+                            "{context}: {negative} negative texels of the environment map read as 0"
+                        ));
+                    }
+                    environment = Some(env);
+                }
+                l => lights.push(self.light(&context, l)?),
+            }
+        }
         let render = file.render.map(|r| self.render(r)).transpose()?;
 
         let parts = SceneParts {
@@ -277,6 +300,7 @@ impl Converter<'_> {
             spheres: acc.spheres,
             cylinders: acc.cylinders,
             lights,
+            environment,
             render: render.unwrap_or_default(),
             notes: acc.notes,
             degenerate_materials: acc.degenerate_materials,
@@ -514,7 +538,59 @@ impl Converter<'_> {
                 direction: self.direction(&key("direction"), direction)?,
                 irradiance: self.colour(&key("irradiance"), irradiance)?,
             },
+            LightToml::Environment { .. } => {
+                return Err(self.invalid(
+                    key("type"),
+                    "\"environment\" is not allowed here (only in a scene's own [[lights]])",
+                ));
+            }
         })
+    }
+
+    /// An environment light: `file` (relative to the scene file) or `radiance`, with an
+    /// optional `scale` and `rotate`. Returns it with the count of negative texels read as 0.
+    fn environment(
+        &self,
+        context: &str,
+        file: Option<String>,
+        radiance: Option<[f32; 3]>,
+        scale: Option<f32>,
+        rotate: Option<[f32; 3]>,
+    ) -> Result<(crate::Environment, usize), LoadError> {
+        let key = |k: &str| format!("{context} {k}");
+        let (mut env, negative) = match (file, radiance) {
+            (Some(file), None) => crate::Environment::from_file(&self.dir.join(file))?,
+            (None, Some(radiance)) => (
+                crate::Environment {
+                    radiance: crate::EnvironmentRadiance::Constant(
+                        self.colour(&key("radiance"), radiance)?,
+                    ),
+                    scale: 1.0,
+                    to_world: glam::Mat3::IDENTITY,
+                },
+                0,
+            ),
+            _ => {
+                return Err(self.invalid(
+                    key("file"),
+                    "or radiance: an environment needs exactly one of the two",
+                ));
+            }
+        };
+        if let Some(scale) = scale {
+            if !(scale.is_finite() && scale >= 0.0) {
+                return Err(self.invalid(
+                    key("scale"),
+                    format!("must be finite and >= 0, got {scale}"),
+                ));
+            }
+            env.scale = scale;
+        }
+        if let Some(rotate) = rotate {
+            env.to_world =
+                crate::Environment::rotation_degrees(self.finite(&key("rotate"), rotate)?);
+        }
+        Ok((env, negative))
     }
 
     pub(super) fn render(&self, r: RenderToml) -> Result<RenderDefaults, LoadError> {

@@ -167,6 +167,13 @@ pub(super) enum LightToml {
         direction: [f32; 3],
         irradiance: [f32; 3],
     },
+    /// An extension (`docs/scene-format-extensions.md`): `file` or `radiance`.
+    Environment {
+        file: Option<String>,
+        radiance: Option<[f32; 3]>,
+        scale: Option<f32>,
+        rotate: Option<[f32; 3]>,
+    },
 }
 
 /// The `[render]` table: `passes`, and render parameters that `ppm` reads.
