@@ -409,10 +409,13 @@ fn run_mitsuba(
 /// its reflectance; a dielectric is `dielectric` with `int_ior` = ior against vacuum; emission
 /// is an `area` emitter (one-sided, front = counter-clockwise side, as in fppm); cylinders are
 /// tessellated (512 segments around the kept arc) with exact vertex normals; the camera is a
-/// `perspective` sensor with `fov_axis = y` and a box-filtered `hdrfilm`; the integrator is
-/// `$integrator` with unlimited depth; the environment is Mitsuba's `constant` or `envmap`
-/// ([`environment_emitter`]). Glossy materials and lights other than emissive surfaces, point
-/// lights and the environment are refused: the peer scenes do not use them.
+/// `perspective` sensor with `fov_axis = y` and a box-filtered `hdrfilm`; a diffuse colour
+/// texture (with albedo 1) is a `bitmap` reflectance (sRGB-decoded by Mitsuba for 8-bit files,
+/// bilinear, with the same wrap mode), a cut-out a `mask` BSDF with the alpha as opacity
+/// (`raw`); the integrator is `$integrator` with unlimited depth; the environment is Mitsuba's
+/// `constant` or `envmap` ([`environment_emitter`]). Glossy materials and lights other than
+/// emissive surfaces, point lights and the environment are refused: the peer scenes do not use
+/// them.
 pub(crate) fn write_mitsuba(
     description: &geometry::SceneDescription,
     dir: &Path,
@@ -459,7 +462,31 @@ pub(crate) fn write_mitsuba(
     let rgb = |c: [f32; 3]| format!("{}, {}, {}", c[0], c[1], c[2]);
     let mut bsdfs = Vec::new();
     for m in &description.materials {
+        let textures = m.textures.as_deref();
+        let color = textures.and_then(|t| t.color.as_ref());
+        if textures.is_some_and(|t| t.emission.is_some() || t.normal.is_some()) {
+            bail!(
+                "material {}: emission and normal textures are not exported",
+                m.name
+            );
+        }
         let bsdf = match m.kind {
+            geometry::MaterialKind::Diffuse { albedo } if color.is_some() => {
+                let texture = color.context("checked")?;
+                if albedo != Vec3::ONE {
+                    bail!(
+                        "material {}: a texture times an albedo other than 1 is not exported",
+                        m.name
+                    );
+                }
+                format!(
+                    "<bsdf type=\"twosided\"><bsdf type=\"diffuse\">{}</bsdf></bsdf>",
+                    bitmap("reflectance", texture)?
+                )
+            }
+            _ if color.is_some() => {
+                bail!("material {}: only diffuse textures are exported", m.name)
+            }
             geometry::MaterialKind::Diffuse { albedo } => format!(
                 "<bsdf type=\"twosided\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"{}\"/></bsdf></bsdf>",
                 rgb(albedo.to_array())
@@ -472,6 +499,27 @@ pub(crate) fn write_mitsuba(
                 "<bsdf type=\"dielectric\"><float name=\"int_ior\" value=\"{ior}\"/><float name=\"ext_ior\" value=\"1.0\"/></bsdf>"
             ),
             other => bail!("material {} ({other:?}) is not exported", m.name),
+        };
+        // A cut-out: Mitsuba's `mask` keeps the surface with probability = opacity (a stochastic
+        // cut-out); fppm's `MASK` thresholds it, which agrees where the mask is 0 or 1.
+        let bsdf = match textures.and_then(|t| t.alpha.as_ref()) {
+            None => bsdf,
+            Some(alpha) => {
+                let texture = alpha
+                    .texture
+                    .as_ref()
+                    .context("a constant alpha is not exported")?;
+                if alpha.factor != 1.0 {
+                    bail!(
+                        "material {}: an alpha factor other than 1 is not exported",
+                        m.name
+                    );
+                }
+                format!(
+                    "<bsdf type=\"mask\">{}{bsdf}</bsdf>",
+                    bitmap("opacity", texture)?
+                )
+            }
         };
         let emission = m.emission.to_array();
         let emitter = (emission.iter().any(|&e| e > 0.0)).then(|| {
@@ -496,6 +544,9 @@ pub(crate) fn write_mitsuba(
         let file = format!("material-{index}.ply");
         let mut ply = String::new();
         let normals = triangles.iter().all(|t| t.normals.is_some());
+        // Texture coordinates as they are: Mitsuba's bitmap, like fppm, puts v = 0 at the
+        // image's top row.
+        let uvs = triangles.iter().all(|t| t.uv.is_some());
         writeln!(ply, "ply\nformat ascii 1.0")?;
         writeln!(ply, "element vertex {}", 3 * triangles.len())?;
         writeln!(ply, "property float x\nproperty float y\nproperty float z")?;
@@ -505,21 +556,22 @@ pub(crate) fn write_mitsuba(
                 "property float nx\nproperty float ny\nproperty float nz"
             )?;
         }
+        if uvs {
+            writeln!(ply, "property float u\nproperty float v")?;
+        }
         writeln!(ply, "element face {}", triangles.len())?;
         writeln!(ply, "property list uchar int vertex_indices\nend_header")?;
         for t in &triangles {
             for k in 0..3 {
                 let p = t.positions[k];
-                match t.normals {
-                    Some(n) if normals => {
-                        writeln!(
-                            ply,
-                            "{} {} {} {} {} {}",
-                            p.x, p.y, p.z, n[k].x, n[k].y, n[k].z
-                        )?;
-                    }
-                    _ => writeln!(ply, "{} {} {}", p.x, p.y, p.z)?,
+                write!(ply, "{} {} {}", p.x, p.y, p.z)?;
+                if let Some(n) = t.normals.filter(|_| normals) {
+                    write!(ply, " {} {} {}", n[k].x, n[k].y, n[k].z)?;
                 }
+                if let Some(uv) = t.uv.filter(|_| uvs) {
+                    write!(ply, " {} {}", uv[k].x, uv[k].y)?;
+                }
+                writeln!(ply)?;
             }
         }
         for i in 0..triangles.len() {
@@ -635,4 +687,31 @@ fn cylinder_ply(c: &geometry::Cylinder, segments: usize) -> String {
         let _ = writeln!(ply, "3 {a} {c2} {d}");
     }
     ply
+}
+
+/// A Mitsuba `bitmap` texture parameter reading `texture`'s image file: colour textures as
+/// Mitsuba decodes them by default (sRGB for 8-bit files), data (alpha) `raw`.
+fn bitmap(name: &str, texture: &geometry::texture::TextureRef) -> Result<String> {
+    if texture.transform != geometry::texture::TextureRef::IDENTITY {
+        bail!("texture transforms are not exported");
+    }
+    let wrap = |w: geometry::texture::Wrap| match w {
+        geometry::texture::Wrap::Repeat => "repeat",
+        geometry::texture::Wrap::Mirror => "mirror",
+        geometry::texture::Wrap::Clamp => "clamp",
+    };
+    if texture.wrap[0] != texture.wrap[1] {
+        bail!("different wrap modes along u and v are not exported");
+    }
+    let path = texture
+        .image
+        .path()
+        .canonicalize()
+        .with_context(|| format!("texture {}", texture.image.path().display()))?;
+    Ok(format!(
+        "<texture type=\"bitmap\" name=\"{name}\"><string name=\"filename\" value=\"{}\"/><string name=\"wrap_mode\" value=\"{}\"/><boolean name=\"raw\" value=\"{}\"/></texture>",
+        path.display(),
+        wrap(texture.wrap[0]),
+        !texture.srgb
+    ))
 }

@@ -7,8 +7,11 @@
 //! RGB in `Vec3`.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
+
+use crate::texture::MaterialTextures;
 
 /// Linear Rec.709 RGB triple.
 pub type Rgb = Vec3;
@@ -87,6 +90,9 @@ pub struct Material {
     pub kind: MaterialKind,
     /// Emitted radiance in W/(sr·m²) per channel, leaving the front face only. Zero if none.
     pub emission: Rgb,
+    /// Image textures that modulate the material (colour, emission, normal, cut-out); `None`
+    /// for an untextured material, which then costs no texture work anywhere.
+    pub textures: Option<Arc<MaterialTextures>>,
 }
 
 /// The scattering models of scene format version 1.
@@ -128,6 +134,9 @@ pub struct Triangle {
     pub normals: Option<[Vec3; 3]>,
     /// Index into [`SceneDescription::materials`].
     pub material: u32,
+    /// Per-vertex texture coordinates (image convention: v grows downwards, see
+    /// [`crate::texture`]), if the source had them.
+    pub uv: Option<[Vec2; 3]>,
 }
 
 /// An analytic sphere.

@@ -251,6 +251,15 @@ pub enum LoadError {
         /// The skipped emitters, e.g. `<emitter type="envmap">`.
         skipped: String,
     },
+    /// A texture image cannot be used: missing, unreadable, corrupt, of an unsupported format,
+    /// empty, too large or with NaN or infinite texels.
+    #[error("{}: {message}", path.display())]
+    Texture {
+        /// The image file.
+        path: PathBuf,
+        /// What is wrong, e.g. `texture has zero size (0x0)`.
+        message: String,
+    },
     /// An environment map cannot be used: unsupported format, undecodable, zero size, not
     /// 2:1, a non-finite texel, or black everywhere.
     #[error("{}: invalid environment map: {message}", path.display())]
@@ -333,6 +342,7 @@ impl LoadError {
             | Self::Xml { path, .. }
             | Self::Pbrt { path, .. }
             | Self::MeshFile { path, .. }
+            | Self::Texture { path, .. }
             | Self::EnvironmentMap { path, .. }
             | Self::NoSupportedEmitter { path, .. } => path,
         }

@@ -61,6 +61,7 @@ mod scene;
 mod summary;
 #[cfg(test)]
 mod test_util;
+pub mod texture;
 mod validate;
 
 pub use aabb::Aabb;

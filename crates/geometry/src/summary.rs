@@ -45,6 +45,9 @@ pub struct SceneSummary {
     pub camera_framed: bool,
     /// Loader warnings.
     pub warnings: Vec<String>,
+    /// The texture images, once each (left out of snapshots when there are none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub textures: Vec<crate::texture::TextureSummary>,
 }
 
 /// Number of delta lights of each kind.
@@ -87,6 +90,9 @@ pub struct MaterialSummary {
     /// Cylinders using the material (left out of snapshots when zero).
     #[serde(skip_serializing_if = "is_zero")]
     pub cylinders: usize,
+    /// What its textures modulate (`color`, `emission`, `normal`, `alpha`; left out when none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub textures: Vec<&'static str>,
 }
 
 fn is_zero(n: &usize) -> bool {
@@ -214,6 +220,11 @@ impl SceneDescription {
                     triangles: 0,
                     spheres: 0,
                     cylinders: 0,
+                    textures: m
+                        .textures
+                        .as_deref()
+                        .map(crate::texture::MaterialTextures::uses)
+                        .unwrap_or_default(),
                 }
             })
             .collect();
@@ -270,6 +281,7 @@ impl SceneDescription {
             degenerate_triangles: self.notes.degenerate_triangles,
             camera_framed: self.notes.camera_framed,
             warnings: self.notes.warnings.clone(),
+            textures: crate::texture::summarize(&self.materials),
         }
     }
 }
@@ -341,11 +353,34 @@ impl fmt::Display for SceneSummary {
             if m.emission != Vec3::ZERO {
                 write!(f, " emission {}", Show3(m.emission))?;
             }
+            if !m.textures.is_empty() {
+                write!(f, " textured ({})", m.textures.join(", "))?;
+            }
             write!(f, " ({} triangles, {} spheres", m.triangles, m.spheres)?;
             if m.cylinders > 0 {
                 write!(f, ", {} cylinders", m.cylinders)?;
             }
             writeln!(f, ")")?;
+        }
+        if !self.textures.is_empty() {
+            let bytes: usize = self.textures.iter().map(|t| t.bytes).sum();
+            writeln!(
+                f,
+                "textures   {} ({:.1} MiB)",
+                self.textures.len(),
+                bytes as f64 / f64::from(1 << 20)
+            )?;
+            for t in &self.textures {
+                writeln!(
+                    f,
+                    "  {} {}x{} {:.1} MiB ({})",
+                    t.file,
+                    t.resolution[0],
+                    t.resolution[1],
+                    t.bytes as f64 / f64::from(1 << 20),
+                    t.uses.join(", ")
+                )?;
+            }
         }
         if self.degenerate_triangles > 0 {
             writeln!(

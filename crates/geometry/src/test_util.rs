@@ -54,6 +54,7 @@ pub(crate) fn diffuse(albedo: f32, emission: Vec3) -> Material {
             albedo: Vec3::splat(albedo),
         },
         emission,
+        textures: None,
     }
 }
 
@@ -100,6 +101,7 @@ pub(crate) fn tri(a: Vec3, b: Vec3, c: Vec3, material: u32) -> Triangle {
         positions: [a, b, c],
         normals: None,
         material,
+        uv: None,
     }
 }
 

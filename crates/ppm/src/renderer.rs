@@ -271,7 +271,8 @@ impl<'s> Renderer<'s> {
                         let albedo = self
                             .scene
                             .material(hit.material)
-                            .map_or(Rgb::ZERO, |m| albedo(m.kind));
+                            .map_or(Rgb::ZERO, |m| albedo(m.kind))
+                            * self.scene.scattering_tint(&hit);
                         values.copy_from_slice(&albedo.to_array());
                     }
                 }

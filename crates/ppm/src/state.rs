@@ -519,6 +519,36 @@ pub fn scene_fingerprint(d: &SceneDescription) -> u64 {
         };
         w.u32(tag);
         values.iter().for_each(|&c| w.f32(c));
+        // Textures: how each is used and which image (file, resolution), not the texels.
+        if let Some(t) = &m.textures {
+            w.str("textures");
+            let mut texture = |name: &str, r: Option<&geometry::texture::TextureRef>| {
+                if let Some(r) = r {
+                    w.str(name);
+                    w.str(&r.image.path().to_string_lossy());
+                    let (width, height) = r.image.resolution();
+                    w.u32(width);
+                    w.u32(height);
+                    w.u32(u32::from(r.srgb));
+                    r.wrap.iter().for_each(|&m| w.u32(m as u32));
+                    r.transform.iter().for_each(|&c| w.f32(c));
+                }
+            };
+            texture("color", t.color.as_ref());
+            texture("emission", t.emission.as_ref());
+            texture("normal", t.normal.as_ref().map(|n| &n.texture));
+            texture("alpha", t.alpha.as_ref().and_then(|a| a.texture.as_ref()));
+            if let Some(n) = &t.normal {
+                w.f32(n.scale);
+            }
+            if let Some(a) = &t.alpha {
+                w.f32(a.factor);
+                match a.mode {
+                    geometry::texture::AlphaMode::Mask { cutoff } => w.f32(cutoff),
+                    geometry::texture::AlphaMode::Blend => w.str("blend"),
+                }
+            }
+        }
     }
     w.u64(d.triangles.len() as u64);
     for t in &d.triangles {
@@ -531,6 +561,10 @@ pub fn scene_fingerprint(d: &SceneDescription) -> u64 {
                 .for_each(|n| n.to_array().iter().for_each(|&c| w.f32(c)));
         }
         w.u32(t.material);
+        if let Some(uv) = t.uv {
+            uv.iter()
+                .for_each(|v| v.to_array().iter().for_each(|&c| w.f32(c)));
+        }
     }
     w.u64(d.spheres.len() as u64);
     for s in &d.spheres {

@@ -411,6 +411,46 @@ fn a_failed_render_keeps_an_existing_output() {
     assert_eq!(files(&dir), ["fppm.exr", "fppm.png"]);
 }
 
+/// Bad textures: a missing image, one that is not an image and one of a format fppm does not
+/// read each fail with exit 1 and one line naming the image, and no output; `info` fails alike.
+#[test]
+fn bad_textures_name_the_image() {
+    let dir = temp_dir("bad_textures");
+    let scene = "format = 1\n[materials.m]\ntype = \"diffuse\"\nalbedo = { texture = \"tex.png\" }\nemission = [1, 1, 1]\n[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n";
+    std::fs::write(dir.join("scene.toml"), scene).unwrap();
+    let args = [&["render", "scene.toml"], TINY].concat();
+    check_in(
+        &dir,
+        &args,
+        1,
+        &["tex.png", "cannot read texture"],
+        &["scene.toml"],
+    );
+    check_in(
+        &dir,
+        &["info", "scene.toml"],
+        1,
+        &["tex.png", "cannot read texture"],
+        &["scene.toml"],
+    );
+    std::fs::write(dir.join("tex.png"), "plain text").unwrap();
+    check_in(
+        &dir,
+        &args,
+        1,
+        &["tex.png", "unsupported texture format"],
+        &["scene.toml", "tex.png"],
+    );
+    std::fs::write(dir.join("tex.png"), "GIF89a\x01\x00\x01\x00").unwrap();
+    check_in(
+        &dir,
+        &args,
+        1,
+        &["tex.png", "unsupported texture format gif"],
+        &["scene.toml", "tex.png"],
+    );
+}
+
 /// Absurd sizes are refused from the estimate, before anything is allocated: at once, with how
 /// much the render would need and which flag to lower.
 #[test]

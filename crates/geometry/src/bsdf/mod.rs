@@ -79,6 +79,9 @@ pub struct Bsdf {
     kind: MaterialKind,
     /// For dielectrics: η on the far side of the shading normal over η on its side.
     eta: f32,
+    /// A texture's colour multiplying a glossy BSDF (one otherwise: a diffuse albedo or a mirror
+    /// reflectance takes the texture into `kind` itself).
+    tint: Rgb,
 }
 
 impl MaterialKind {
@@ -126,7 +129,29 @@ impl Bsdf {
             frame: Frame::from_normal(normal),
             kind,
             eta,
+            tint: Rgb::ONE,
         }
+    }
+
+    /// [`Bsdf::from_normal`] with a texture colour `tint` that multiplies the BSDF: folded into a
+    /// diffuse albedo or a mirror reflectance, kept as a factor of the whole glossy BSDF, ignored
+    /// by a dielectric.
+    #[inline]
+    pub fn tinted(kind: MaterialKind, normal: Vec3, front_face: bool, tint: Rgb) -> Self {
+        let mut bsdf = Self::from_normal(kind, normal, front_face);
+        match &mut bsdf.kind {
+            MaterialKind::Diffuse { albedo } => *albedo *= tint,
+            MaterialKind::Mirror { reflectance } => *reflectance *= tint,
+            MaterialKind::Glossy { .. } => bsdf.tint = tint,
+            MaterialKind::Dielectric { .. } => {}
+        }
+        bsdf
+    }
+
+    /// The scattering model, with a texture's colour folded into a diffuse albedo or a mirror
+    /// reflectance (a glossy BSDF's texture colour is a separate factor).
+    pub fn kind(&self) -> MaterialKind {
+        self.kind
     }
 
     /// The shading frame (its `n` is the shading normal).
@@ -160,8 +185,9 @@ impl Bsdf {
                 roughness,
                 diffuse,
             } => {
-                coupled_diffuse(wo, wi, reflectance, diffuse)
-                    + ggx_eval(wo, wi, roughness, reflectance)
+                (coupled_diffuse(wo, wi, reflectance, diffuse)
+                    + ggx_eval(wo, wi, roughness, reflectance))
+                    * self.tint
             }
         }
     }
@@ -262,7 +288,7 @@ impl Bsdf {
                 let wi = if flip { -wi_up } else { wi_up };
                 Some(BsdfSample {
                     incoming: self.frame.to_world(wi),
-                    weight: f * (wi_up.z / pdf),
+                    weight: f * (wi_up.z / pdf) * self.tint,
                     pdf,
                     is_specular: false,
                     is_transmission: false,

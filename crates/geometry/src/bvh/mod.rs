@@ -19,6 +19,7 @@
 //! box padding against its culling of boxes left before t = 10⁻⁴; the scene is still scaled
 //! internally by a power of two (see [`internal_scale`]), now only for the range of the arithmetic.
 
+mod cutout;
 mod prim;
 mod simd;
 #[cfg(test)]
@@ -115,6 +116,8 @@ pub(crate) struct Accel {
     scale: f32,
     /// Number of primitives in the BVH.
     len: usize,
+    /// Per leaf, the lanes whose triangle is a cut-out (see `cutout.rs`); empty unless set.
+    cutout_lanes: Vec<u8>,
 }
 
 /// One ray's query of the leaves: the ray in the forms the primitive tests take, and the slot of
@@ -208,6 +211,7 @@ impl Accel {
             cylinders: cylinders.iter().map(|c| CylGeom::new(c, scale)).collect(),
             scale,
             len: ids.len(),
+            cutout_lanes: Vec::new(),
         };
         if ids.is_empty() {
             return accel;

@@ -31,6 +31,9 @@ use crate::{
 mod environment;
 #[cfg(test)]
 mod tests;
+mod textured;
+
+use textured::TexturedTriangle;
 
 use environment::EnvironmentLight;
 pub use environment::{Environment, EnvironmentMap, EnvironmentRadiance};
@@ -150,6 +153,9 @@ enum Emitter {
         frame: Frame,
         size: f32,
         flux: Rgb,
+        /// Index into the textured emitters when an emission texture modulates `radiance`
+        /// (which then holds the texture's mean over the triangle), else `u32::MAX`.
+        texture: u32,
     },
     Sphere {
         center: Vec3,
@@ -170,6 +176,8 @@ pub struct LightSampler {
     triangle_emitter: Vec<u32>,
     /// Emitter index per sphere (`u32::MAX` for none); empty if no sphere emits.
     sphere_emitter: Vec<u32>,
+    /// The emission textures of textured triangle emitters.
+    textured: Vec<TexturedTriangle>,
     /// The environment light and its emitter index, if the scene has one.
     environment: Option<(Box<EnvironmentLight>, usize)>,
 }
@@ -182,6 +190,7 @@ pub(crate) struct Emitters {
     powers: Vec<Rgb>,
     triangle_emitter: Vec<u32>,
     sphere_emitter: Vec<u32>,
+    textured: Vec<TexturedTriangle>,
     environment: Option<(Box<EnvironmentLight>, usize)>,
 }
 
@@ -235,10 +244,26 @@ impl Emitters {
                 .filter(|e| e.cmpgt(Rgb::ZERO).any())
         };
         let mut triangle_emitter = Vec::new();
+        let mut textured = Vec::new();
         for (i, tri) in desc.triangles.iter().enumerate() {
-            let Some(radiance) = emission(tri.material) else {
+            let Some(mut radiance) = emission(tri.material) else {
                 continue;
             };
+            let mut texture = u32::MAX;
+            if let Some(map) = desc.materials[tri.material as usize]
+                .textures
+                .as_deref()
+                .and_then(|t| t.emission.as_ref())
+            {
+                let emitter = TexturedTriangle {
+                    emission: radiance,
+                    uv: tri.uv.unwrap_or([Vec2::ZERO, Vec2::X, Vec2::Y]),
+                    texture: map.clone(),
+                };
+                radiance = emitter.mean();
+                texture = textured.len() as u32;
+                textured.push(emitter);
+            }
             let [p0, p1, p2] = tri.positions;
             let (e1, e2) = (p1 - p0, p2 - p0);
             let n = e1.cross(e2);
@@ -261,8 +286,11 @@ impl Emitters {
                 p1: p0 + e1,
                 p2: p0 + e2,
                 frame: Frame::from_normal(normal),
-                size: area.sqrt(),
+                size: textured
+                    .get(texture as usize)
+                    .map_or(area.sqrt(), |t| t.feature_size(area)),
                 flux: radiance * (PI * area),
+                texture,
             });
         }
         let mut sphere_emitter = Vec::new();
@@ -302,6 +330,7 @@ impl Emitters {
             powers,
             triangle_emitter,
             sphere_emitter,
+            textured,
             environment,
         }
     }
@@ -325,6 +354,7 @@ impl LightSampler {
                 powers,
                 triangle_emitter,
                 sphere_emitter,
+                textured,
                 environment,
             },
             distribution,
@@ -335,6 +365,7 @@ impl LightSampler {
             distribution,
             triangle_emitter,
             sphere_emitter,
+            textured,
             environment,
         }
     }
@@ -439,9 +470,14 @@ impl LightSampler {
                 normal,
                 area,
                 radiance,
+                texture,
                 ..
             } => {
                 let b = uniform_triangle(u);
+                let radiance = match self.textured.get(texture as usize) {
+                    None => radiance,
+                    Some(t) => t.radiance(b),
+                };
                 (p0 + b.x * e1 + b.y * e2, radiance, (normal, area))
             }
             Emitter::Sphere {
@@ -593,9 +629,15 @@ impl LightSampler {
                 frame,
                 size,
                 flux,
+                texture,
+                area,
                 ..
             } => {
                 let b = uniform_triangle(u_pos);
+                let flux = match self.textured.get(texture as usize) {
+                    None => flux,
+                    Some(t) => t.radiance(b) * (PI * area),
+                };
                 let b0 = 1.0 - b.x - b.y;
                 let origin = b0 * p0 + b.x * p1 + b.y * p2;
                 let error =

@@ -5,7 +5,7 @@
 //! - materials: transmission > 0 → dielectric (ior from `KHR_materials_ior`, default 1.5);
 //!   metallic ≥ 0.5 ([`METALLIC_THRESHOLD`]) with roughness < 0.01 → mirror with the base
 //!   colour; metallic ≥ 0.5 otherwise → glossy with α = roughness² and no diffuse base;
-//!   else diffuse with the base colour. Textures are ignored (factors only; one warning).
+//!   else diffuse with the base colour; textures as [`material`] says.
 //!   Emission = emissive factor × emissive strength. A primitive without a material gets
 //!   the glTF default material (white, metallic 1, roughness 1, so glossy with α = 1);
 //! - the camera is the perspective camera with the lowest index that a node of the scene
@@ -18,15 +18,19 @@
 //! - missing normals give flat shading; a node transform with negative determinant swaps
 //!   the winding so that front faces stay front faces.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
-use glam::{Mat3, Mat4, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3};
 use gltf::khr_lights_punctual::Kind;
 use gltf::mesh::Mode;
 
 use super::{MeshData, read_bytes};
 use crate::description::{Camera, Light, Material, MaterialKind};
 use crate::error::LoadError;
+use crate::texture::{
+    Alpha, AlphaMode, MaterialTextures, NormalMap, TextureCache, TextureRef, Wrap,
+};
 
 /// Metallic factor from which a glTF material counts as a conductor.
 pub const METALLIC_THRESHOLD: f32 = 0.5;
@@ -53,28 +57,20 @@ pub(crate) fn load_gltf(path: &Path) -> Result<MeshData, LoadError> {
     let doc = &gltf.document;
 
     let mut data = MeshData::default();
-    let mut textured = 0usize;
+    let mut textures = Textures {
+        path,
+        dir: path.parent(),
+        buffers: &buffers,
+        cache: TextureCache::default(),
+        warnings: Vec::new(),
+    };
+    let mut uv_sets = Vec::new();
     for (i, m) in doc.materials().enumerate() {
-        if m.pbr_metallic_roughness().base_color_texture().is_some()
-            || m.emissive_texture().is_some()
-        {
-            textured += 1;
-        }
-        let converted = material(&m, i);
-        if m.emissive_texture().is_some() && converted.emission.max_element() > 0.0 {
-            data.warnings.push(format!(
-                "material {:?} has an emissive texture, which is ignored: its whole surface emits {}",
-                converted.name,
-                super::fmt_vec(converted.emission)
-            ));
-        }
+        let (converted, uv_set) = material(&m, i, &mut textures)?;
         data.materials.push(converted);
+        uv_sets.push(uv_set);
     }
-    if textured > 0 {
-        data.warnings.push(format!(
-            "{textured} material(s) have textures, which are ignored (factors only)"
-        ));
-    }
+    data.warnings.append(&mut textures.warnings);
 
     let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
         data.warnings.push("the file has no scene".to_owned());
@@ -84,6 +80,7 @@ pub(crate) fn load_gltf(path: &Path) -> Result<MeshData, LoadError> {
     let mut walker = Walker {
         path,
         buffers: &buffers,
+        uv_sets,
         data,
         default_material: None,
         camera: None,
@@ -130,6 +127,8 @@ pub(crate) fn load_gltf(path: &Path) -> Result<MeshData, LoadError> {
 struct Walker<'a> {
     path: &'a Path,
     buffers: &'a [gltf::buffer::Data],
+    /// Per material, the texture-coordinate set its textures read.
+    uv_sets: Vec<u32>,
     data: MeshData,
     default_material: Option<u32>,
     /// (camera index, camera, aspect ratio).
@@ -302,6 +301,13 @@ impl Walker<'_> {
                 (self.data.materials.len() - 1) as u32
             }),
         };
+        let uv_set = self.uv_sets.get(material as usize).copied().unwrap_or(0);
+        let uvs: Option<Vec<Vec2>> = reader
+            .read_tex_coords(uv_set)
+            .map(|tc| tc.into_f32().map(Vec2::from).collect())
+            .filter(|tc: &Vec<Vec2>| {
+                tc.len() == positions.len() && tc.iter().all(|v| v.is_finite())
+            });
         let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
         let flip = world.determinant() < 0.0;
         let world_positions: Vec<Vec3> = positions
@@ -319,7 +325,8 @@ impl Walker<'_> {
             }
             let p = t.map(|i| world_positions[i as usize]);
             let n = world_normals.as_ref().map(|n| t.map(|i| n[i as usize]));
-            self.data.push_triangle(p, n, material);
+            let uv = uvs.as_ref().map(|uv| t.map(|i| uv[i as usize]));
+            self.data.push_triangle(p, n, uv, material);
         }
         Ok(())
     }
@@ -335,15 +342,130 @@ fn default_material() -> Material {
             diffuse: Vec3::ZERO,
         },
         emission: Vec3::ZERO,
+        textures: None,
     }
 }
 
-fn material(m: &gltf::Material<'_>, index: usize) -> Material {
+/// The images of a glTF file's textures, read once each.
+struct Textures<'a> {
+    path: &'a Path,
+    dir: Option<&'a Path>,
+    buffers: &'a [gltf::buffer::Data],
+    cache: TextureCache,
+    warnings: Vec<String>,
+}
+
+impl Textures<'_> {
+    /// The texture `tex` as a colour (`srgb`) or data texture with its sampler's wrap modes and
+    /// the transform of `KHR_texture_transform`; `None` (with a warning) for an image embedded
+    /// as a data URI, which is not read.
+    fn get(
+        &mut self,
+        tex: &gltf::Texture<'_>,
+        srgb: bool,
+        transform: Option<gltf::texture::TextureTransform<'_>>,
+    ) -> Result<Option<TextureRef>, LoadError> {
+        let image = tex.source();
+        let image = match image.source() {
+            gltf::image::Source::Uri { uri, .. } => {
+                if uri.starts_with("data:") {
+                    self.warnings.push(format!(
+                        "image {} is embedded as a data uri, which is not read: its materials use their factors only",
+                        image.index()
+                    ));
+                    return Ok(None);
+                }
+                let file = self.dir.unwrap_or(Path::new("")).join(percent_decode(uri));
+                self.cache.load(&file)?
+            }
+            gltf::image::Source::View { view, .. } => {
+                let key = PathBuf::from(format!("{}#image{}", self.path.display(), image.index()));
+                let bytes = self
+                    .buffers
+                    .get(view.buffer().index())
+                    .and_then(|b| b.0.get(view.offset()..view.offset() + view.length()))
+                    .ok_or_else(|| {
+                        gltf_error(
+                            self.path,
+                            format!("image {} lies outside its buffer", image.index()),
+                        )
+                    })?;
+                self.cache.load_bytes(&key, bytes)?
+            }
+        };
+        let wrap = |mode: gltf::texture::WrappingMode| match mode {
+            gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+            gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
+            gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
+        };
+        let sampler = tex.sampler();
+        let mut texture = TextureRef::new(image, srgb);
+        texture.wrap = [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())];
+        if let Some(t) = transform {
+            // KHR_texture_transform: uv' = T·R·S·uv.
+            let ([ox, oy], r, [sx, sy]) = (t.offset(), t.rotation(), t.scale());
+            let (sin, cos) = r.sin_cos();
+            let m = [cos * sx, sin * sy, -sin * sx, cos * sy, ox, oy];
+            if m.iter().all(|v| v.is_finite()) {
+                texture.transform = m;
+            }
+        }
+        Ok(Some(texture))
+    }
+
+    /// A texture's colour channels' mean (linear data), for the metallic-roughness stand-in.
+    fn mean(&mut self, tex: &gltf::Texture<'_>) -> Result<Option<Vec3>, LoadError> {
+        Ok(self.get(tex, false, None)?.map(|t| t.image.mean(false)))
+    }
+}
+
+/// A URI's `%XX` escapes decoded (glTF URIs are percent-encoded: `a%20b.png`).
+fn percent_decode(uri: &str) -> String {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = |b: u8| (b as char).to_digit(16);
+        if bytes[i] == b'%'
+            && let (Some(&h), Some(&l)) = (bytes.get(i + 1), bytes.get(i + 2))
+            && let (Some(h), Some(l)) = (hex(h), hex(l))
+        {
+            out.push((h * 16 + l) as u8);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// The material and the texture-coordinate set its textures read (the base colour's, else
+/// the first texture's).
+///
+/// Textures: the base colour texture multiplies the base colour (and its alpha the alpha);
+/// the emissive texture the emission; the normal texture perturbs the shading normal; the
+/// metallic-roughness texture stands in as its mean (metallic × mean blue, roughness × mean
+/// green), which decides the kind and the roughness for the whole material. `MASK` cuts the
+/// surface out below `alphaCutoff`, `BLEND` keeps it with probability alpha.
+fn material(
+    m: &gltf::Material<'_>,
+    index: usize,
+    textures: &mut Textures<'_>,
+) -> Result<(Material, u32), LoadError> {
     let pbr = m.pbr_metallic_roughness();
-    let [r, g, b, _] = pbr.base_color_factor();
+    let [r, g, b, alpha_factor] = pbr.base_color_factor();
     let base = Vec3::new(r, g, b);
-    let metallic = pbr.metallic_factor();
-    let roughness = pbr.roughness_factor();
+    let mut metallic = pbr.metallic_factor();
+    let mut roughness = pbr.roughness_factor();
+    let mut uv_sets = Vec::new();
+    if let Some(info) = pbr.metallic_roughness_texture() {
+        uv_sets.push(info.tex_coord());
+        if let Some(mean) = textures.mean(&info.texture())? {
+            metallic *= mean.z;
+            roughness *= mean.y;
+        }
+    }
     let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
     let kind = if transmission > 0.0 {
         MaterialKind::Dielectric {
@@ -363,11 +485,55 @@ fn material(m: &gltf::Material<'_>, index: usize) -> Material {
         MaterialKind::Diffuse { albedo: base }
     };
     let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
-    Material {
+    let mut maps = MaterialTextures::default();
+    let base_info = pbr.base_color_texture();
+    if let Some(info) = &base_info {
+        uv_sets.insert(0, info.tex_coord());
+        maps.color = textures.get(&info.texture(), true, info.texture_transform())?;
+    }
+    if let Some(info) = m.emissive_texture()
+        && emission != Vec3::ZERO
+    {
+        uv_sets.push(info.tex_coord());
+        maps.emission = textures.get(&info.texture(), true, info.texture_transform())?;
+    }
+    if let Some(normal) = m.normal_texture() {
+        uv_sets.push(normal.tex_coord());
+        maps.normal = textures
+            .get(&normal.texture(), false, None)?
+            .map(|texture| NormalMap {
+                texture,
+                scale: normal.scale(),
+            });
+    }
+    let alpha_texture = maps.color.clone().filter(|t| t.image.has_alpha);
+    let mode = match m.alpha_mode() {
+        gltf::material::AlphaMode::Opaque => None,
+        gltf::material::AlphaMode::Mask => Some(AlphaMode::Mask {
+            cutoff: m.alpha_cutoff().unwrap_or(0.5),
+        }),
+        gltf::material::AlphaMode::Blend => {
+            (alpha_texture.is_some() || alpha_factor < 1.0).then_some(AlphaMode::Blend)
+        }
+    };
+    maps.alpha = mode.map(|mode| Alpha {
+        texture: alpha_texture,
+        factor: alpha_factor,
+        mode,
+    });
+    let uv_set = uv_sets.first().copied().unwrap_or(0);
+    if uv_sets.iter().any(|&s| s != uv_set) {
+        textures.warnings.push(format!(
+            "material {index} reads several texture-coordinate sets; all its textures use set {uv_set}"
+        ));
+    }
+    let material = Material {
         name: m
             .name()
             .map_or_else(|| format!("material {index}"), str::to_owned),
         kind,
         emission,
-    }
+        textures: (!maps.is_empty()).then(|| Arc::new(maps)),
+    };
+    Ok((material, uv_set))
 }

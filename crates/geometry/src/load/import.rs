@@ -248,6 +248,7 @@ impl Builder {
             positions,
             normals,
             material,
+            uv: None,
         });
     }
 

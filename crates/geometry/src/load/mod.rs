@@ -185,6 +185,7 @@ impl MeshData {
         &mut self,
         positions: [Vec3; 3],
         normals: Option<[Vec3; 3]>,
+        uv: Option<[glam::Vec2; 3]>,
         material: u32,
     ) {
         if is_degenerate(positions) {
@@ -196,6 +197,7 @@ impl MeshData {
             positions,
             normals: normals.and_then(clean_normals),
             material,
+            uv,
         });
     }
 

@@ -21,11 +21,14 @@ use std::collections::BTreeSet;
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
-use glam::Vec3;
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
 
 use super::{MeshData, polygon};
 use crate::description::{Material, MaterialKind};
 use crate::error::LoadError;
+use crate::texture::{Alpha, AlphaMode, MaterialTextures, NormalMap, TextureCache, TextureRef};
 
 /// Albedo of the default material and of MTL materials without `Kd`.
 pub const DEFAULT_ALBEDO: f32 = 0.8;
@@ -88,8 +91,11 @@ pub(crate) fn load_obj(path: &Path) -> Result<MeshData, LoadError> {
             scan.skipped_points_lines
         ));
     }
+    let mut textures = TextureCache::default();
     for m in &tobj_materials {
-        data.materials.push(mtl_material(m, &mut data.warnings));
+        let mut material = mtl_material(m, &mut data.warnings);
+        material.textures = mtl_textures(m, &dir, &mut textures, &mut data.warnings)?;
+        data.materials.push(material);
     }
     let known: BTreeSet<&str> = tobj_materials.iter().map(|m| m.name.as_str()).collect();
     for name in scan.usemtl.iter().filter(|n| !known.contains(n.as_str())) {
@@ -127,6 +133,7 @@ pub(crate) fn default_material_value() -> Material {
             albedo: Vec3::splat(DEFAULT_ALBEDO),
         },
         emission: Vec3::ZERO,
+        textures: None,
     }
 }
 
@@ -138,6 +145,14 @@ fn add_mesh(data: &mut MeshData, mesh: &tobj::Mesh, material: u32) {
             .map_or(Vec3::NAN, |p| Vec3::new(p[0], p[1], p[2]))
     };
     let has_normals = !mesh.normals.is_empty() && mesh.normals.len() == mesh.positions.len();
+    let has_uv = !mesh.texcoords.is_empty() && mesh.texcoords.len() / 2 == mesh.positions.len() / 3;
+    // OBJ puts v = 0 at the bottom of the image; texture coordinates here grow downwards.
+    let uv = |i: u32| -> Vec2 {
+        let i = i as usize * 2;
+        mesh.texcoords
+            .get(i..i + 2)
+            .map_or(Vec2::ZERO, |t| Vec2::new(t[0], 1.0 - t[1]))
+    };
     let normal = |i: u32| -> Vec3 {
         let i = i as usize * 3;
         mesh.normals
@@ -163,7 +178,10 @@ fn add_mesh(data: &mut MeshData, mesh: &tobj::Mesh, material: u32) {
         for tri in polygon::triangulate(&points) {
             let corner = tri.map(|k| indices[k]);
             let normals = has_normals.then(|| corner.map(normal));
-            data.push_triangle(corner.map(vertex), normals, material);
+            let uvs = has_uv
+                .then(|| corner.map(uv))
+                .filter(|t| t.iter().all(|v| v.is_finite()));
+            data.push_triangle(corner.map(vertex), normals, uvs, material);
         }
     }
 }
@@ -328,7 +346,12 @@ fn mtl_material(m: &tobj::Material, warnings: &mut Vec<String>) -> Material {
     let kd = m.diffuse.map_or(Vec3::splat(DEFAULT_ALBEDO), Vec3::from);
     let ks = m.specular.map(Vec3::from);
     let ns = m.shininess.unwrap_or(0.0);
-    let emission = m.emissive.map_or(Vec3::ZERO, Vec3::from);
+    let emission = match m.emissive.map(Vec3::from) {
+        // `map_Ke` alone means the texture is the emission.
+        Some(e) if e != Vec3::ZERO => e,
+        _ if m.unknown_param.contains_key("map_Ke") => Vec3::ONE,
+        _ => Vec3::ZERO,
+    };
     let illum = m.illumination_model;
     let dissolve = m.dissolve.unwrap_or(1.0);
     let kind = if illum == Some(5) {
@@ -369,5 +392,65 @@ fn mtl_material(m: &tobj::Material, warnings: &mut Vec<String>) -> Material {
         name: m.name.clone(),
         kind,
         emission,
+        textures: None,
     }
+}
+
+/// The file of a texture statement: its last word (options such as `-bm 1` come first).
+fn texture_file(statement: &str) -> Option<&str> {
+    statement.split_whitespace().last()
+}
+
+/// The textures of an MTL material: `map_Kd` multiplies the diffuse colour (the whole glossy
+/// BSDF of a `Kd` + `Ks` material, see `docs/scene-format-extensions.md`), `map_Ke` the
+/// emission, `map_d` cuts the surface out where it is below ½, and `norm` (or a `bump` /
+/// `map_Bump` image that is a tangent-space normal map: mean blue above 0.7, mean red and green
+/// within 0.1 of ½) perturbs the shading normal; a height `bump` map is ignored with a warning.
+fn mtl_textures(
+    m: &tobj::Material,
+    dir: &Path,
+    cache: &mut TextureCache,
+    warnings: &mut Vec<String>,
+) -> Result<Option<Arc<MaterialTextures>>, LoadError> {
+    let mut load =
+        |statement: Option<&String>, srgb: bool| -> Result<Option<TextureRef>, LoadError> {
+            match statement.and_then(|s| texture_file(s)) {
+                None => Ok(None),
+                Some(file) => Ok(Some(TextureRef::new(cache.load(&dir.join(file))?, srgb))),
+            }
+        };
+    let mut maps = MaterialTextures {
+        color: load(m.diffuse_texture.as_ref(), true)?,
+        emission: load(m.unknown_param.get("map_Ke"), true)?,
+        ..MaterialTextures::default()
+    };
+    if maps.emission.is_some() && m.emissive.is_none_or(|e| e == [0.0; 3]) {
+        warnings.push(format!(
+            "material {:?} has map_Ke but no Ke: taken as Ke 1 1 1",
+            m.name
+        ));
+    }
+    maps.alpha = load(m.dissolve_texture.as_ref(), false)?.map(|texture| Alpha {
+        texture: Some(texture),
+        factor: 1.0,
+        mode: AlphaMode::Mask { cutoff: 0.5 },
+    });
+    let norm = m.unknown_param.get("norm");
+    if let Some(texture) = load(norm.or(m.normal_texture.as_ref()), false)? {
+        let mean = texture.image.mean(false);
+        let looks_normal = mean.z > 0.7 && (mean.x - 0.5).abs() < 0.1 && (mean.y - 0.5).abs() < 0.1;
+        if norm.is_some() || looks_normal {
+            maps.normal = Some(NormalMap {
+                texture,
+                scale: 1.0,
+            });
+        } else {
+            warnings.push(format!(
+                "material {:?}: bump map {} is a height map, which is ignored",
+                m.name,
+                texture.image.path().display()
+            ));
+        }
+    }
+    Ok((!maps.is_empty()).then(|| Arc::new(maps)))
 }

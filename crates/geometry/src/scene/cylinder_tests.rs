@@ -597,6 +597,7 @@ fn scene_rejects_bad_cylinders() {
             reflectance: Vec3::ONE,
         },
         emission: Vec3::ZERO,
+        textures: None,
     };
     for bad in [
         Cylinder {

@@ -12,8 +12,11 @@ use crate::{
 
 #[cfg(test)]
 mod cylinder_tests;
+mod shading;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod texture_tests;
 
 /// Relative floating-point error bound γₙ = n·ε/(1 − n·ε) of pbrt (ε = half an ulp of 1).
 const fn gamma(n: f32) -> f32 {
@@ -89,6 +92,10 @@ pub struct Scene {
     camera: CameraModel,
     lights: LightSampler,
     bounds: Aabb,
+    /// Whether some triangle's material has a cut-out (alpha test).
+    cutouts: bool,
+    /// Whether some hit needs texture work before it is returned (a cut-out or a normal map).
+    textured_hits: bool,
 }
 
 impl Scene {
@@ -157,11 +164,29 @@ impl Scene {
                 crate::bvh::MAX_PRIMITIVES - 1
             )));
         }
-        let accel = Accel::build(
+        let mut accel = Accel::build(
             &description.triangles,
             &description.spheres,
             &description.cylinders,
         );
+        let cutout_materials: Vec<bool> = description
+            .materials
+            .iter()
+            .map(|m| shading::has_cutout(m.textures.as_deref()))
+            .collect();
+        let cutouts = description
+            .triangles
+            .iter()
+            .any(|t| cutout_materials[t.material as usize]);
+        if cutouts {
+            accel.set_cutouts(|i| {
+                cutout_materials[description.triangles[i as usize].material as usize]
+            });
+        }
+        let normal_mapped = description
+            .materials
+            .iter()
+            .any(|m| m.textures.as_ref().is_some_and(|t| t.normal.is_some()));
         Ok(Self {
             description,
             accel,
@@ -169,6 +194,8 @@ impl Scene {
             camera,
             lights,
             bounds,
+            cutouts,
+            textured_hits: cutouts || normal_mapped,
         })
     }
 
@@ -214,8 +241,27 @@ impl Scene {
     /// ([`Scene::intersect_inlined`] compiles it in too).
     #[inline(always)]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        if self.textured_hits {
+            return self.intersect_textured(ray);
+        }
         let raw = self.accel.intersect(ray)?;
         Some(self.hit(ray, raw))
+    }
+
+    /// [`Scene::intersect`] in a scene with cut-outs or normal maps: the closest hit that the
+    /// alpha tests let through, with its normal mapped. Kept out of line so that the queries
+    /// of untextured scenes compile as before.
+    #[inline(never)]
+    fn intersect_textured(&self, ray: &Ray) -> Option<Hit> {
+        let raw = if self.cutouts {
+            self.accel
+                .intersect_cutout(ray, &|i, b1, b2| self.covered(ray, i, b1, b2))?
+        } else {
+            self.accel.intersect(ray)?
+        };
+        let mut hit = self.hit(ray, raw);
+        self.apply_normal_map(&mut hit);
+        Some(hit)
     }
 
     /// [`Scene::intersect`], with the BVH traversal compiled into the caller instead of called:
@@ -226,6 +272,9 @@ impl Scene {
     #[doc(hidden)]
     #[inline(always)]
     pub fn intersect_inlined(&self, ray: &Ray) -> Option<Hit> {
+        if self.textured_hits {
+            return self.intersect_textured(ray);
+        }
         let raw = self.accel.intersect_inlined(ray)?;
         Some(self.hit(ray, raw))
     }
@@ -242,6 +291,11 @@ impl Scene {
     /// Whether anything is hit with 0 < t < `ray.t_max` (a shadow-ray query, faster than [`Scene::intersect`]).
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
+        if self.cutouts {
+            return self
+                .accel
+                .occluded_cutout(ray, &|i, b1, b2| self.covered(ray, i, b1, b2));
+        }
         self.accel.occluded(ray)
     }
 
@@ -262,17 +316,26 @@ impl Scene {
         }
     }
 
-    /// The BSDF at `hit` (see [`Bsdf::new`]); `None` if the hit's material index is out of range.
+    /// The BSDF at `hit` (see [`Bsdf::new`]), with the material's colour texture; `None` if the
+    /// hit's material index is out of range.
     #[inline]
     pub fn bsdf(&self, hit: &Hit) -> Option<Bsdf> {
-        self.material(hit.material).map(|m| Bsdf::new(m, hit))
+        self.material(hit.material)
+            .map(|m| self.material_bsdf(m, hit))
     }
 
-    /// Radiance emitted at `hit` back along the ray: the material's emission on a front face, else zero.
+    /// Radiance emitted at `hit` back along the ray: the material's emission (times its
+    /// emission texture) on a front face, else zero.
     #[inline]
     pub fn emitted(&self, hit: &Hit) -> Rgb {
         match self.material(hit.material) {
-            Some(m) if hit.front_face => m.emission,
+            Some(m) if hit.front_face => {
+                if m.textures.is_none() {
+                    m.emission
+                } else {
+                    self.textured_emission(m, hit)
+                }
+            }
             _ => Rgb::ZERO,
         }
     }

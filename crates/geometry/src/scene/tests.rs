@@ -228,6 +228,7 @@ fn mesh_curvature_from_vertex_normals() {
                     positions: [p * r, q * r, s * r],
                     normals: Some([p, q, s]),
                     material: 0,
+                    uv: None,
                 });
             }
         }
@@ -515,6 +516,7 @@ fn mesh_curvature_is_the_focusing_principal_curvature() {
                 positions: [p, q, s],
                 normals: Some(normals),
                 material: 0,
+                uv: None,
             });
         }
     }

@@ -39,6 +39,19 @@ edge2 = [0.0, 0.0, 0.4]
 material = "lamp"
 "#;
 
+/// A scene whose emitter's albedo is the texture `tex.png` next to it.
+const TEXTURED: &str = "format = 1\n[materials.m]\ntype = \"diffuse\"\nalbedo = { texture = \"tex.png\" }\nemission = [1, 1, 1]\n[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n";
+
+/// A glTF triangle whose material's base colour is the texture `tex.png` (positions and texture
+/// coordinates in one base64 buffer; the material emits).
+const GLTF_TEXTURED: &str = r#"{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+"meshes":[{"primitives":[{"attributes":{"POSITION":0},"material":0}]}],
+"materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0},"metallicFactor":0},"emissiveFactor":[1,1,1]}],
+"textures":[{"source":0}],"images":[{"uri":"tex.png"}],
+"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
+"bufferViews":[{"buffer":0,"byteLength":36}],
+"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]}"#;
+
 /// Loads `BASE` with one textual replacement, as if from `dir/scene.toml`.
 fn load_edited(
     from: &str,
@@ -364,6 +377,57 @@ const FILES: &[BadFile] = &[
         named: "empty.obj",
     },
     BadFile {
+        test: "missing_texture",
+        files: &[("scene.toml", TEXTURED)],
+        expect: &["Texture {", "cannot read texture"],
+        named: "tex.png",
+    },
+    BadFile {
+        test: "texture_of_unknown_format",
+        files: &[
+            ("scene.toml", TEXTURED),
+            ("tex.png", "not an image at all\n"),
+        ],
+        expect: &["Texture {", "unsupported texture format"],
+        named: "tex.png",
+    },
+    BadFile {
+        test: "texture_of_unsupported_format",
+        files: &[
+            ("scene.toml", TEXTURED),
+            ("tex.png", "GIF89a\x01\x00\x01\x00"),
+        ],
+        expect: &["Texture {", "unsupported texture format gif"],
+        named: "tex.png",
+    },
+    BadFile {
+        test: "missing_cutout_mask",
+        files: &[(
+            "scene.toml",
+            "format = 1\n[materials.m]\ntype = \"diffuse\"\nalbedo = [1, 1, 1]\nemission = [1, 1, 1]\ncutout = \"mask.png\"\n[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n",
+        )],
+        expect: &["Texture {", "cannot read texture"],
+        named: "mask.png",
+    },
+    BadFile {
+        test: "missing_mtl_texture",
+        files: &[
+            (
+                "scene.obj",
+                "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl lamp\nf 1 2 3\n",
+            ),
+            ("m.mtl", "newmtl lamp\nKe 1 1 1\nmap_Kd -bm 1 kd.png\n"),
+        ],
+        expect: &["Texture {", "cannot read texture"],
+        named: "kd.png",
+    },
+    BadFile {
+        test: "missing_gltf_texture",
+        files: &[("scene.gltf", GLTF_TEXTURED)],
+        expect: &["Texture {", "cannot read texture"],
+        named: "tex.png",
+    },
+    BadFile {
         test: "no_emitter",
         files: &[("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")],
         expect: &["NoEmitter {"],
@@ -535,6 +599,7 @@ fn messages_read_well() {
         ("nan.obj", "v 0 0 0\nv nan 0 0\n"),
         ("bad.gltf", "{ \"asset\": 1 }"),
         ("scene.ply", ""),
+        ("textured.toml", TEXTURED),
     ];
     for (name, text) in files {
         std::fs::write(dir.join(name), text).unwrap();
@@ -544,6 +609,62 @@ fn messages_read_well() {
     insta::assert_snapshot!(lines.join("\n"));
 }
 
+/// A PNG file of `width` × `height` (8-bit grey) with a valid signature and header and
+/// `rest` after the header (CRCs computed, so only what is meant to be wrong is).
+fn png(width: u32, height: u32, rest: &[u8]) -> Vec<u8> {
+    let mut out = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = b"IHDR".to_vec();
+    ihdr.extend(width.to_be_bytes());
+    ihdr.extend(height.to_be_bytes());
+    ihdr.extend([8, 0, 0, 0, 0]);
+    out.extend(13u32.to_be_bytes());
+    out.extend(&ihdr);
+    let mut crc = flate2::Crc::new();
+    crc.update(&ihdr);
+    out.extend(crc.sum().to_be_bytes());
+    out.extend(rest);
+    out
+}
+
+/// Texture files that need bytes, not text: each must fail with one line naming the image.
+#[test]
+fn bad_texture_files_name_the_image() {
+    let nan_exr = {
+        let dir = crate::temp_dir("nan_exr_source");
+        let path = dir.join("nan.exr");
+        let img =
+            image::Rgba32FImage::from_raw(2, 1, vec![0.5, 0.5, 0.5, 1.0, f32::NAN, 0.0, 0.0, 1.0])
+                .unwrap();
+        image::DynamicImage::ImageRgba32F(img).save(&path).unwrap();
+        std::fs::read(&path).unwrap()
+    };
+    let cases: [(&str, Vec<u8>, &str); 4] = [
+        ("zero_size", png(0, 4, b""), "tex.png"),
+        (
+            "truncated_png",
+            png(4, 4, b"\x00\x00"),
+            "corrupt png texture",
+        ),
+        (
+            "corrupt_jpeg",
+            b"\xff\xd8\xff\xe0garbage".to_vec(),
+            "corrupt jpg texture",
+        ),
+        ("nan_texel", nan_exr, "nan texel at (1, 0)"),
+    ];
+    for (test, bytes, needle) in cases {
+        let dir = crate::temp_dir(test);
+        let scene = dir.join("scene.toml");
+        std::fs::write(&scene, TEXTURED).unwrap();
+        std::fs::write(dir.join("tex.png"), &bytes).unwrap();
+        let err = load(&scene).expect_err(test);
+        assert!(matches!(err, LoadError::Texture { .. }), "{test}: {err:?}");
+        assert_names_file(&err, &dir.join("tex.png"));
+        let msg = err.to_string();
+        assert!(msg.contains(needle), "{test}: {msg}");
+        assert!(!msg.contains('\n'), "{test}: {msg}");
+    }
+}
 /// An OpenEXR file of `width` × `height` RGB texels from `texel(x, y)`.
 fn write_exr(path: &Path, width: usize, height: usize, texel: impl Fn(usize, usize) -> f32 + Sync) {
     exr::prelude::write_rgb_file(path, width, height, |x, y| {

@@ -317,3 +317,61 @@ fn points_and_lines_are_skipped_with_a_warning() {
         scene.notes.warnings
     );
 }
+
+/// MTL textures: `map_Kd` colours, `map_Ke` alone emits its texture (Ke taken as 1), `map_d`
+/// cuts out, `norm` is a normal map, a height `bump` is dropped with a warning; OBJ texture
+/// coordinates are flipped to the image convention (v down); one image file read once.
+#[test]
+fn mtl_textures_and_texture_coordinates() {
+    let dir = crate::temp_dir("mtl_textures");
+    let rgba = |c: [u8; 4]| image::RgbaImage::from_pixel(2, 2, image::Rgba(c));
+    rgba([200, 100, 50, 255]).save(dir.join("kd.png")).unwrap();
+    rgba([128, 128, 255, 255])
+        .save(dir.join("normal.png"))
+        .unwrap();
+    rgba([90, 90, 90, 255])
+        .save(dir.join("height.png"))
+        .unwrap();
+    std::fs::write(
+        dir.join("m.mtl"),
+        "newmtl lamp\nKd 1 1 1\nmap_Kd kd.png\nmap_Ke kd.png\nmap_d kd.png\nnorm normal.png\n\
+         newmtl bumpy\nKd 0.5 0.5 0.5\nbump -bm 1 height.png\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("quad.obj"),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 0.25\n\
+         usemtl lamp\nf 1/1 2/2 3/3\nusemtl bumpy\nf 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    let scene = geometry::load(&dir.join("quad.obj")).unwrap();
+    let lamp = &scene.materials[0];
+    assert_eq!(lamp.emission, glam::Vec3::ONE);
+    let t = lamp.textures.as_deref().unwrap();
+    let (color, emission) = (t.color.as_ref().unwrap(), t.emission.as_ref().unwrap());
+    assert!(std::sync::Arc::ptr_eq(&color.image, &emission.image));
+    assert!(color.srgb && t.alpha.is_some() && t.normal.is_some());
+    assert!(!t.normal.as_ref().unwrap().texture.srgb);
+    assert!(scene.materials[1].textures.is_none());
+    assert!(
+        scene
+            .notes
+            .warnings
+            .iter()
+            .any(|w| w.contains("height map")),
+        "{:?}",
+        scene.notes.warnings
+    );
+    let uv = scene.triangles[0].uv.unwrap();
+    assert_eq!(
+        uv,
+        [
+            glam::Vec2::new(0.0, 1.0),
+            glam::Vec2::new(1.0, 1.0),
+            glam::Vec2::new(1.0, 0.75)
+        ]
+    );
+    // sRGB 200 decodes to 0.578 (IEC 61966-2-1), the texel of every lookup on a flat image.
+    let texel = color.color(glam::Vec2::new(0.3, 0.6));
+    assert!((texel.x - 0.577_580).abs() < 1e-4, "{texel}");
+}

@@ -179,7 +179,9 @@ impl Setup<'_> {
                 geometric_normal: hit.geometric_normal,
                 outgoing: end.outgoing,
                 material: hit.material,
-                weight: end.throughput * weight_scale,
+                // A colour texture multiplies the material's scattering: the photon gather
+                // evaluates the untextured material and the hitpoint carries the texture.
+                weight: end.throughput * self.scene.scattering_tint(hit) * weight_scale,
                 normal_distance: hit.t * mu,
                 mu_o: mu,
                 bounces: end.bounces,
@@ -222,7 +224,7 @@ impl Setup<'_> {
             let Some(material) = self.scene.material(hit.material) else {
                 break;
             };
-            let bsdf = Bsdf::new(material, &hit);
+            let bsdf = self.scene.material_bsdf(material, &hit);
             let outgoing = -ray.direction;
             if bsdf.is_specular() {
                 let u_lobe = sampler.next_f32();

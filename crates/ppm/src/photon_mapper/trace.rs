@@ -1,7 +1,7 @@
 //! Tracing one photon path: emission, Russian roulette, scattering, and the photons it stores
 //! on non-specular surfaces (with the frequency steps of `frequency.rs` for frequency photons).
 
-use geometry::{Bsdf, Hit, MaterialKind, Rgb, TransportMode};
+use geometry::{Hit, MaterialKind, Rgb, TransportMode};
 use glam::Vec3;
 use photon::Photon;
 
@@ -83,7 +83,7 @@ impl Setup<'_> {
             }
             // The frequency photon's field where it lands: the sharper of its two axes.
             let here = spectrum.map(arrived);
-            let bsdf = Bsdf::new(material, &hit);
+            let bsdf = self.scene.material_bsdf(material, &hit);
             // With direct lighting by light sampling, photons straight from an emitter are
             // already accounted for at the hitpoints.
             let counted_by_light_sampling = self.params.direct_lighting && depth == 0;
@@ -125,7 +125,7 @@ impl Setup<'_> {
                 (1.0 - ratio).max(0.0)
             };
             // The survival probability, when the roulette is decided before sampling.
-            let decided = match material.kind {
+            let decided = match bsdf.kind() {
                 MaterialKind::Diffuse { albedo } if roulette => {
                     let q = kill_probability(power * albedo);
                     if u_roulette < q {

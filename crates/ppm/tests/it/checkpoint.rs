@@ -74,3 +74,34 @@ fn checkpoints_of_another_scene_version_or_corrupt_bytes_are_refused() {
         Err(StateError::Version { .. })
     ));
 }
+
+/// A checkpoint knows which texture files its scene read: the same scene with another texture
+/// file (even with the same texels) or with none has another fingerprint.
+#[test]
+fn the_fingerprint_covers_textures() {
+    // A 1 × 1 RGBA PNG.
+    let png: Vec<u8> = (0..)
+        .step_by(2)
+        .take_while(|&i| i < PNG_HEX.len())
+        .map(|i| u8::from_str_radix(&PNG_HEX[i..i + 2], 16).unwrap())
+        .collect();
+    let dir = std::env::temp_dir().join(format!("fppm-ppm-fingerprint-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("a.png"), &png).unwrap();
+    std::fs::write(dir.join("b.png"), &png).unwrap();
+    let scene = |albedo: &str| {
+        let text = format!(
+            "format = 1\n[materials.m]\ntype = \"diffuse\"\nalbedo = {albedo}\nemission = [1, 1, 1]\n[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n"
+        );
+        geometry::load_toml_str(&text, &dir.join("scene.toml")).unwrap()
+    };
+    let a = ppm::scene_fingerprint(&scene("{ texture = \"a.png\" }"));
+    let b = ppm::scene_fingerprint(&scene("{ texture = \"b.png\" }"));
+    let plain = ppm::scene_fingerprint(&scene("[1, 1, 1]"));
+    assert_ne!(a, b);
+    assert_ne!(a, plain);
+    assert_eq!(a, ppm::scene_fingerprint(&scene("{ texture = \"a.png\" }")));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+const PNG_HEX: &str = "89504e470d0a1a0a0000000d49484452000000010000000108060000001f15c4890000000d4944415478da636460f85f0f0002870180eb47ba920000000049454e44ae426082";

@@ -96,6 +96,7 @@ impl<'a> Importer<'a> {
             name,
             kind,
             emission,
+            textures: None,
         });
         let to_world = parent * self.transform(node, "to_world")?;
         let m = to_world.as_mat4();

@@ -120,6 +120,7 @@ impl Parser {
                 name,
                 kind,
                 emission,
+                textures: None,
             });
             let to_world = fix * shape.state.ctm;
             self.shape(

@@ -6,6 +6,7 @@ use crate::description::{
 };
 use crate::error::LoadError;
 use crate::load::{LoadOptions, MAX_FILM_SIDE, MeshData, SceneParts, fmt_vec};
+use crate::texture::{Alpha, AlphaMode, MaterialTextures, TextureCache, TextureRef};
 use glam::{Mat3, Mat4, Vec3};
 use std::collections::{BTreeMap, HashSet};
 use std::path::Path;
@@ -15,6 +16,8 @@ use super::schema::*;
 pub(super) struct Converter<'a> {
     pub(super) path: &'a Path,
     pub(super) dir: &'a Path,
+    /// The texture images read so far (each file once).
+    pub(super) textures: std::cell::RefCell<TextureCache>,
 }
 
 impl Converter<'_> {
@@ -182,8 +185,21 @@ impl Converter<'_> {
                     let e1 = self.finite(&format!("{context} edge1"), edge1)?;
                     let e2 = self.finite(&format!("{context} edge2"), edge2)?;
                     let m = lookup(&context, &material)?;
-                    acc.push([c, c + e1, c + e1 + e2], None, m);
-                    acc.push([c, c + e1 + e2, c + e2], None, m);
+                    // Texture coordinates: the corner at the image's bottom left, edge1
+                    // along u, edge2 up the image (v grows downwards, see `crate::texture`).
+                    let uv = |a: f32, b: f32| glam::Vec2::new(a, 1.0 - b);
+                    acc.push(
+                        [c, c + e1, c + e1 + e2],
+                        None,
+                        Some([uv(0.0, 0.0), uv(1.0, 0.0), uv(1.0, 1.0)]),
+                        m,
+                    );
+                    acc.push(
+                        [c, c + e1 + e2, c + e2],
+                        None,
+                        Some([uv(0.0, 0.0), uv(1.0, 1.0), uv(0.0, 1.0)]),
+                        m,
+                    );
                 }
                 ShapeToml::Mesh {
                     file: mesh_file,
@@ -225,6 +241,7 @@ impl Converter<'_> {
                     let flip = matrix.determinant() < 0.0;
                     for t in mesh.triangles {
                         let mut p = t.positions.map(|p| matrix.transform_point3(p));
+                        let mut uv = t.uv;
                         let mut n = t
                             .normals
                             .map(|n| n.map(|n| (normal_matrix * n).normalize_or_zero()));
@@ -233,9 +250,12 @@ impl Converter<'_> {
                             if let Some(n) = n.as_mut() {
                                 n.swap(1, 2);
                             }
+                            if let Some(uv) = uv.as_mut() {
+                                uv.swap(1, 2);
+                            }
                         }
                         let n = n.filter(|n| n.iter().all(|v| *v != Vec3::ZERO));
-                        acc.push(p, n, material_of(t.material));
+                        acc.push(p, n, uv, material_of(t.material));
                     }
                 }
             }
@@ -346,23 +366,33 @@ impl Converter<'_> {
 
     pub(super) fn material(&self, name: &str, m: MaterialToml) -> Result<Material, LoadError> {
         let key = |k: &str| format!("[materials.{name}] {k}");
+        let mut color = None;
+        let mut cutout_file = None;
         let (kind, emission) = match m {
-            MaterialToml::Diffuse { albedo, emission } => (
-                MaterialKind::Diffuse {
-                    albedo: self.reflectance(&key("albedo"), albedo)?,
-                },
+            MaterialToml::Diffuse {
+                albedo,
                 emission,
-            ),
+                cutout,
+            } => {
+                cutout_file = cutout;
+                let (albedo, texture) = self.colour_input(&key("albedo"), albedo, true)?;
+                color = texture;
+                (MaterialKind::Diffuse { albedo }, emission)
+            }
             MaterialToml::Mirror {
                 reflectance,
                 emission,
-            } => (
-                MaterialKind::Mirror {
-                    reflectance: self
-                        .reflectance(&key("reflectance"), reflectance.unwrap_or([1.0; 3]))?,
-                },
-                emission,
-            ),
+                cutout,
+            } => {
+                cutout_file = cutout;
+                let (reflectance, texture) = self.colour_input(
+                    &key("reflectance"),
+                    reflectance.unwrap_or(ColorToml::Rgb([1.0; 3])),
+                    true,
+                )?;
+                color = texture;
+                (MaterialKind::Mirror { reflectance }, emission)
+            }
             MaterialToml::Dielectric { ior, emission } => (
                 MaterialKind::Dielectric {
                     ior: self.positive(&key("ior"), ior)?,
@@ -373,24 +403,76 @@ impl Converter<'_> {
                 reflectance,
                 roughness,
                 emission,
-            } => (
-                MaterialKind::Glossy {
-                    reflectance: self.reflectance(&key("reflectance"), reflectance)?,
-                    roughness: self.positive(&key("roughness"), roughness)?,
-                    diffuse: Vec3::ZERO,
-                },
-                emission,
-            ),
+                cutout,
+            } => {
+                cutout_file = cutout;
+                let (reflectance, texture) =
+                    self.colour_input(&key("reflectance"), reflectance, true)?;
+                color = texture;
+                (
+                    MaterialKind::Glossy {
+                        reflectance,
+                        roughness: self.positive(&key("roughness"), roughness)?,
+                        diffuse: Vec3::ZERO,
+                    },
+                    emission,
+                )
+            }
         };
-        let emission = match emission {
-            Some(e) => self.colour(&key("emission"), e)?,
-            None => Vec3::ZERO,
+        let (emission, emission_texture) = match emission {
+            Some(e) => self.colour_input(&key("emission"), e, false)?,
+            None => (Vec3::ZERO, None),
+        };
+        let alpha = match cutout_file {
+            None => None,
+            Some(file) => {
+                let image = self.textures.borrow_mut().load(&self.dir.join(file))?;
+                Some(Alpha {
+                    texture: Some(TextureRef::new(image, false)),
+                    factor: 1.0,
+                    mode: AlphaMode::Mask { cutoff: 0.5 },
+                })
+            }
+        };
+        let textures = MaterialTextures {
+            color,
+            emission: emission_texture,
+            alpha,
+            ..MaterialTextures::default()
         };
         Ok(Material {
             name: name.to_owned(),
             kind,
             emission,
+            textures: (!textures.is_empty()).then(|| std::sync::Arc::new(textures)),
         })
+    }
+
+    /// A colour given as `[r, g, b]` or as `{ texture = "file", scale = [r, g, b] }`: the
+    /// constant colour (the scale, 1 by default) and the texture, if any, read relative to the
+    /// scene file. A `reflectance` must be at most 1 (the texture's texels are not checked:
+    /// 8-bit colours are at most 1, and HDR images belong to emission).
+    fn colour_input(
+        &self,
+        key: &str,
+        input: ColorToml,
+        reflectance: bool,
+    ) -> Result<(Vec3, Option<TextureRef>), LoadError> {
+        let check = |v| {
+            if reflectance {
+                self.reflectance(key, v)
+            } else {
+                self.colour(key, v)
+            }
+        };
+        match input {
+            ColorToml::Rgb(v) => Ok((check(v)?, None)),
+            ColorToml::Texture { texture, scale } => {
+                let scale = check(scale.unwrap_or([1.0; 3]))?;
+                let image = self.textures.borrow_mut().load(&self.dir.join(texture))?;
+                Ok((scale, Some(TextureRef::new(image, true))))
+            }
+        }
     }
 
     /// Scale, then rotate about x, y, z (degrees), then translate.
@@ -549,7 +631,13 @@ pub(super) struct Accumulator {
 }
 
 impl Accumulator {
-    pub(super) fn push(&mut self, positions: [Vec3; 3], normals: Option<[Vec3; 3]>, material: u32) {
+    pub(super) fn push(
+        &mut self,
+        positions: [Vec3; 3],
+        normals: Option<[Vec3; 3]>,
+        uv: Option<[glam::Vec2; 3]>,
+        material: u32,
+    ) {
         if crate::load::is_degenerate(positions) {
             self.notes.degenerate_triangles += 1;
             self.degenerate_materials.insert(material);
@@ -558,6 +646,7 @@ impl Accumulator {
                 positions,
                 normals,
                 material,
+                uv,
             });
         }
     }

@@ -70,6 +70,7 @@ pub(crate) fn load_toml(
     Converter {
         path,
         dir: path.parent().unwrap_or(Path::new("")),
+        textures: std::cell::RefCell::default(),
     }
     .convert(file, options)
 }

@@ -41,22 +41,73 @@ pub(super) struct FilmToml {
 #[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
 pub(super) enum MaterialToml {
     Diffuse {
-        albedo: [f32; 3],
-        emission: Option<[f32; 3]>,
+        albedo: ColorToml,
+        emission: Option<ColorToml>,
+        cutout: Option<String>,
     },
     Mirror {
-        reflectance: Option<[f32; 3]>,
-        emission: Option<[f32; 3]>,
+        reflectance: Option<ColorToml>,
+        emission: Option<ColorToml>,
+        cutout: Option<String>,
     },
     Dielectric {
         ior: f32,
-        emission: Option<[f32; 3]>,
+        emission: Option<ColorToml>,
     },
     Glossy {
-        reflectance: [f32; 3],
+        reflectance: ColorToml,
         roughness: f32,
-        emission: Option<[f32; 3]>,
+        emission: Option<ColorToml>,
+        cutout: Option<String>,
     },
+}
+
+/// A colour: `[r, g, b]`, or (extension, `docs/scene-format-extensions.md`) an image texture
+/// `{ texture = "file.png", scale = [r, g, b] }`.
+pub(super) enum ColorToml {
+    Rgb([f32; 3]),
+    Texture {
+        texture: String,
+        scale: Option<[f32; 3]>,
+    },
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TextureToml {
+    texture: String,
+    scale: Option<[f32; 3]>,
+}
+
+impl<'de> Deserialize<'de> for ColorToml {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = ColorToml;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("an array of 3 numbers or a table { texture = \"file\" }")
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                seq: A,
+            ) -> Result<ColorToml, A::Error> {
+                <[f32; 3]>::deserialize(serde::de::value::SeqAccessDeserializer::new(seq))
+                    .map(ColorToml::Rgb)
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                map: A,
+            ) -> Result<ColorToml, A::Error> {
+                let t =
+                    TextureToml::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
+                Ok(ColorToml::Texture {
+                    texture: t.texture,
+                    scale: t.scale,
+                })
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
 }
 
 #[derive(Deserialize)]

@@ -1,0 +1,159 @@
+//! What textures change at a hit: the scattering colour, the emission, the shading normal and
+//! whether the surface is there at all (cut-outs). Untextured materials skip all of it: the
+//! scene knows whether any material has a normal map or a cut-out and tests nothing otherwise.
+
+use glam::{Vec2, Vec3};
+
+use super::Scene;
+use crate::texture::MaterialTextures;
+use crate::{Bsdf, Hit, Material, Primitive, Ray, Rgb};
+
+impl Scene {
+    /// The texture coordinates at `hit`: the triangle's interpolated texture coordinates (its
+    /// barycentrics if it has none), a sphere's (φ/2π, θ/π) about +z, a cylinder's (arc, height).
+    #[inline]
+    pub fn texture_uv(&self, hit: &Hit) -> Vec2 {
+        match hit.primitive {
+            Primitive::Triangle(i) => {
+                triangle_uv(&self.description.triangles[i as usize], hit.uv.x, hit.uv.y)
+            }
+            Primitive::Sphere(_) | Primitive::Cylinder(_) => hit.uv,
+        }
+    }
+
+    /// The BSDF of `material` at `hit` (whose material it is), with its colour texture.
+    #[inline]
+    pub fn material_bsdf(&self, material: &Material, hit: &Hit) -> Bsdf {
+        match material.textures.as_deref().and_then(|t| t.color.as_ref()) {
+            None => Bsdf::new(material, hit),
+            Some(color) => {
+                let tint = color.color(self.texture_uv(hit));
+                Bsdf::tinted(material.kind, hit.shading_normal, hit.front_face, tint)
+            }
+        }
+    }
+
+    /// The colour by which a texture multiplies the material's scattering at `hit` (one when
+    /// untextured): what a hitpoint stores in its weight, so that the photon gather, which
+    /// evaluates the untextured material, gets the textured one.
+    #[inline]
+    pub fn scattering_tint(&self, hit: &Hit) -> Rgb {
+        match self
+            .material(hit.material)
+            .and_then(|m| m.textures.as_deref())
+            .and_then(|t| t.color.as_ref())
+        {
+            None => Rgb::ONE,
+            Some(color) => color.color(self.texture_uv(hit)),
+        }
+    }
+
+    /// The emission of `material` at `hit`, with its emission texture.
+    #[inline]
+    pub(super) fn textured_emission(&self, material: &Material, hit: &Hit) -> Rgb {
+        match material
+            .textures
+            .as_deref()
+            .and_then(|t| t.emission.as_ref())
+        {
+            None => material.emission,
+            Some(e) => material.emission * e.color(self.texture_uv(hit)),
+        }
+    }
+
+    /// Applies the material's normal map, if any, to the shading normal of a triangle hit.
+    ///
+    /// The tangent frame is the triangle's: T = ∂p/∂u made perpendicular to the interpolated
+    /// normal, B = −∂p/∂v (texture v grows downwards while a normal map's green axis points up
+    /// the image), on the side of N × T that ∂p/∂v says, so that mirrored texture coordinates
+    /// keep the map's handedness. A perturbed normal that would face away from the geometric
+    /// one is not used.
+    pub(super) fn apply_normal_map(&self, hit: &mut Hit) {
+        let Primitive::Triangle(i) = hit.primitive else {
+            return;
+        };
+        let tri = &self.description.triangles[i as usize];
+        let Some(map) = self
+            .material(hit.material)
+            .and_then(|m| m.textures.as_deref())
+            .and_then(|t| t.normal.as_ref())
+        else {
+            return;
+        };
+        let Some([uv0, uv1, uv2]) = tri.uv else {
+            return;
+        };
+        let [p0, p1, p2] = tri.positions;
+        let (duv02, duv12) = (uv0 - uv2, uv1 - uv2);
+        let (dp02, dp12) = (p0 - p2, p1 - p2);
+        let det = duv02.x * duv12.y - duv02.y * duv12.x;
+        if det == 0.0 || !det.is_finite() {
+            return;
+        }
+        let dpdu = (duv12.y * dp02 - duv02.y * dp12) / det;
+        let dpdv = (duv02.x * dp12 - duv12.x * dp02) / det;
+        // The interpolated normal on the front side: the map is in the surface's own frame.
+        let n = if hit.front_face {
+            hit.shading_normal
+        } else {
+            -hit.shading_normal
+        };
+        let Some(t) = (dpdu - n * n.dot(dpdu)).try_normalize() else {
+            return;
+        };
+        let b = n.cross(t);
+        let b = if b.dot(-dpdv) < 0.0 { -b } else { b };
+        let texel = map.texture.lookup(self.texture_uv(hit)).truncate() * 2.0 - Vec3::ONE;
+        let local = Vec3::new(texel.x * map.scale, texel.y * map.scale, texel.z);
+        let Some(mapped) = (local.x * t + local.y * b + local.z * n).try_normalize() else {
+            return;
+        };
+        let mapped = if hit.front_face { mapped } else { -mapped };
+        if mapped.dot(hit.geometric_normal) > 0.0 {
+            hit.shading_normal = mapped;
+        }
+    }
+
+    /// Whether triangle `index` is present at barycentrics (b1, b2) for `ray` (its material's
+    /// cut-out test; a blend cut-out decides by a hash of the ray, so that a ray meets the same
+    /// surface every time it is traced).
+    pub(super) fn covered(&self, ray: &Ray, index: u32, b1: f32, b2: f32) -> bool {
+        let tri = &self.description.triangles[index as usize];
+        let Some(textures) = self
+            .material(tri.material)
+            .and_then(|m| m.textures.as_deref())
+        else {
+            return true;
+        };
+        textures.opaque(triangle_uv(tri, b1, b2), ray_hash(ray, index))
+    }
+}
+
+/// Whether a material's textures cut its surface out anywhere.
+pub(super) fn has_cutout(textures: Option<&MaterialTextures>) -> bool {
+    textures.is_some_and(|t| t.alpha.is_some())
+}
+
+/// The texture coordinates of a triangle at barycentrics (b1, b2).
+#[inline]
+fn triangle_uv(tri: &crate::Triangle, b1: f32, b2: f32) -> Vec2 {
+    match tri.uv {
+        Some([uv0, uv1, uv2]) => (1.0 - b1 - b2) * uv0 + b1 * uv1 + b2 * uv2,
+        None => Vec2::new(b1, b2),
+    }
+}
+
+/// A number in [0, 1) that depends on the ray and the triangle only (a 64-bit mix of their
+/// bits), the random number of a stochastic cut-out.
+fn ray_hash(ray: &Ray, index: u32) -> f32 {
+    let mut h = u64::from(index) ^ 0x9e37_79b9_7f4a_7c15;
+    for v in [ray.origin, ray.direction] {
+        for c in v.to_array() {
+            h = (h ^ u64::from(c.to_bits())).wrapping_mul(0xff51_afd7_ed55_8ccd);
+            h ^= h >> 33;
+        }
+    }
+    h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+    h ^= h >> 33;
+    (h >> 40) as f32 / (1u64 << 24) as f32
+}

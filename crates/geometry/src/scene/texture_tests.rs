@@ -1,0 +1,216 @@
+//! Textures at hits: cut-outs for every query, textured emitters sampled without bias, the
+//! colour a hit reports, and normal maps in the triangle's frame.
+
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
+
+use crate::test_util::{description, diffuse, point_light, tri};
+use crate::texture::{Alpha, AlphaMode, MaterialTextures, NormalMap, TextureRef, Wrap, test_image};
+use crate::{Ray, Scene};
+
+/// A unit quad in the z = 0 plane facing +z, texture coordinates (0, 0) at its top-left
+/// (x = 0, y = 1) as an image lies, made of two triangles of material `material`.
+fn quad(material: u32) -> Vec<crate::Triangle> {
+    let (p00, p10, p11, p01) = (
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(1.0, 1.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+    );
+    let uv = |p: Vec3| Vec2::new(p.x, 1.0 - p.y);
+    let mut a = tri(p00, p10, p11, material);
+    a.uv = Some([uv(p00), uv(p10), uv(p11)]);
+    let mut b = tri(p00, p11, p01, material);
+    b.uv = Some([uv(p00), uv(p11), uv(p01)]);
+    vec![a, b]
+}
+
+/// Black on the left half of the image, white on the right, clamped at the edges.
+fn half_white(srgb: bool) -> TextureRef {
+    let image = test_image(2, 1, vec![[0, 0, 0, 0], [255, 255, 255, 255]]);
+    let mut t = TextureRef::new(image, srgb);
+    t.wrap = [Wrap::Clamp; 2];
+    t
+}
+
+fn with_textures(mut m: crate::Material, t: MaterialTextures) -> crate::Material {
+    m.textures = Some(Arc::new(t));
+    m
+}
+
+#[test]
+fn cutouts_let_every_query_through_their_holes() {
+    // A masked quad (alpha 0 on the left, 1 on the right, cutoff ½: the hole is x < ½) in front
+    // of a plain quad at z = −1.
+    let mut d = description(quad(2), Vec::new(), Vec::new());
+    let mut back = quad(0);
+    for t in &mut back {
+        t.positions = t.positions.map(|p| p - Vec3::Z);
+    }
+    d.triangles.extend(back);
+    d.triangles.extend(quad(1).into_iter().map(|mut t| {
+        t.positions = t.positions.map(|p| p + 3.0 * Vec3::Z);
+        t.normals = None;
+        t
+    }));
+    d.materials.push(with_textures(
+        diffuse(0.5, Vec3::ZERO),
+        MaterialTextures {
+            alpha: Some(Alpha {
+                texture: Some(half_white(false)),
+                factor: 1.0,
+                mode: AlphaMode::Mask { cutoff: 0.5 },
+            }),
+            ..Default::default()
+        },
+    ));
+    let scene = Scene::new(d).unwrap();
+    for (x, through) in [(0.2, true), (0.4, true), (0.6, false), (0.8, false)] {
+        let ray = Ray::infinite(Vec3::new(x, 0.5, 1.0), -Vec3::Z);
+        let hit = scene.intersect(&ray).unwrap();
+        let expected_t = if through { 2.0 } else { 1.0 };
+        assert!((hit.t - expected_t).abs() < 1e-5, "x = {x}: t = {}", hit.t);
+        assert_eq!(scene.intersect_inlined(&ray).map(|h| h.t), Some(hit.t));
+        // A shadow ray from in front of the mask to just before the back quad.
+        let shadow = Ray::new(Vec3::new(x, 0.5, 1.0), -Vec3::Z, 1.5);
+        assert_eq!(scene.occluded(&shadow), !through, "x = {x}");
+    }
+}
+
+#[test]
+fn blend_cutouts_keep_the_share_alpha_says_and_the_same_ray_decides_alike() {
+    // Alpha 0.25 everywhere in blend mode: about a quarter of the rays stop on the quad.
+    let mut d = description(
+        quad(2),
+        Vec::new(),
+        vec![point_light(Vec3::new(5.0, 5.0, 10.0))],
+    );
+    d.materials.push(with_textures(
+        diffuse(0.5, Vec3::ZERO),
+        MaterialTextures {
+            alpha: Some(Alpha {
+                texture: None,
+                factor: 0.25,
+                mode: AlphaMode::Blend,
+            }),
+            ..Default::default()
+        },
+    ));
+    let scene = Scene::new(d).unwrap();
+    let n = 4000;
+    let mut hits = 0;
+    for i in 0..n {
+        let x = (i as f32 + 0.5) / n as f32;
+        let ray = Ray::infinite(Vec3::new(x, 0.37, 1.0), Vec3::new(0.01, 0.0, -1.0));
+        let hit = scene.intersect(&ray).is_some();
+        assert_eq!(hit, scene.intersect(&ray).is_some());
+        assert_eq!(hit, scene.occluded(&ray));
+        hits += usize::from(hit);
+    }
+    let share = hits as f64 / f64::from(n);
+    // Binomial standard deviation √(0.25·0.75/4000) ≈ 0.007.
+    assert!((share - 0.25).abs() < 0.03, "{share}");
+}
+
+#[test]
+fn textured_emitter_emits_its_texture_without_bias() {
+    // The quad emits 2·texel; the texel's mean over the quad is ½ exactly (bilinear between
+    // black and white texel centres at u = ¼ and ¾, clamped: symmetric about u = ½), so the
+    // total flux is π·A·2·½ = π.
+    let mut d = description(quad(2), Vec::new(), Vec::new());
+    let mut lamp = diffuse(0.0, Vec3::splat(2.0));
+    lamp = with_textures(
+        lamp,
+        MaterialTextures {
+            emission: Some(half_white(false)),
+            ..Default::default()
+        },
+    );
+    d.materials.push(lamp);
+    let scene = Scene::new(d).unwrap();
+    let lights = scene.lights();
+    let n = 200_000;
+    let mut sum = Vec3::ZERO.as_dvec3();
+    let mut rng = crate::test_util::Rng::new(7);
+    for _ in 0..n {
+        if let Some(s) = lights.sample_emission(rng.f32(), rng.vec2(), rng.vec2()) {
+            sum += s.power.as_dvec3();
+            // Photons start only where the texture is not black (u = x > ¼).
+            assert!(s.origin.x > 0.25 - 1e-4, "{}", s.origin);
+        }
+    }
+    let mean = sum / f64::from(n);
+    let exact = std::f64::consts::PI;
+    assert!((mean.x / exact - 1.0).abs() < 0.01, "{mean} vs {exact}");
+    // A camera ray sees the texel.
+    let hit = scene
+        .intersect(&Ray::infinite(Vec3::new(0.75, 0.5, 1.0), -Vec3::Z))
+        .unwrap();
+    assert!((scene.emitted(&hit) - Vec3::splat(2.0)).length() < 1e-5);
+}
+
+#[test]
+fn colour_textures_tint_the_bsdf_and_the_hitpoint() {
+    let mut d = description(
+        quad(2),
+        Vec::new(),
+        vec![point_light(Vec3::new(5.0, 5.0, 10.0))],
+    );
+    d.materials.push(with_textures(
+        diffuse(0.5, Vec3::ZERO),
+        MaterialTextures {
+            color: Some(half_white(true)),
+            ..Default::default()
+        },
+    ));
+    let scene = Scene::new(d).unwrap();
+    for (x, texel) in [(0.1, 0.0), (0.9, 1.0)] {
+        let hit = scene
+            .intersect(&Ray::infinite(Vec3::new(x, 0.5, 1.0), -Vec3::Z))
+            .unwrap();
+        assert_eq!(scene.scattering_tint(&hit), Vec3::splat(texel));
+        let bsdf = scene.bsdf(&hit).unwrap();
+        let f = bsdf.eval(Vec3::Z, Vec3::new(0.0, 0.6, 0.8));
+        assert!((f.x - 0.5 * texel * std::f32::consts::FRAC_1_PI).abs() < 1e-6);
+    }
+}
+
+#[test]
+fn normal_maps_turn_the_shading_normal_in_the_texture_frame() {
+    // A map that tilts the normal toward +u (texel (1 + sin 30°)/2, ½, (1 + cos 30°)/2 in data
+    // terms): on the quad, +u is +x, so the shading normal tilts toward +x by about 30°.
+    let (s, c) = (30f32.to_radians().sin(), 30f32.to_radians().cos());
+    let byte = |v: f32| ((v * 0.5 + 0.5) * 255.0).round() as u8;
+    let image = test_image(1, 1, vec![[byte(s), byte(0.0), byte(c), 255]]);
+    let mut d = description(
+        quad(2),
+        Vec::new(),
+        vec![point_light(Vec3::new(5.0, 5.0, 10.0))],
+    );
+    d.materials.push(with_textures(
+        diffuse(0.5, Vec3::ZERO),
+        MaterialTextures {
+            normal: Some(NormalMap {
+                texture: TextureRef::new(image, false),
+                scale: 1.0,
+            }),
+            ..Default::default()
+        },
+    ));
+    let scene = Scene::new(d).unwrap();
+    let hit = scene
+        .intersect(&Ray::infinite(Vec3::new(0.3, 0.6, 1.0), -Vec3::Z))
+        .unwrap();
+    let n = hit.shading_normal;
+    assert!((n - Vec3::new(s, 0.0, c)).length() < 0.01, "{n}");
+    // From behind, the same tilt seen from the other side.
+    let back = scene
+        .intersect(&Ray::infinite(Vec3::new(0.3, 0.6, -1.0), Vec3::Z))
+        .unwrap();
+    assert!(
+        (back.shading_normal - Vec3::new(-s, 0.0, -c)).length() < 0.01,
+        "{}",
+        back.shading_normal
+    );
+}

@@ -1,0 +1,174 @@
+//! Reading image files into [`Image`]s, once per file.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use image::{DynamicImage, ImageFormat, ImageReader};
+
+use super::{Image, Texels};
+use crate::error::LoadError;
+
+/// Largest image accepted, in texels (a 8192 × 8192 image).
+pub(crate) const MAX_TEXELS: u64 = 64 << 20;
+
+/// The images a loader has read, by file: a texture used by several materials (or twice by
+/// one) is decoded once and shared.
+#[derive(Debug, Default)]
+pub(crate) struct TextureCache {
+    images: HashMap<PathBuf, Arc<Image>>,
+}
+
+/// The error naming `path`, its message on one line (decoders' messages may span several).
+fn texture_error(path: &Path, message: impl Into<String>) -> LoadError {
+    let message: String = message.into();
+    LoadError::Texture {
+        path: path.to_path_buf(),
+        message: message
+            .lines()
+            .map(str::trim)
+            .filter(|l| !l.is_empty())
+            .collect::<Vec<_>>()
+            .join("; "),
+    }
+}
+
+impl TextureCache {
+    /// The image in file `path`, read and decoded on first use.
+    ///
+    /// # Errors
+    /// [`LoadError::Texture`] naming the file when it is missing, unreadable, of an unsupported
+    /// format, corrupt, empty, too large or has NaN or infinite texels.
+    pub(crate) fn load(&mut self, path: &Path) -> Result<Arc<Image>, LoadError> {
+        if let Some(image) = self.images.get(path) {
+            return Ok(Arc::clone(image));
+        }
+        let bytes = std::fs::read(path).map_err(|e| {
+            texture_error(
+                path,
+                format!(
+                    "cannot read texture: {}",
+                    crate::error::lower_first(&e.to_string())
+                ),
+            )
+        })?;
+        let image = Arc::new(decode(path, &bytes)?);
+        self.images.insert(path.to_path_buf(), Arc::clone(&image));
+        Ok(image)
+    }
+
+    /// An image held in memory (a glTF buffer view), decoded once under the name `key`.
+    ///
+    /// # Errors
+    /// As [`TextureCache::load`], naming `key`.
+    pub(crate) fn load_bytes(&mut self, key: &Path, bytes: &[u8]) -> Result<Arc<Image>, LoadError> {
+        if let Some(image) = self.images.get(key) {
+            return Ok(Arc::clone(image));
+        }
+        let image = Arc::new(decode(key, bytes)?);
+        self.images.insert(key.to_path_buf(), Arc::clone(&image));
+        Ok(image)
+    }
+}
+
+/// Decodes an image file's bytes (PNG, JPEG, EXR, Radiance HDR, told apart by their contents).
+pub(crate) fn decode(path: &Path, bytes: &[u8]) -> Result<Image, LoadError> {
+    let reader = ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| texture_error(path, format!("cannot read texture: {e}")))?;
+    let format = match reader.format() {
+        Some(
+            f @ (ImageFormat::Png | ImageFormat::Jpeg | ImageFormat::OpenExr | ImageFormat::Hdr),
+        ) => f,
+        Some(other) => {
+            return Err(texture_error(
+                path,
+                format!(
+                    "unsupported texture format {} (expected png, jpeg, exr or hdr)",
+                    other.extensions_str().first().copied().unwrap_or("?")
+                ),
+            ));
+        }
+        None => {
+            return Err(texture_error(
+                path,
+                "unsupported texture format: not a png, jpeg, exr or hdr image",
+            ));
+        }
+    };
+    let corrupt = |e: image::ImageError| {
+        texture_error(
+            path,
+            format!(
+                "corrupt {} texture: {}",
+                format.extensions_str().first().copied().unwrap_or("image"),
+                crate::error::lower_first(&e.to_string())
+            ),
+        )
+    };
+    let (width, height) = reader.into_dimensions().map_err(corrupt)?;
+    if width == 0 || height == 0 {
+        return Err(texture_error(
+            path,
+            format!("texture has zero size ({width}x{height})"),
+        ));
+    }
+    if u64::from(width) * u64::from(height) > MAX_TEXELS {
+        return Err(texture_error(
+            path,
+            format!("texture of {width}x{height} texels is larger than the {MAX_TEXELS} accepted"),
+        ));
+    }
+    let img = image::load_from_memory_with_format(bytes, format).map_err(corrupt)?;
+    from_dynamic(path, img)
+}
+
+/// An [`Image`] from decoded pixels: 8-bit images keep their bytes, float images become linear
+/// RGBA floats (checked for NaN and infinities).
+pub(crate) fn from_dynamic(path: &Path, img: DynamicImage) -> Result<Image, LoadError> {
+    let (width, height) = (img.width(), img.height());
+    if width == 0 || height == 0 {
+        return Err(texture_error(
+            path,
+            format!("texture has zero size ({width}x{height})"),
+        ));
+    }
+    let alpha_channel = img.color().has_alpha();
+    let float = matches!(
+        img,
+        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
+    );
+    let texels = if float {
+        let rgba = img.into_rgba32f();
+        let texels: Vec<[f32; 4]> = rgba.pixels().map(|p| p.0).collect();
+        if let Some(i) = texels.iter().position(|t| !t.iter().all(|c| c.is_finite())) {
+            let (x, y) = (i as u32 % width, i as u32 / width);
+            let what = if texels[i].iter().any(|c| c.is_nan()) {
+                "nan"
+            } else {
+                "infinite"
+            };
+            return Err(texture_error(
+                path,
+                format!("texture has a {what} texel at ({x}, {y})"),
+            ));
+        }
+        Texels::Floats(texels)
+    } else {
+        Texels::Bytes(img.into_rgba8().pixels().map(|p| p.0).collect())
+    };
+    // An alpha channel counts when it masks something (some texel below ½): files whose mask
+    // is their grey channel often carry an all-but-opaque alpha channel as well.
+    let has_alpha = alpha_channel
+        && match &texels {
+            Texels::Bytes(t) => t.iter().any(|p| p[3] < 128),
+            Texels::Floats(t) => t.iter().any(|p| p[3] < 0.5),
+        };
+    Ok(Image {
+        path: path.to_path_buf(),
+        width,
+        height,
+        texels,
+        has_alpha,
+    })
+}

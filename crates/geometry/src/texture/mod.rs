@@ -1,0 +1,398 @@
+//! Image textures: decoded images shared by the materials that use them, and how a material
+//! uses one (colour or data, wrap modes, a texture-coordinate transform).
+//!
+//! Texture coordinates follow glTF and image files: (0, 0) is the top-left corner of the image,
+//! u grows to the right and v downwards. Loaders whose formats put v = 0 at the bottom (OBJ,
+//! pbrt, Mitsuba, our TOML) flip v when they read texture coordinates.
+//!
+//! Lookups are bilinear between texel centres (pbrt-v4's convention: texel (x, y) is centred
+//! on ((x + ½)/w, (y + ½)/h)). 8-bit images keep their bytes (4 per texel) and decode on
+//! lookup: through the sRGB curve where the texture is a colour and the file is 8-bit, linearly
+//! for data (normal maps, alpha) and always for the alpha channel. EXR and Radiance HDR images
+//! hold linear floats and are never sRGB-decoded.
+
+mod image_file;
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3, Vec4};
+
+pub(crate) use image_file::TextureCache;
+
+/// A decoded image, loaded once per file and shared by every material that uses it.
+#[derive(Clone)]
+pub struct Image {
+    path: PathBuf,
+    width: u32,
+    height: u32,
+    texels: Texels,
+    /// Whether the file has an alpha channel that masks something (some texel below ½);
+    /// otherwise a cut-out reads the first channel (a grey mask).
+    pub(crate) has_alpha: bool,
+}
+
+#[derive(Clone)]
+enum Texels {
+    /// 8-bit RGBA as stored in the file (sRGB-encoded or data).
+    Bytes(Vec<[u8; 4]>),
+    /// Linear RGBA floats (EXR, Radiance HDR).
+    Floats(Vec<[f32; 4]>),
+}
+
+impl std::fmt::Debug for Image {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Image")
+            .field("path", &self.path)
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .field("bytes", &self.memory())
+            .finish()
+    }
+}
+
+/// Two images are the same texture when they come from the same file.
+impl PartialEq for Image {
+    fn eq(&self, other: &Self) -> bool {
+        self.path == other.path
+    }
+}
+
+/// The sRGB transfer function, decoded, for each 8-bit value.
+fn srgb_table() -> &'static [f32; 256] {
+    static TABLE: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        let mut t = [0.0; 256];
+        for (i, v) in t.iter_mut().enumerate() {
+            let c = f64::from(i as u8) / 255.0;
+            *v = if c <= 0.04045 {
+                c / 12.92
+            } else {
+                ((c + 0.055) / 1.055).powf(2.4)
+            } as f32;
+        }
+        t
+    })
+}
+
+impl Image {
+    /// The file the image was read from.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Width and height in texels.
+    pub fn resolution(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// Bytes the decoded texels take in memory.
+    pub fn memory(&self) -> usize {
+        match &self.texels {
+            Texels::Bytes(t) => t.len() * 4,
+            Texels::Floats(t) => t.len() * 16,
+        }
+    }
+
+    /// Whether the texels are linear floats (EXR, HDR) rather than 8-bit values.
+    pub fn is_float(&self) -> bool {
+        matches!(self.texels, Texels::Floats(_))
+    }
+
+    /// Texel (x, y) (in range) as linear RGBA: colour channels of an 8-bit image through the
+    /// sRGB curve if `srgb`, else divided by 255.
+    #[inline]
+    fn texel(&self, x: u32, y: u32, srgb: bool) -> Vec4 {
+        let i = (y as usize) * (self.width as usize) + x as usize;
+        match &self.texels {
+            Texels::Bytes(t) => {
+                let [r, g, b, a] = t[i];
+                let alpha = f32::from(a) / 255.0;
+                if srgb {
+                    let lut = srgb_table();
+                    Vec4::new(lut[r as usize], lut[g as usize], lut[b as usize], alpha)
+                } else {
+                    Vec4::new(f32::from(r), f32::from(g), f32::from(b), f32::from(a)) / 255.0
+                }
+            }
+            Texels::Floats(t) => Vec4::from(t[i]),
+        }
+    }
+
+    /// Bilinear lookup at texture coordinates `uv` with the wrap modes of `wrap`.
+    fn bilinear(&self, uv: Vec2, wrap: [Wrap; 2], srgb: bool) -> Vec4 {
+        let x = uv.x * self.width as f32 - 0.5;
+        let y = uv.y * self.height as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        if !(fx.is_finite() && fy.is_finite()) {
+            return self.texel(0, 0, srgb);
+        }
+        let xs = [
+            wrap[0].index(x0 as i64, self.width),
+            wrap[0].index(x0 as i64 + 1, self.width),
+        ];
+        let ys = [
+            wrap[1].index(y0 as i64, self.height),
+            wrap[1].index(y0 as i64 + 1, self.height),
+        ];
+        let t = |i: usize, j: usize| self.texel(xs[i], ys[j], srgb);
+        (t(0, 0) * (1.0 - fx) + t(1, 0) * fx) * (1.0 - fy)
+            + (t(0, 1) * (1.0 - fx) + t(1, 1) * fx) * fy
+    }
+
+    /// The mean of the image's colour channels (linear, sRGB-decoded if `srgb`).
+    pub(crate) fn mean(&self, srgb: bool) -> Vec3 {
+        let mut sum = glam::DVec3::ZERO;
+        for y in 0..self.height {
+            for x in 0..self.width {
+                sum += self.texel(x, y, srgb).truncate().as_dvec3();
+            }
+        }
+        (sum / (f64::from(self.width) * f64::from(self.height))).as_vec3()
+    }
+}
+
+/// An 8-bit image held in memory, for tests (alpha counts as in a file).
+#[cfg(test)]
+pub(crate) fn test_image(width: u32, height: u32, texels: Vec<[u8; 4]>) -> Arc<Image> {
+    let has_alpha = texels.iter().any(|t| t[3] < 128);
+    Arc::new(Image {
+        path: PathBuf::from(format!("test-{width}x{height}.png")),
+        width,
+        height,
+        texels: Texels::Bytes(texels),
+        has_alpha,
+    })
+}
+
+/// What happens to texture coordinates outside [0, 1] (glTF's sampler wrap modes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Wrap {
+    /// Tile the image (glTF `REPEAT`, the default of glTF, OBJ and pbrt).
+    #[default]
+    Repeat,
+    /// Tile with every other copy mirrored (glTF `MIRRORED_REPEAT`).
+    Mirror,
+    /// Extend the edge texels (glTF `CLAMP_TO_EDGE`).
+    Clamp,
+}
+
+impl Wrap {
+    /// The texel index for the integer coordinate `i` on an axis of `n` texels.
+    #[inline]
+    fn index(self, i: i64, n: u32) -> u32 {
+        let n = i64::from(n);
+        let j = match self {
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::Clamp => i.clamp(0, n - 1),
+            Wrap::Mirror => {
+                let k = i.rem_euclid(2 * n);
+                if k < n { k } else { 2 * n - 1 - k }
+            }
+        };
+        j as u32
+    }
+}
+
+/// How a material uses an image: the image, whether it is a colour (sRGB-decoded when 8-bit),
+/// the wrap modes and an affine transform of the texture coordinates (glTF
+/// `KHR_texture_transform`, OBJ `-o`/`-s`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TextureRef {
+    /// The shared image.
+    pub image: Arc<Image>,
+    /// Whether the texels are colours: 8-bit colour channels then go through the sRGB curve.
+    pub srgb: bool,
+    /// Wrap modes along u and v.
+    pub wrap: [Wrap; 2],
+    /// `uv' = [a b; c d]·uv + (e, f)`, stored as (a, b, c, d, e, f); the identity by default.
+    pub transform: [f32; 6],
+}
+
+impl TextureRef {
+    /// The identity texture-coordinate transform.
+    pub const IDENTITY: [f32; 6] = [1.0, 0.0, 0.0, 1.0, 0.0, 0.0];
+
+    /// A texture with repeat wrapping and no transform.
+    pub fn new(image: Arc<Image>, srgb: bool) -> Self {
+        Self {
+            image,
+            srgb,
+            wrap: [Wrap::Repeat; 2],
+            transform: Self::IDENTITY,
+        }
+    }
+
+    /// Linear RGBA at texture coordinates `uv`.
+    #[inline]
+    pub fn lookup(&self, uv: Vec2) -> Vec4 {
+        let [a, b, c, d, e, f] = self.transform;
+        let uv = Vec2::new(a * uv.x + b * uv.y + e, c * uv.x + d * uv.y + f);
+        self.image.bilinear(uv, self.wrap, self.srgb)
+    }
+
+    /// The colour at `uv`.
+    #[inline]
+    pub fn color(&self, uv: Vec2) -> Vec3 {
+        self.lookup(uv).truncate()
+    }
+
+    /// The alpha at `uv`: the alpha channel if the image has one that masks something, else
+    /// its first channel (a grey mask, as OBJ `map_d` files and Mitsuba's opacity maps are).
+    #[inline]
+    pub fn alpha(&self, uv: Vec2) -> f32 {
+        let v = self.lookup(uv);
+        if self.image.has_alpha { v.w } else { v.x }
+    }
+}
+
+/// How a material's coverage is tested: glTF `MASK` (opaque where alpha ≥ cutoff) or `BLEND`
+/// (taken as a stochastic cut-out: opaque with probability alpha).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AlphaMode {
+    /// Opaque where alpha ≥ the cutoff, absent elsewhere.
+    Mask {
+        /// glTF `alphaCutoff` (0.5 by default).
+        cutoff: f32,
+    },
+    /// Opaque with probability alpha, decided by a hash of the ray.
+    Blend,
+}
+
+/// A material's cut-out: alpha = `factor` × the texture's alpha (1 without a texture).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Alpha {
+    /// The alpha texture, if any.
+    pub texture: Option<TextureRef>,
+    /// Constant factor (glTF base colour factor's alpha).
+    pub factor: f32,
+    /// The test.
+    pub mode: AlphaMode,
+}
+
+/// A tangent-space normal map (glTF `normalTexture`, OBJ `norm`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NormalMap {
+    /// The map (read as data: n = 2·texel − 1).
+    pub texture: TextureRef,
+    /// glTF `scale`: multiplies the tangent-plane components.
+    pub scale: f32,
+}
+
+/// The textures of one material. Every colour texture multiplies what the material would do
+/// without it (see `docs/scene-format-extensions.md`, "Textures").
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MaterialTextures {
+    /// Multiplies the material's scattering (diffuse albedo, mirror reflectance, the whole
+    /// glossy BSDF); dielectrics ignore it.
+    pub color: Option<TextureRef>,
+    /// Multiplies the emitted radiance.
+    pub emission: Option<TextureRef>,
+    /// Perturbs the shading normal.
+    pub normal: Option<NormalMap>,
+    /// Cuts the surface out where it is transparent.
+    pub alpha: Option<Alpha>,
+}
+
+impl MaterialTextures {
+    /// Whether nothing is textured.
+    pub fn is_empty(&self) -> bool {
+        self.color.is_none()
+            && self.emission.is_none()
+            && self.normal.is_none()
+            && self.alpha.is_none()
+    }
+
+    /// What the textures modulate, for reports: `color`, `emission`, `normal`, `alpha` (an
+    /// alpha without a texture is a constant cut-out and counts too).
+    pub fn uses(&self) -> Vec<&'static str> {
+        [
+            (self.color.is_some(), "color"),
+            (self.emission.is_some(), "emission"),
+            (self.normal.is_some(), "normal"),
+            (self.alpha.is_some(), "alpha"),
+        ]
+        .into_iter()
+        .filter_map(|(used, name)| used.then_some(name))
+        .collect()
+    }
+
+    /// Every texture reference, for reports.
+    pub fn references(&self) -> impl Iterator<Item = &TextureRef> {
+        self.color
+            .iter()
+            .chain(&self.emission)
+            .chain(self.normal.iter().map(|n| &n.texture))
+            .chain(self.alpha.iter().filter_map(|a| a.texture.as_ref()))
+    }
+
+    /// Whether the surface is present at `uv` for a ray whose hash (uniform in [0, 1)) is `u`.
+    #[inline]
+    pub(crate) fn opaque(&self, uv: Vec2, u: f32) -> bool {
+        let Some(alpha) = &self.alpha else {
+            return true;
+        };
+        let a = alpha.factor * alpha.texture.as_ref().map_or(1.0, |t| t.alpha(uv));
+        match alpha.mode {
+            AlphaMode::Mask { cutoff } => a >= cutoff,
+            AlphaMode::Blend => u < a,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
+
+/// One image in a [`crate::SceneSummary`]: its file name, resolution, memory and uses.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct TextureSummary {
+    /// The image's file name (without its directory, so that snapshots do not depend on where
+    /// the scene lies).
+    pub file: String,
+    /// Width and height in texels.
+    pub resolution: [u32; 2],
+    /// Bytes of the decoded texels.
+    pub bytes: usize,
+    /// How materials use it: `color`, `emission`, `normal`, `alpha`.
+    pub uses: Vec<&'static str>,
+}
+
+/// Every image the materials of `materials` use, once each, in order of first use.
+pub(crate) fn summarize(materials: &[crate::Material]) -> Vec<TextureSummary> {
+    let mut out: Vec<(Arc<Image>, TextureSummary)> = Vec::new();
+    for t in materials.iter().filter_map(|m| m.textures.as_deref()) {
+        let uses = [
+            (t.color.as_ref(), "color"),
+            (t.emission.as_ref(), "emission"),
+            (t.normal.as_ref().map(|n| &n.texture), "normal"),
+            (t.alpha.as_ref().and_then(|a| a.texture.as_ref()), "alpha"),
+        ];
+        for (texture, what) in uses {
+            let Some(texture) = texture else { continue };
+            let entry = match out.iter().position(|(i, _)| Arc::ptr_eq(i, &texture.image)) {
+                Some(i) => &mut out[i].1,
+                None => {
+                    let image = &texture.image;
+                    out.push((
+                        Arc::clone(image),
+                        TextureSummary {
+                            file: image.path.file_name().map_or_else(
+                                || image.path.display().to_string(),
+                                |n| n.to_string_lossy().into_owned(),
+                            ),
+                            resolution: [image.width, image.height],
+                            bytes: image.memory(),
+                            uses: Vec::new(),
+                        },
+                    ));
+                    &mut out.last_mut().expect("just pushed").1
+                }
+            };
+            if !entry.uses.contains(&what) {
+                entry.uses.push(what);
+            }
+        }
+    }
+    out.into_iter().map(|(_, s)| s).collect()
+}
