@@ -90,9 +90,9 @@ pub struct Hit {
     pub curvature: f32,
     /// The primitive that was hit.
     pub primitive: Primitive,
-    /// Triangle barycentrics (b1, b2) of the hit (b0 = 1 − b1 − b2); for spheres (φ/2π, θ/π) about +z;
-    /// for cylinders (position across the kept arc from 0 to 1, counter-clockwise about the axis;
-    /// height / `height`).
+    /// Triangle barycentrics (b1, b2) of the hit (b0 = 1 − b1 − b2); for cylinders (position
+    /// across the kept arc from 0 to 1, counter-clockwise about the axis; height / `height`);
+    /// zero for spheres, whose (φ/2π, θ/π) `Scene::texture_uv` computes when a texture asks.
     pub uv: Vec2,
 }
 

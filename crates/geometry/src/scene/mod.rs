@@ -403,8 +403,6 @@ impl Scene {
         } else {
             (-outward, 1.0 / s.radius)
         };
-        let phi = outward.y.atan2(outward.x).rem_euclid(std::f32::consts::TAU);
-        let theta = outward.z.clamp(-1.0, 1.0).acos();
         Hit {
             t,
             position,
@@ -415,7 +413,8 @@ impl Scene {
             material: s.material,
             curvature,
             primitive: Primitive::Sphere(index),
-            uv: Vec2::new(phi / std::f32::consts::TAU, theta / std::f32::consts::PI),
+            // Computed from the position when a texture asks (`Scene::texture_uv`).
+            uv: Vec2::ZERO,
         }
     }
 
