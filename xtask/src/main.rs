@@ -5,11 +5,13 @@
 //! - `converge`: error versus time of every method on one scene (CSV, SVG plots, masks, maps).
 //! - `docs-image`: renders the CLI's default scene for `docs/default-scene.png`.
 //! - `peers`: equal-time comparison with Mitsuba 3 against pixel-averaged references.
+//! - `fuzz`: runs the cargo-fuzz targets of `fuzz/` and reports executions and crashes.
 
 #![allow(clippy::print_stdout, clippy::print_stderr, clippy::unwrap_used)]
 
 mod converge;
 mod docs_image;
+mod fuzz;
 mod peers;
 mod render_all;
 mod suite;
@@ -26,7 +28,8 @@ commands:
   render-all   golden-image check of every scene of tests/scenes.toml (see `render-all --help`)
   converge     error-versus-time study of one scene (see `converge --help`)
   docs-image   render docs/default-scene.png with the fppm binary
-  peers        equal-time comparison with Mitsuba 3 (see `peers --help`)";
+  peers        equal-time comparison with Mitsuba 3 (see `peers --help`)
+  fuzz         run the fuzz targets (nightly, cargo-fuzz; see `fuzz --help`)";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -41,6 +44,7 @@ fn main() -> ExitCode {
             "converge" => converge::HELP,
             "docs-image" => docs_image::HELP,
             "peers" => peers::HELP,
+            "fuzz" => fuzz::HELP,
             _ => HELP,
         };
         println!("{help}");
@@ -56,6 +60,7 @@ fn main() -> ExitCode {
         "converge" => converge::run(&root, rest),
         "docs-image" => docs_image::run(&root, rest),
         "peers" => peers::run(&root, rest),
+        "fuzz" => fuzz::run(&root, rest),
         other => {
             eprintln!("xtask: unknown command `{other}`\n\n{HELP}");
             return ExitCode::from(2);

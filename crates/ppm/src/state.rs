@@ -298,6 +298,10 @@ fn read_photon_mapper(
             return Err(StateError::Corrupt);
         }
         let radius = r.f64()?;
+        // Every slot of a saved renderer has a positive radius (the update rule divides by it).
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(StateError::Corrupt);
+        }
         let photon_count = r.f64()?;
         let flux = [r.f64()?, r.f64()?, r.f64()?];
         let has_freq = r.bool()?;

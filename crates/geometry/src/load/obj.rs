@@ -245,7 +245,7 @@ fn line_number(index: usize) -> u32 {
 
 /// Reads and checks an MTL file. `Ok(None)` if it does not exist.
 fn read_mtl(path: &Path) -> Result<Option<tobj::MTLLoadResult>, LoadError> {
-    let bytes = match std::fs::read(path) {
+    let bytes = match super::files::read(path) {
         Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         Err(source) => {

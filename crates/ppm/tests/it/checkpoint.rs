@@ -74,3 +74,48 @@ fn checkpoints_of_another_scene_version_or_corrupt_bytes_are_refused() {
         Err(StateError::Version { .. })
     ));
 }
+
+/// FNV-1a (64-bit), the checksum that ends a checkpoint, written from its definition.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |hash, &b| {
+        (hash ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+/// Found by the `checkpoint` fuzz target: a checkpoint whose checksum is right but whose slot
+/// radius is zero was restored, and the next pass's update rule failed its assertion (in a
+/// release build it divides by R² = 0). It is refused as corrupt.
+#[test]
+fn checkpoint_with_a_zero_radius_is_refused() {
+    let scene = cornell("CornellBox-Sphere.obj", 4, 4);
+    let mut p = params(Method::Ppm, 1);
+    // A radius no computation produces, to find the slots' radii in the bytes: the parameters
+    // store it first, then every slot that no photon reached still has it.
+    let radius = 0.012_345_678_9_f64;
+    p.initial_radius = Some(radius);
+    let mut renderer = Renderer::new(&scene, p).unwrap();
+    renderer.iterate();
+    let mut bytes = renderer.save_state("");
+    let pattern = radius.to_le_bytes();
+    let at: Vec<usize> = bytes
+        .windows(8)
+        .enumerate()
+        .filter(|(_, w)| *w == pattern)
+        .map(|(i, _)| i)
+        .collect();
+    assert!(
+        at.len() >= 2,
+        "the initial radius is stored and kept by a slot"
+    );
+    bytes[at[1]..at[1] + 8].copy_from_slice(&0.0f64.to_le_bytes());
+    let end = bytes.len() - 8;
+    let checksum = fnv1a(&bytes[..end]);
+    bytes[end..].copy_from_slice(&checksum.to_le_bytes());
+    match Renderer::restore(&scene, &bytes) {
+        Err(e) => assert_eq!(e, StateError::Corrupt),
+        Ok(mut restored) => {
+            restored.iterate();
+            panic!("a zero radius was restored and rendered");
+        }
+    }
+}
