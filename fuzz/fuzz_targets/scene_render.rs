@@ -4,7 +4,7 @@
 //! must render without panicking or hanging.
 #![no_main]
 
-use arbitrary::Arbitrary;
+use arbitrary::{Arbitrary, Unstructured};
 use geometry::{
     Camera, Cylinder, Film, Light, LoadNotes, Material, MaterialKind, RenderDefaults,
     SceneDescription, Sphere, Triangle,
@@ -13,12 +13,40 @@ use glam::Vec3;
 use libfuzzer_sys::fuzz_target;
 use ppm::{FrequencyFloor, MergePolicy, Method, RenderParams, Renderer};
 
+/// A float as the fuzzer picks it: mostly a small multiple of 1/16 (so that many scenes are
+/// valid and reach the integrators), sometimes a special value (zero, ±0, tiny, huge, NaN,
+/// infinities), sometimes any bit pattern.
+#[derive(Clone, Copy, Debug)]
+struct F(f32);
+
+impl<'a> Arbitrary<'a> for F {
+    fn arbitrary(u: &mut Unstructured<'a>) -> arbitrary::Result<Self> {
+        const SPECIAL: [f32; 10] = [
+            0.0,
+            -0.0,
+            1e-30,
+            1e-7,
+            1e7,
+            1e30,
+            f32::MAX,
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ];
+        Ok(F(match u.int_in_range(0u8..=9)? {
+            0 => f32::from_bits(u.arbitrary()?),
+            1 => *u.choose(&SPECIAL)?,
+            _ => f32::from(u.arbitrary::<i8>()?) / 16.0,
+        }))
+    }
+}
+
 #[derive(Arbitrary, Debug)]
-struct V([f32; 3]);
+struct V([F; 3]);
 
 impl V {
     fn get(&self) -> Vec3 {
-        Vec3::from_array(self.0)
+        Vec3::new(self.0[0].0, self.0[1].0, self.0[2].0)
     }
 }
 
@@ -26,8 +54,8 @@ impl V {
 enum Kind {
     Diffuse(V),
     Mirror(V),
-    Dielectric(f32),
-    Glossy(V, f32, V),
+    Dielectric(F),
+    Glossy(V, F, V),
 }
 
 #[derive(Arbitrary, Debug)]
@@ -39,20 +67,20 @@ struct Mat {
 #[derive(Arbitrary, Debug)]
 enum Shape {
     Triangle([V; 3], Option<[V; 3]>, u8),
-    Sphere(V, f32, u8),
-    Cylinder(V, V, f32, f32, f32, V, u8),
+    Sphere(V, F, u8),
+    Cylinder(V, V, F, F, F, V, u8),
 }
 
 #[derive(Arbitrary, Debug)]
 enum Lamp {
     Point(V, V),
-    Spot(V, V, V, f32, f32),
+    Spot(V, V, V, F, F),
     Directional(V, V),
 }
 
 #[derive(Arbitrary, Debug)]
 struct Input {
-    camera: (V, V, V, f32, f32, f32),
+    camera: (V, V, V, F, F, F),
     film: (u8, u8),
     materials: Vec<Mat>,
     shapes: Vec<Shape>,
@@ -76,10 +104,10 @@ fn material(m: &Mat, i: usize) -> Material {
         Kind::Mirror(r) => MaterialKind::Mirror {
             reflectance: r.get(),
         },
-        Kind::Dielectric(ior) => MaterialKind::Dielectric { ior: *ior },
+        Kind::Dielectric(ior) => MaterialKind::Dielectric { ior: ior.0 },
         Kind::Glossy(r, roughness, d) => MaterialKind::Glossy {
             reflectance: r.get(),
-            roughness: *roughness,
+            roughness: roughness.0,
             diffuse: d.get(),
         },
     };
@@ -98,9 +126,9 @@ fn description(input: &Input) -> SceneDescription {
             position: position.get(),
             look_at: look_at.get(),
             up: up.get(),
-            fov_y: *fov_y,
-            aperture_radius: *aperture_radius,
-            focus_distance: *focus_distance,
+            fov_y: fov_y.0 * 8.0,
+            aperture_radius: aperture_radius.0,
+            focus_distance: focus_distance.0,
         },
         film: Film {
             width: u32::from(input.film.0 % 8) + 1,
@@ -129,16 +157,16 @@ fn description(input: &Input) -> SceneDescription {
             }),
             Shape::Sphere(c, r, m) => d.spheres.push(Sphere {
                 center: c.get(),
-                radius: *r,
+                radius: r.0,
                 material: u32::from(*m % 5),
             }),
             Shape::Cylinder(c, axis, radius, height, arc, facing, m) => {
                 d.cylinders.push(Cylinder {
                     center: c.get(),
                     axis: axis.get(),
-                    radius: *radius,
-                    height: *height,
-                    arc: *arc,
+                    radius: radius.0,
+                    height: height.0,
+                    arc: arc.0,
                     facing: facing.get(),
                     material: u32::from(*m % 5),
                 });
@@ -155,8 +183,8 @@ fn description(input: &Input) -> SceneDescription {
                 position: p.get(),
                 direction: dir.get(),
                 intensity: i.get(),
-                cone_angle: *cone,
-                falloff_start: *falloff,
+                cone_angle: cone.0,
+                falloff_start: falloff.0,
             },
             Lamp::Directional(dir, e) => Light::Directional {
                 direction: dir.get(),

@@ -8,6 +8,12 @@ use std::process::{Command, Stdio};
 
 use anyhow::{Context, Result, bail};
 
+/// The fuzz harness's stubs and checkpoint framing, shared with the targets so that the seeds
+/// match what the `checkpoint` target takes and the normal test suite checks the stubs.
+#[allow(unreachable_pub, dead_code)]
+#[path = "../../fuzz/src/harness.rs"]
+mod harness;
+
 pub(crate) const HELP: &str = "\
 cargo xtask fuzz [--seconds N] [--runs N] [--target T]... [--asan] [--skip-missing] [--list]
 
@@ -403,7 +409,7 @@ mod seeds {
                 seeds.insert("tiny.exr".to_owned(), tiny_exr(root)?);
             }
             "checkpoint" => {
-                for (name, bytes) in checkpoints(root)? {
+                for (name, bytes) in checkpoints()? {
                     seeds.insert(name, bytes);
                 }
             }
@@ -482,11 +488,8 @@ mod seeds {
 
     /// Bodies of checkpoints of the checkpoint target's scene (what the target takes: without
     /// the header and the checksum it writes itself), one per method, after one and two passes.
-    fn checkpoints(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
-        const HEADER: usize = 8 + 4 + 8;
-        let scene_path = root.join("fuzz/seeds/checkpoint_scene.toml");
-        let description = geometry::load(&scene_path)?;
-        let scene = geometry::Scene::new(description)?;
+    pub(super) fn checkpoints() -> Result<Vec<(String, Vec<u8>)>> {
+        let scene = harness::checkpoint_scene();
         let mut out = Vec::new();
         for method in ppm::Method::ALL {
             let mut params = ppm::RenderParams::preview();
@@ -497,7 +500,7 @@ mod seeds {
             for pass in 1..=2 {
                 renderer.iterate();
                 let saved = renderer.save_state("seed");
-                let body = saved[HEADER..saved.len() - 8].to_vec();
+                let body = harness::checkpoint_body(&saved).to_vec();
                 out.push((format!("{}-{pass}", method.name()), body));
             }
         }
@@ -507,7 +510,58 @@ mod seeds {
 
 #[cfg(test)]
 mod tests {
-    use super::parse_stats;
+    use geometry::{LoadOptions, load_from};
+
+    use super::{harness, parse_stats, seeds};
+
+    /// The stubs the fuzz targets serve are real files: a harness serving broken stubs would
+    /// only ever fuzz error paths.
+    #[test]
+    fn the_fuzz_stubs_load() {
+        let toml = "format = 1\n[[shapes]]\ntype = \"mesh\"\nfile = \"a.obj\"\n\
+                    [[shapes]]\ntype = \"mesh\"\nfile = \"b.gltf\"\n";
+        let path = harness::fuzzed("scene.toml");
+        let files = harness::with_stubs(path.clone(), toml.into());
+        let d = load_from(&path, files, &LoadOptions::default()).unwrap();
+        assert_eq!(
+            d.triangles.len(),
+            2 + 1,
+            "the OBJ quad and the glTF triangle"
+        );
+        assert_eq!(
+            d.materials
+                .iter()
+                .filter(|m| m.emission.max_element() > 0.0)
+                .count(),
+            1
+        );
+
+        let path = harness::fuzzed("scene.pbrt");
+        let files = harness::with_stubs(path.clone(), harness::PLY_SCENE.into());
+        let d = load_from(&path, files, &LoadOptions::default()).unwrap();
+        assert_eq!((d.triangles.len(), d.lights.len()), (1, 1));
+
+        let xml = r#"<scene version="3.0.0"><shape type="ply"><string name="filename" value="m.ply"/></shape></scene>"#;
+        let path = harness::fuzzed("scene.xml");
+        let files = harness::with_stubs(path.clone(), xml.into());
+        let d = load_from(&path, files, &LoadOptions::allow_no_emitter()).unwrap();
+        assert_eq!(d.triangles.len(), 1);
+        assert!(harness::split_nul(b"obj\0mtl") == (&b"obj"[..], &b"mtl"[..]));
+    }
+
+    /// The checkpoint seeds, framed again by the harness, are the checkpoints that were saved,
+    /// and restore.
+    #[test]
+    fn checkpoint_seeds_restore_through_the_harness_framing() {
+        let scene = harness::checkpoint_scene();
+        let seeds = seeds::checkpoints().unwrap();
+        assert_eq!(seeds.len(), 2 * ppm::Method::ALL.len());
+        for (name, body) in &seeds {
+            let bytes = harness::checkpoint_bytes(&scene, body);
+            let restored = ppm::Renderer::restore(&scene, &bytes);
+            assert!(restored.is_ok(), "{name}: {:?}", restored.err());
+        }
+    }
 
     /// The end of a real libFuzzer run (the toml_scene target, 10 s).
     #[test]
