@@ -176,3 +176,26 @@ fn gltf_float_indices_are_an_error() {
         "accessor 1 (indices) is Scalar of F32",
     );
 }
+
+/// Found by the `ply` fuzz target: a binary PLY declaring 2 222 222 222 records of an element
+/// without properties passed the size check (zero bytes each) and kept the parser busy for
+/// minutes; such records now count one byte each against the file's size.
+#[test]
+fn ply_with_billions_of_empty_records_is_refused() {
+    let scene = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+                 Shape \"plymesh\" \"string filename\" [ \"m.ply\" ]\n";
+    let mut ply =
+        b"ply\nformat binary_little_endian 1.0\nelement vertexce 2222222222\nend_header\n".to_vec();
+    ply.extend_from_slice(&[0x79, 0, 0x32, 0x32]);
+    let files = MemoryFiles::new()
+        .with("/mem/s.pbrt", scene)
+        .with("/mem/m.ply", ply);
+    let err = load_memory("/mem/s.pbrt", files).unwrap_err();
+    // The pbrt loader reports it at the Shape line, with the PLY file's own message.
+    assert!(matches!(err, LoadError::Pbrt { line: Some(4), .. }), "{err:?}");
+    assert_names_file(&err, Path::new("/mem/s.pbrt"));
+    assert!(
+        err.to_string().contains("declares 2222222222 vertexce"),
+        "{err}"
+    );
+}
