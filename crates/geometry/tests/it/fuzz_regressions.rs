@@ -192,10 +192,50 @@ fn ply_with_billions_of_empty_records_is_refused() {
         .with("/mem/m.ply", ply);
     let err = load_memory("/mem/s.pbrt", files).unwrap_err();
     // The pbrt loader reports it at the Shape line, with the PLY file's own message.
-    assert!(matches!(err, LoadError::Pbrt { line: Some(4), .. }), "{err:?}");
+    assert!(
+        matches!(err, LoadError::Pbrt { line: Some(4), .. }),
+        "{err:?}"
+    );
     assert_names_file(&err, Path::new("/mem/s.pbrt"));
     assert!(
         err.to_string().contains("declares 2222222222 vertexce"),
         "{err}"
     );
+}
+
+/// Found by the `obj` fuzz target: the relative texture index `-12` with four `vt` defined made
+/// tobj 4.0.5 wrap the offset around and overflow when scaling it (`lib.rs:852`).
+#[test]
+fn obj_relative_index_before_the_first_element_is_an_error() {
+    let obj = "v -1.0 -1.0  0.0\nv  1.0 0  0.0\nv  1.0  1.0  0.0\n\nvt0 1.0\nvt 0.0 0.0\n\
+               vt 0.0 1.0\nvt 1.0 0.0\n\nf 2/1 3/-12 1/3\nf 2/1 6/4 3/2";
+    let files = MemoryFiles::new().with("/mem/a.obj", obj);
+    let err = load_memory("/mem/a.obj", files).unwrap_err();
+    assert!(
+        matches!(err, LoadError::Obj { line: Some(10), .. }),
+        "{err:?}"
+    );
+    assert_names_file(&err, Path::new("/mem/a.obj"));
+    assert!(
+        err.to_string()
+            .contains("relative texture coordinate index -12, but only 3 are defined"),
+        "{err}"
+    );
+    // Index 0 and indices beyond the file's count are refused the same way.
+    for (face, needle) in [
+        ("f 1/1 2/2 3/0", "texture coordinate index 0"),
+        (
+            "f 1/1 2/2 3/9",
+            "texture coordinate index 9, but the file defines 3",
+        ),
+        (
+            "f 1//-2 2//1 3//1",
+            "relative normal index -2, but only 1 are defined",
+        ),
+    ] {
+        let obj = format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\n{face}\n");
+        let files = MemoryFiles::new().with("/mem/b.obj", obj);
+        let err = load_memory("/mem/b.obj", files).unwrap_err();
+        assert!(err.to_string().contains(needle), "{face}: {err}");
+    }
 }
