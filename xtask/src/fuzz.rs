@@ -15,7 +15,7 @@ use anyhow::{Context, Result, bail};
 mod harness;
 
 pub(crate) const HELP: &str = "\
-cargo xtask fuzz [--seconds N] [--runs N] [--target T]... [--asan] [--skip-missing] [--list]
+cargo xtask fuzz [--seconds N] [--runs N] [--target T]... [--asan] [--dev] [--skip-missing] [--list]
 
 Runs the fuzz targets of fuzz/ (cargo-fuzz, libFuzzer) one after the other, one process each,
 and prints per target the executions, executions per second, coverage (libFuzzer's `cov` and
@@ -33,6 +33,8 @@ Exit status 1 if a target crashed.
   --target T       run only T (repeatable); default all
   --asan           build with AddressSanitizer (default: no sanitizer, about twice as fast;
                    the code under test is safe Rust, and debug assertions stay on)
+  --dev            build the targets in the dev profile: quicker to build from cold, much slower
+                   to run (for the CI smoke)
   --skip-missing   if nightly or cargo-fuzz is missing, say so and exit 0 (for CI)
   --list           print the targets and exit";
 
@@ -58,6 +60,7 @@ struct Flags {
     runs: Option<u64>,
     targets: Vec<String>,
     asan: bool,
+    dev: bool,
     skip_missing: bool,
     list: bool,
 }
@@ -69,6 +72,7 @@ impl Flags {
             runs: None,
             targets: Vec::new(),
             asan: false,
+            dev: false,
             skip_missing: false,
             list: false,
         };
@@ -99,6 +103,7 @@ impl Flags {
                     flags.targets.push(t.clone());
                 }
                 "--asan" => flags.asan = true,
+                "--dev" => flags.dev = true,
                 "--skip-missing" => flags.skip_missing = true,
                 "--list" => flags.list = true,
                 other => bail!("fuzz: unknown flag `{other}`\n\n{HELP}"),
@@ -200,10 +205,18 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
     }
 
     let sanitizer = if flags.asan { "address" } else { "none" };
-    println!("fuzz: building the targets (cargo +nightly fuzz build -s {sanitizer})");
+    let mut build_flags = vec!["-s", sanitizer];
+    if flags.dev {
+        build_flags.push("--dev");
+    }
+    println!(
+        "fuzz: building the targets (cargo +nightly fuzz build {})",
+        build_flags.join(" ")
+    );
     let status = Command::new("cargo")
         .current_dir(&fuzz_dir)
-        .args(["+nightly", "fuzz", "build", "-s", sanitizer])
+        .args(["+nightly", "fuzz", "build"])
+        .args(&build_flags)
         .status()
         .context("running cargo +nightly fuzz build")?;
     if !status.success() {
@@ -219,7 +232,9 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         let mut command = Command::new("cargo");
         command
             .current_dir(&fuzz_dir)
-            .args(["+nightly", "fuzz", "run", "-s", sanitizer, name])
+            .args(["+nightly", "fuzz", "run"])
+            .args(&build_flags)
+            .arg(name)
             .arg(&corpus)
             .arg(seeds_dir.join(name))
             .arg("--")
@@ -268,8 +283,9 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         Ok(true)
     } else {
         println!(
-            "fuzz: {} crashed; reproduce with `cd fuzz && cargo +nightly fuzz run -s {sanitizer} <target> <artifact>`",
-            crashed.join(", ")
+            "fuzz: {} crashed; reproduce with `cd fuzz && cargo +nightly fuzz run {} <target> <artifact>`",
+            crashed.join(", "),
+            build_flags.join(" ")
         );
         Ok(false)
     }
