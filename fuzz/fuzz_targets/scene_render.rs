@@ -90,12 +90,14 @@ struct Input {
     max_depth: u8,
     two_passes: bool,
     seed: u64,
-    alpha: f64,
-    freq_fraction: f64,
-    kernel_k: f64,
-    freq_grow: f64,
+    alpha: u8,
+    freq_fraction: u8,
+    kernel_k: u8,
+    freq_grow: u8,
     freq_pilot: u8,
     options: u8,
+    /// Sometimes one parameter gets any value at all: `Renderer::new` must refuse it or run.
+    wild: Option<(u8, f64)>,
 }
 
 fn material(m: &Mat, i: usize) -> Material {
@@ -201,11 +203,20 @@ fn params(input: &Input) -> RenderParams {
     p.photons_per_pass = u32::from(input.photons % 64) + 1;
     p.max_depth = u32::from(input.max_depth % 12);
     p.seed = input.seed;
-    // Parameters the fuzzer may set freely: `Renderer::new` must refuse what is out of range.
-    p.alpha = input.alpha;
-    p.freq_fraction = input.freq_fraction;
-    p.kernel_k = input.kernel_k;
-    p.freq_grow = input.freq_grow;
+    // Mostly in range, so that passes run; 0 is out of range for α and K.
+    p.alpha = f64::from(input.alpha) / 255.0;
+    p.freq_fraction = f64::from(input.freq_fraction) / 255.0;
+    p.kernel_k = f64::from(input.kernel_k) / 32.0;
+    p.freq_grow = 1.0 + f64::from(input.freq_grow) / 64.0;
+    if let Some((which, value)) = input.wild {
+        match which % 5 {
+            0 => p.alpha = value,
+            1 => p.freq_fraction = value,
+            2 => p.kernel_k = value,
+            3 => p.freq_grow = value,
+            _ => p.freq_hold_alpha = value,
+        }
+    }
     p.freq_pilot = u32::from(input.freq_pilot % 4);
     p.freq_merge = if input.options & 1 == 0 {
         MergePolicy::MinRadius
