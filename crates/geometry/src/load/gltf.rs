@@ -248,6 +248,66 @@ fn buffer_uri(path: &Path, index: usize, uri: &str) -> Result<Vec<u8>, LoadError
     })
 }
 
+/// Whether `count` items of `size` bytes, `stride` bytes apart from `offset`, end at an
+/// address that fits in a `usize`.
+fn range_fits(offset: usize, stride: usize, count: usize, size: usize) -> bool {
+    count
+        .checked_sub(1)
+        .and_then(|c| stride.checked_mul(c))
+        .and_then(|x| x.checked_add(offset))
+        .and_then(|x| x.checked_add(size))
+        .is_some()
+}
+
+/// Checks what gltf 1.4.1's accessor reader computes without checking (`accessor/util.rs`,
+/// `Iter::new`): at least one item, a stride no smaller than an item, and byte ranges
+/// (`offset + stride · (count − 1) + size`, a view's `offset + length`) that do not overflow;
+/// the same for a sparse accessor's indices and values. A range past the end of its buffer is
+/// the reader's to report.
+fn layout(accessor: &gltf::Accessor<'_>) -> Result<(), String> {
+    let view_fits =
+        |view: &gltf::buffer::View<'_>| view.offset().checked_add(view.length()).is_some();
+    let strided = |view: &gltf::buffer::View<'_>, offset: usize, count: usize, size: usize| {
+        let stride = view.stride().unwrap_or(size);
+        if stride < size {
+            return Err(format!(
+                "buffer view {} has a stride of {stride} bytes, less than its {size}-byte items",
+                view.index()
+            ));
+        }
+        if !view_fits(view) || !range_fits(offset, stride, count, size) {
+            return Err(format!(
+                "its byte range in buffer view {} overflows",
+                view.index()
+            ));
+        }
+        Ok(())
+    };
+    let (count, size) = (accessor.count(), accessor.size());
+    if count == 0 {
+        return Err("it has no items (count 0)".to_owned());
+    }
+    if let Some(view) = accessor.view() {
+        strided(&view, accessor.offset(), count, size)?;
+    }
+    if let Some(sparse) = accessor.sparse() {
+        let n = sparse.count();
+        if n == 0 {
+            return Err("its sparse storage has no items (count 0)".to_owned());
+        }
+        let indices = sparse.indices();
+        strided(
+            &indices.view(),
+            indices.offset(),
+            n,
+            indices.index_type().size(),
+        )?;
+        let values = sparse.values();
+        strided(&values.view(), values.offset(), n, size)?;
+    }
+    Ok(())
+}
+
 /// What glTF 2.0 allows for an accessor the loader reads.
 struct AccessorRule {
     what: &'static str,
@@ -367,9 +427,10 @@ impl Walker<'_> {
         Ok(())
     }
 
-    /// Checks the type of the accessors the loader reads against what glTF 2.0 allows. The
-    /// gltf crate's validation does not, and its readers assume it: a `VEC2` position fails a
-    /// debug assertion (`accessor/util.rs`), `FLOAT` indices reach an `unreachable!`.
+    /// Checks the type and layout of the accessors the loader reads against what glTF 2.0
+    /// allows. The gltf crate's validation does not, and its readers assume it: a `VEC2`
+    /// position or a stride shorter than an item fails a debug assertion (`accessor/util.rs`),
+    /// `FLOAT` indices reach an `unreachable!`, a count of 0 underflows.
     fn check_accessor_types(&self, prim: &gltf::Primitive<'_>) -> Result<(), LoadError> {
         let checks = [
             (prim.get(&gltf::Semantic::Positions), POSITION_RULE),
@@ -401,6 +462,12 @@ impl Walker<'_> {
                     ),
                 ));
             }
+            layout(&accessor).map_err(|problem| {
+                gltf_error(
+                    self.path,
+                    format!("accessor {} ({}): {problem}", accessor.index(), rule.what),
+                )
+            })?;
         }
         Ok(())
     }

@@ -239,3 +239,27 @@ fn obj_relative_index_before_the_first_element_is_an_error() {
         assert!(err.to_string().contains(needle), "{face}: {err}");
     }
 }
+
+/// Found by the `gltf` fuzz target: a buffer view whose stride (11) is shorter than a position
+/// (12 bytes) failed a debug assertion of gltf's reader (`accessor/util.rs:376`); a count of 0
+/// underflows there.
+#[test]
+fn gltf_accessor_layouts_gltf_cannot_read_are_errors() {
+    let strided = triangle_gltf("accessors").replace(
+        r#""bufferViews":[{"buffer":0,"byteLength":36}]"#,
+        r#""bufferViews":[{"buffer":0,"byteLength":36,"byteStride":11}]"#,
+    );
+    let files = MemoryFiles::new().with("/mem/t.gltf", strided);
+    assert_gltf_error(
+        load_memory("/mem/t.gltf", files),
+        "/mem/t.gltf",
+        "accessor 0 (POSITION): buffer view 0 has a stride of 11 bytes, less than its 12-byte items",
+    );
+    let empty = triangle_gltf("accessors").replace(r#""count":3"#, r#""count":0"#);
+    let files = MemoryFiles::new().with("/mem/t.gltf", empty);
+    assert_gltf_error(
+        load_memory("/mem/t.gltf", files),
+        "/mem/t.gltf",
+        "no items (count 0)",
+    );
+}
