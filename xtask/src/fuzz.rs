@@ -189,7 +189,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
             println!("fuzz: skipped: {missing}");
             return Ok(true);
         }
-        bail!("{missing}");
+        bail!("fuzz: {missing}");
     }
     let fuzz_dir = root.join("fuzz");
     let seeds_dir = root.join("target/fuzz-seeds");
@@ -304,15 +304,13 @@ fn check_tools() -> Result<(), String> {
     };
     if !works(&["+nightly", "--version"]) {
         return Err(
-            "fuzz: the nightly toolchain is missing (`cargo +nightly` fails); \
+            "the nightly toolchain is missing (`cargo +nightly` fails); \
                     install it with `rustup toolchain install nightly`"
                 .to_owned(),
         );
     }
     if !works(&["+nightly", "fuzz", "--version"]) {
-        return Err(
-            "fuzz: cargo-fuzz is missing; install it with `cargo install cargo-fuzz`".to_owned(),
-        );
+        return Err("cargo-fuzz is missing; install it with `cargo install cargo-fuzz`".to_owned());
     }
     Ok(())
 }
