@@ -279,6 +279,13 @@ fn read_photon_mapper(
 ) -> Result<(), StateError> {
     let n_emitted = r.u64()?;
     let camera_passes = r.u32()?;
+    // Every pass emits `photons_per_pass` and runs at most one camera pass; the photon indices
+    // of the next pass start at `n_emitted`.
+    if n_emitted != u64::from(passes) * u64::from(p.params().photons_per_pass)
+        || camera_passes > passes
+    {
+        return Err(StateError::Corrupt);
+    }
     let n = usize::try_from(r.u64()?).map_err(|_| StateError::Corrupt)?;
     if n != p.n_slots() && n != 0 {
         return Err(StateError::Corrupt);

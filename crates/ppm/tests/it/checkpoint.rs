@@ -119,3 +119,34 @@ fn checkpoint_with_a_zero_radius_is_refused() {
         }
     }
 }
+
+/// Found by the `checkpoint` fuzz target: a checkpoint whose photon count was near `u64::MAX`
+/// was restored, and the next pass's photon indices overflowed (`photon_pass.rs`). The count
+/// must be the passes times the photons per pass.
+#[test]
+fn checkpoint_with_an_impossible_photon_count_is_refused() {
+    let scene = cornell("CornellBox-Sphere.obj", 4, 4);
+    let photons = 777;
+    let mut renderer = Renderer::new(&scene, params(Method::Ppm, photons)).unwrap();
+    renderer.iterate();
+    let mut bytes = renderer.save_state("");
+    // The pass count (1) is followed by the photons emitted.
+    let mut pattern = 1u32.to_le_bytes().to_vec();
+    pattern.extend_from_slice(&u64::from(photons).to_le_bytes());
+    let at = bytes
+        .windows(pattern.len())
+        .position(|w| w == pattern)
+        .expect("passes and photons emitted are stored side by side")
+        + 4;
+    bytes[at..at + 8].copy_from_slice(&(u64::MAX - 5).to_le_bytes());
+    let end = bytes.len() - 8;
+    let checksum = fnv1a(&bytes[..end]);
+    bytes[end..].copy_from_slice(&checksum.to_le_bytes());
+    match Renderer::restore(&scene, &bytes) {
+        Err(e) => assert_eq!(e, StateError::Corrupt),
+        Ok(mut restored) => {
+            restored.iterate();
+            panic!("an impossible photon count was restored and rendered");
+        }
+    }
+}
