@@ -146,6 +146,10 @@ fn read_header(r: &mut Reader<'_>) -> Result<StateHeader, StateError> {
     let params = read_params(r)?;
     params.validate()?;
     let passes = r.u32()?;
+    // The pass counter is a u32: a checkpoint after which no pass can be counted is corrupt.
+    if passes == u32::MAX {
+        return Err(StateError::Corrupt);
+    }
     Ok(StateHeader {
         note,
         params,

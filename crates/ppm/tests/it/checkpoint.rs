@@ -150,3 +150,31 @@ fn checkpoint_with_an_impossible_photon_count_is_refused() {
         }
     }
 }
+
+/// Found by the `checkpoint` fuzz target: a path-tracer checkpoint claiming `u32::MAX` passes
+/// was restored, and the next pass overflowed the pass counter (`path.rs`).
+#[test]
+fn checkpoint_with_no_pass_left_is_refused() {
+    let scene = cornell("CornellBox-Sphere.obj", 4, 4);
+    let mut renderer = Renderer::new(&scene, params(Method::Path, 1)).unwrap();
+    renderer.iterate();
+    let mut bytes = renderer.save_state("");
+    // The pass count (1) is followed by the number of pixels (16).
+    let mut pattern = 1u32.to_le_bytes().to_vec();
+    pattern.extend_from_slice(&16u64.to_le_bytes());
+    let at = bytes
+        .windows(pattern.len())
+        .position(|w| w == pattern)
+        .expect("passes and pixel count are stored side by side");
+    bytes[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+    let end = bytes.len() - 8;
+    let checksum = fnv1a(&bytes[..end]);
+    bytes[end..].copy_from_slice(&checksum.to_le_bytes());
+    match Renderer::restore(&scene, &bytes) {
+        Err(e) => assert_eq!(e, StateError::Corrupt),
+        Ok(mut restored) => {
+            restored.iterate();
+            panic!("a checkpoint with u32::MAX passes was restored and rendered");
+        }
+    }
+}
