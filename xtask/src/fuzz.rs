@@ -31,8 +31,8 @@ Exit status 1 if a target crashed.
   --seconds N      time per target (default 60)
   --runs N         stop a target after N executions (whichever of --seconds and --runs comes first)
   --target T       run only T (repeatable); default all
-  --asan           build with AddressSanitizer (default: no sanitizer, about twice as fast;
-                   the code under test is safe Rust, and debug assertions stay on)
+  --asan           build with AddressSanitizer (default: no sanitizer, which runs faster; the
+                   code under test is safe Rust, and debug assertions stay on)
   --dev            build the targets in the dev profile: quicker to build from cold, much slower
                    to run (for the CI smoke)
   --skip-missing   if nightly or cargo-fuzz is missing, say so and exit 0 (for CI)
