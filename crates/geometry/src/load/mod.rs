@@ -17,6 +17,7 @@
 mod files;
 mod frame;
 mod gltf;
+mod gltf_document;
 mod import;
 mod mitsuba;
 mod obj;
