@@ -6,12 +6,14 @@
 //! - `docs-image`: renders the CLI's default scene for `docs/default-scene.png`.
 //! - `peers`: equal-time comparison with Mitsuba 3 against pixel-averaged references.
 //! - `farm-test`: work units on a one-node Slurm cluster, merged bit for bit.
+//! - `fuzz`: runs the cargo-fuzz targets of `fuzz/` and reports executions and crashes.
 
 #![allow(clippy::print_stdout, clippy::print_stderr, clippy::unwrap_used)]
 
 mod converge;
 mod docs_image;
 mod farm;
+mod fuzz;
 mod peers;
 mod render_all;
 mod suite;
@@ -29,7 +31,8 @@ commands:
   converge     error-versus-time study of one scene (see `converge --help`)
   docs-image   render docs/default-scene.png with the fppm binary
   peers        equal-time comparison with Mitsuba 3 (see `peers --help`)
-  farm-test    work units on a local one-node Slurm cluster, merged bit for bit (needs root)";
+  farm-test    work units on a local one-node Slurm cluster, merged bit for bit (needs root)
+  fuzz         run the fuzz targets (nightly, cargo-fuzz; see `fuzz --help`)";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -45,6 +48,7 @@ fn main() -> ExitCode {
             "docs-image" => docs_image::HELP,
             "peers" => peers::HELP,
             "farm-test" => farm::HELP,
+            "fuzz" => fuzz::HELP,
             _ => HELP,
         };
         println!("{help}");
@@ -61,6 +65,7 @@ fn main() -> ExitCode {
         "docs-image" => docs_image::run(&root, rest),
         "peers" => peers::run(&root, rest),
         "farm-test" => farm::run(&root, rest),
+        "fuzz" => fuzz::run(&root, rest),
         other => {
             eprintln!("xtask: unknown command `{other}`\n\n{HELP}");
             return ExitCode::from(2);

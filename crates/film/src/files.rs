@@ -166,6 +166,69 @@ pub fn write_exr(path: &Path, frame: &Frame) -> Result<(), FilmError> {
 /// [`FilmError::Read`] if the file is not a readable EXR, [`FilmError::MissingChannel`] if it
 /// lacks R, G or B.
 pub fn read_exr(path: &Path) -> Result<Image, FilmError> {
+    let io_error = |e: std::io::Error| FilmError::Read {
+        path: path.to_path_buf(),
+        message: lower_first(&e.to_string()),
+    };
+    let file = std::fs::File::open(path).map_err(io_error)?;
+    let length = file.metadata().map_err(io_error)?.len();
+    read_exr_from(std::io::BufReader::new(file), length, path)
+}
+
+/// Reads an EXR held in memory like [`read_exr`]; errors name `path`.
+///
+/// # Errors
+///
+/// As [`read_exr`].
+pub fn read_exr_bytes(bytes: &[u8], path: &Path) -> Result<Image, FilmError> {
+    read_exr_from(std::io::Cursor::new(bytes), bytes.len() as u64, path)
+}
+
+/// Largest ratio of pixel data to file size an EXR can have. Deflate (ZIP, PXR24, DWA)
+/// expands at most 1032 times; PIZ's Huffman code with its run-length symbol less than that;
+/// RLE at most 64 times; B44 is fixed-rate. A header that declares more pixel data than this
+/// allows for the file's size is refused before anything is allocated for it.
+const MAX_COMPRESSION_RATIO: u64 = 2048;
+
+/// Checks the image sizes an EXR's headers declare against the file's length (`length`
+/// bytes), then rewinds `reader`.
+fn check_declared_size(
+    mut reader: impl std::io::Read + std::io::Seek,
+    length: u64,
+    path: &Path,
+) -> Result<(), FilmError> {
+    let read_error = |message: String| FilmError::Read {
+        path: path.to_path_buf(),
+        message,
+    };
+    let meta = exr::meta::MetaData::read_from_buffered(&mut reader, false)
+        .map_err(|e| read_error(lower_first(&e.to_string())))?;
+    for header in &meta.headers {
+        let size = header.layer_size;
+        let bytes = header.channels.list.iter().fold(0u64, |sum, c| {
+            let samples =
+                (size.0 / c.sampling.0.max(1)) as u64 * (size.1 / c.sampling.1.max(1)) as u64;
+            sum.saturating_add(samples.saturating_mul(c.sample_type.bytes_per_sample() as u64))
+        });
+        if bytes / MAX_COMPRESSION_RATIO > length {
+            return Err(read_error(format!(
+                "its header declares a {} × {} image ({bytes} bytes of samples), more than a {length}-byte file can hold",
+                size.0, size.1
+            )));
+        }
+    }
+    reader
+        .seek(std::io::SeekFrom::Start(0))
+        .map_err(|e| read_error(lower_first(&e.to_string())))?;
+    Ok(())
+}
+
+fn read_exr_from(
+    mut reader: impl std::io::Read + std::io::Seek + Send,
+    length: u64,
+    path: &Path,
+) -> Result<Image, FilmError> {
+    check_declared_size(&mut reader, length, path)?;
     let image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
@@ -173,7 +236,7 @@ pub fn read_exr(path: &Path) -> Result<Image, FilmError> {
         .first_valid_layer()
         .all_attributes()
         .non_parallel()
-        .from_file(path)
+        .from_buffered(reader)
         .map_err(|e| FilmError::Read {
             path: path.to_path_buf(),
             message: lower_first(&e.to_string()),
@@ -193,6 +256,13 @@ pub fn read_exr(path: &Path) -> Result<Image, FilmError> {
             })
     };
     let (r, g, b) = (channel("R")?, channel("G")?, channel("B")?);
+    if [&r, &g, &b].iter().any(|c| c.len() != size.0 * size.1) {
+        return Err(FilmError::Read {
+            path: path.to_path_buf(),
+            message: "its R, G or B channel is subsampled (one sample per pixel is needed)"
+                .to_owned(),
+        });
+    }
     let pixels = (0..size.0 * size.1).map(|i| [r[i], g[i], b[i]]).collect();
     Ok(Image::new(size.0, size.1, pixels))
 }
@@ -252,6 +322,37 @@ fn latin1(s: &str) -> Text {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Found by the `exr` fuzz target: an 827-byte file whose data window is 771 751 939 × 2
+    /// pixels made the reader allocate for all of them (11 s, gigabytes); it is refused from
+    /// its header.
+    #[test]
+    fn exr_declaring_more_pixels_than_its_size_allows_is_refused() {
+        let bytes = include_bytes!("../tests/fuzz/huge-data-window.exr");
+        let path = Path::new("huge.exr");
+        let err = read_exr_bytes(bytes, path).unwrap_err();
+        assert!(matches!(err, FilmError::Read { .. }), "{err:?}");
+        let message = err.to_string();
+        assert!(
+            message.contains("header declares a 771751939 × 2 image"),
+            "{message}"
+        );
+        assert!(message.starts_with("huge.exr"), "{message}");
+    }
+
+    #[test]
+    fn exr_bytes_read_as_the_file() {
+        let pixels = (0..6).map(|i| [i as f32, 0.5, -2.0]).collect();
+        let frame = Frame::new(Image::new(3, 2, pixels));
+        let dir = std::env::temp_dir().join(format!("film-test-bytes-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("bytes.exr");
+        write_exr(&path, &frame).unwrap();
+        let from_bytes = read_exr_bytes(&std::fs::read(&path).unwrap(), &path).unwrap();
+        assert_eq!(from_bytes.pixels, read_exr(&path).unwrap().pixels);
+        assert_eq!(from_bytes.pixels, frame.image.pixels);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn exr_round_trip_is_exact() {

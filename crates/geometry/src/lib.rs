@@ -27,7 +27,8 @@
 //! [`load()`] picks the loader by extension (`.toml` scene files of format version 1, lone
 //! `.obj` files with their `.mtl`, `.gltf`/`.glb` files, Mitsuba 3 `.xml` and pbrt-v4 `.pbrt`
 //! scenes, whose mapping is in `docs/scene-import.md`), [`load_toml_str`] reads a TOML scene
-//! held in memory, and [`load_with`] takes [`LoadOptions`] (e.g. to accept a scene without
+//! held in memory, [`load_from`] reads a scene and the files it refers to from a [`FileSource`]
+//! (e.g. [`MemoryFiles`]) instead of the file system, and [`load_with`] takes [`LoadOptions`] (e.g. to accept a scene without
 //! emitters for `fppm info`). Every failure is a [`LoadError`] naming the file.
 //! [`SceneDescription::summary`] gives a [`SceneSummary`] for reports and snapshots.
 //!
@@ -78,8 +79,9 @@ pub use light::{
     LightSampler,
 };
 pub use load::{
-    DEFAULT_ALBEDO, DEFAULT_FILM_HEIGHT, DEFAULT_FILM_WIDTH, FRAMED_FOV_Y_DEGREES, LoadOptions,
-    MAX_FILM_SIDE, METALLIC_THRESHOLD, load, load_toml_str, load_toml_str_with, load_with,
+    DEFAULT_ALBEDO, DEFAULT_FILM_HEIGHT, DEFAULT_FILM_WIDTH, FRAMED_FOV_Y_DEGREES, FileSource,
+    LoadOptions, MAX_FILM_SIDE, METALLIC_THRESHOLD, MemoryFiles, load, load_from, load_toml_str,
+    load_toml_str_with, load_with,
 };
 pub use ray::{Hit, Primitive, Ray};
 pub use scene::{Scene, SceneError};

@@ -55,6 +55,8 @@ pub use crate::photon_mapper::{
 pub use crate::pointwise::{pointwise_reference, pointwise_reference_paths};
 pub use crate::renderer::{Aov, Renderer};
 pub use crate::rng::Sampler;
+#[doc(hidden)]
+pub use crate::state::surgery as checkpoint_surgery;
 pub use crate::state::{STATE_VERSION, StateError, StateHeader, scene_fingerprint};
 pub use crate::update::{FrequencyFloor, FrequencyRadius, GatherStats};
 pub use spectrum::{K_POSTER, K_STRICT, MergePolicy};

@@ -59,6 +59,38 @@ pub enum StateError {
     Params(#[from] ParamError),
 }
 
+/// Checkpoint surgery for tests and fuzzing: a checkpoint cut into its head (magic, version,
+/// fingerprint, note, parameters, pass count) and its decompressed columns, and put back
+/// together with a correct length, compression and checksum, so that a test can change one
+/// field and see the parser refuse it.
+#[doc(hidden)]
+pub mod surgery {
+    use super::{FNV_OFFSET, Reader, ZSTD_LEVEL, fnv1a, read_header};
+
+    /// The head and the decompressed columns of `bytes`; `None` if they are not a checkpoint
+    /// of this version.
+    #[must_use]
+    pub fn split(bytes: &[u8]) -> Option<(Vec<u8>, Vec<u8>)> {
+        let mut r = Reader::new(bytes).ok()?;
+        read_header(&mut r).ok()?;
+        let head_len = bytes.len() - 8 - r.rest.len();
+        let length = usize::try_from(r.u64().ok()?).ok()?;
+        let body = zstd::bulk::decompress(r.rest, length).ok()?;
+        Some((bytes[..head_len].to_vec(), body))
+    }
+
+    /// The checkpoint made of `head` and the columns `body`.
+    #[must_use]
+    pub fn join(head: &[u8], body: &[u8]) -> Vec<u8> {
+        let mut out = head.to_vec();
+        out.extend_from_slice(&(body.len() as u64).to_le_bytes());
+        out.extend_from_slice(&zstd::bulk::compress(body, ZSTD_LEVEL).unwrap_or_default());
+        let checksum = fnv1a(FNV_OFFSET, &out);
+        out.extend_from_slice(&checksum.to_le_bytes());
+        out
+    }
+}
+
 /// What a checkpoint says about itself, readable without the scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StateHeader {
@@ -184,6 +216,10 @@ fn read_header(r: &mut Reader<'_>) -> Result<StateHeader, StateError> {
     let params = read_params(r)?;
     params.validate()?;
     let passes = r.u32()?;
+    // The pass counter is a u32: a checkpoint after which no pass can be counted is corrupt.
+    if passes == u32::MAX {
+        return Err(StateError::Corrupt);
+    }
     Ok(StateHeader {
         note,
         params,
@@ -394,6 +430,13 @@ fn read_photon_mapper(
 ) -> Result<(), StateError> {
     let n_emitted = r.u64()?;
     let camera_passes = r.u32()?;
+    // Every pass emits `photons_per_pass` and runs at most one camera pass; the photon indices
+    // of the next pass start at `n_emitted`.
+    if n_emitted != u64::from(passes) * u64::from(p.params().photons_per_pass)
+        || camera_passes > passes
+    {
+        return Err(StateError::Corrupt);
+    }
     let n = usize::try_from(r.u64()?).map_err(|_| StateError::Corrupt)?;
     if n != p.n_slots() && n != 0 {
         return Err(StateError::Corrupt);
@@ -413,6 +456,10 @@ fn read_photon_mapper(
             return Err(StateError::Corrupt);
         }
         let radius = r.f64()?;
+        // Every slot of a saved renderer has a positive radius (the update rule divides by it).
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(StateError::Corrupt);
+        }
         let photon_count = r.f64()?;
         let flux = [r.f64()?, r.f64()?, r.f64()?];
         let has_freq = r.bool()?;

@@ -41,7 +41,7 @@ const MIRROR_ROUGHNESS: f32 = 0.01;
 /// Deepest node hierarchy accepted (guards against cyclic node graphs).
 const MAX_DEPTH: usize = 1024;
 
-fn gltf_error(path: &Path, message: impl std::fmt::Display) -> LoadError {
+pub(super) fn gltf_error(path: &Path, message: impl std::fmt::Display) -> LoadError {
     LoadError::Gltf {
         path: path.to_path_buf(),
         message: crate::error::lower_first(&message.to_string()),
@@ -51,9 +51,8 @@ fn gltf_error(path: &Path, message: impl std::fmt::Display) -> LoadError {
 /// Loads a glTF or GLB file.
 pub(crate) fn load_gltf(path: &Path) -> Result<MeshData, LoadError> {
     let bytes = read_bytes(path)?;
-    let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| gltf_error(path, e))?;
-    let buffers = gltf::import_buffers(&gltf.document, path.parent(), gltf.blob.clone())
-        .map_err(|e| gltf_error(path, e))?;
+    let gltf = super::gltf_document::parse(path, &bytes)?;
+    let buffers = super::gltf_document::import_buffers(path, &gltf.document, gltf.blob)?;
     let doc = &gltf.document;
 
     let mut data = MeshData::default();
@@ -123,6 +122,93 @@ pub(crate) fn load_gltf(path: &Path) -> Result<MeshData, LoadError> {
     });
     Ok(data)
 }
+
+/// Whether `count` items of `size` bytes, `stride` bytes apart from `offset`, end at an
+/// address that fits in a `usize`.
+fn range_fits(offset: usize, stride: usize, count: usize, size: usize) -> bool {
+    count
+        .checked_sub(1)
+        .and_then(|c| stride.checked_mul(c))
+        .and_then(|x| x.checked_add(offset))
+        .and_then(|x| x.checked_add(size))
+        .is_some()
+}
+
+/// Checks what gltf 1.4.1's accessor reader computes without checking (`accessor/util.rs`,
+/// `Iter::new`): at least one item, a stride no smaller than an item, and byte ranges
+/// (`offset + stride · (count − 1) + size`, a view's `offset + length`) that do not overflow;
+/// the same for a sparse accessor's indices and values. A range past the end of its buffer is
+/// the reader's to report.
+fn layout(accessor: &gltf::Accessor<'_>) -> Result<(), String> {
+    let view_fits =
+        |view: &gltf::buffer::View<'_>| view.offset().checked_add(view.length()).is_some();
+    let strided = |view: &gltf::buffer::View<'_>, offset: usize, count: usize, size: usize| {
+        let stride = view.stride().unwrap_or(size);
+        if stride < size {
+            return Err(format!(
+                "buffer view {} has a stride of {stride} bytes, less than its {size}-byte items",
+                view.index()
+            ));
+        }
+        if !view_fits(view) || !range_fits(offset, stride, count, size) {
+            return Err(format!(
+                "its byte range in buffer view {} overflows",
+                view.index()
+            ));
+        }
+        Ok(())
+    };
+    let (count, size) = (accessor.count(), accessor.size());
+    if count == 0 {
+        return Err("it has no items (count 0)".to_owned());
+    }
+    if let Some(view) = accessor.view() {
+        strided(&view, accessor.offset(), count, size)?;
+    }
+    if let Some(sparse) = accessor.sparse() {
+        let n = sparse.count();
+        if n == 0 {
+            return Err("its sparse storage has no items (count 0)".to_owned());
+        }
+        let indices = sparse.indices();
+        strided(
+            &indices.view(),
+            indices.offset(),
+            n,
+            indices.index_type().size(),
+        )?;
+        let values = sparse.values();
+        strided(&values.view(), values.offset(), n, size)?;
+    }
+    Ok(())
+}
+
+/// What glTF 2.0 allows for an accessor the loader reads.
+struct AccessorRule {
+    what: &'static str,
+    dimensions: gltf::accessor::Dimensions,
+    types: &'static [gltf::accessor::DataType],
+}
+
+const POSITION_RULE: AccessorRule = AccessorRule {
+    what: "POSITION",
+    dimensions: gltf::accessor::Dimensions::Vec3,
+    types: &[gltf::accessor::DataType::F32],
+};
+const NORMAL_RULE: AccessorRule = AccessorRule {
+    what: "NORMAL",
+    dimensions: gltf::accessor::Dimensions::Vec3,
+    types: &[gltf::accessor::DataType::F32],
+};
+const INDICES_RULE: AccessorRule = AccessorRule {
+    what: "indices",
+    dimensions: gltf::accessor::Dimensions::Scalar,
+    types: &[
+        gltf::accessor::DataType::U8,
+        gltf::accessor::DataType::U16,
+        gltf::accessor::DataType::U32,
+    ],
+};
 
 struct Walker<'a> {
     path: &'a Path,
@@ -218,6 +304,51 @@ impl Walker<'_> {
         Ok(())
     }
 
+    /// Checks the type and layout of the accessors the loader reads against what glTF 2.0
+    /// allows. The gltf crate's validation does not, and its readers assume it: a `VEC2`
+    /// position or a stride shorter than an item fails a debug assertion (`accessor/util.rs`),
+    /// `FLOAT` indices reach an `unreachable!`, a count of 0 underflows.
+    fn check_accessor_types(&self, prim: &gltf::Primitive<'_>) -> Result<(), LoadError> {
+        let checks = [
+            (prim.get(&gltf::Semantic::Positions), POSITION_RULE),
+            (prim.get(&gltf::Semantic::Normals), NORMAL_RULE),
+            (prim.indices(), INDICES_RULE),
+        ];
+        for (accessor, rule) in checks {
+            let Some(accessor) = accessor else {
+                continue;
+            };
+            let (dimensions, data_type) = (accessor.dimensions(), accessor.data_type());
+            if dimensions != rule.dimensions
+                || !rule.types.contains(&data_type)
+                || accessor.normalized()
+            {
+                return Err(gltf_error(
+                    self.path,
+                    format!(
+                        "accessor {} ({}) is {dimensions:?} of {data_type:?}{}; glTF 2.0 requires {:?} of {:?}",
+                        accessor.index(),
+                        rule.what,
+                        if accessor.normalized() {
+                            " (normalized)"
+                        } else {
+                            ""
+                        },
+                        rule.dimensions,
+                        rule.types,
+                    ),
+                ));
+            }
+            layout(&accessor).map_err(|problem| {
+                gltf_error(
+                    self.path,
+                    format!("accessor {} ({}): {problem}", accessor.index(), rule.what),
+                )
+            })?;
+        }
+        Ok(())
+    }
+
     fn primitive(&mut self, prim: &gltf::Primitive<'_>, world: Mat4) -> Result<(), LoadError> {
         let mode = prim.mode();
         if !matches!(
@@ -227,6 +358,7 @@ impl Walker<'_> {
             self.skipped_primitives += 1;
             return Ok(());
         }
+        self.check_accessor_types(prim)?;
         let reader = prim.reader(|b| self.buffers.get(b.index()).map(|d| &d.0[..]));
         let Some(positions) = reader.read_positions() else {
             if let Some(accessor) = prim.get(&gltf::Semantic::Positions) {

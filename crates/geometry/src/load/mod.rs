@@ -14,8 +14,10 @@
 //!   [`MAX_FILM_SIDE`].
 //! - Triangles with zero area are skipped and counted, never an error.
 
+mod files;
 mod frame;
 mod gltf;
+mod gltf_document;
 mod import;
 mod mitsuba;
 mod obj;
@@ -40,6 +42,7 @@ use crate::error::LoadError;
 use crate::validate;
 pub(crate) use crate::validate::fmt_vec;
 
+pub use files::{FileSource, MemoryFiles};
 pub use frame::FRAMED_FOV_Y_DEGREES;
 pub(crate) use frame::{bounds, frame_camera};
 pub use gltf::METALLIC_THRESHOLD;
@@ -125,6 +128,33 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<SceneDescription,
     }
 }
 
+/// Loads a scene like [`load_with`], reading `path` and every file it refers to from `files`
+/// instead of the file system: a scene held in memory, with its meshes, includes and buffers.
+/// Errors name the paths as the scene gives them.
+///
+/// ```
+/// use std::path::Path;
+/// use geometry::{LoadOptions, MemoryFiles, load_from};
+///
+/// let files = MemoryFiles::new()
+///     .with("/s/scene.toml", "format = 1\n[[shapes]]\ntype = \"mesh\"\nfile = \"quad.obj\"\n")
+///     .with("/s/quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+/// let options = LoadOptions::allow_no_emitter();
+/// let scene = load_from(Path::new("/s/scene.toml"), files, &options).unwrap();
+/// assert_eq!(scene.triangles.len(), 2);
+/// ```
+///
+/// # Errors
+/// As [`load_with`]; a file the source does not have is [`LoadError::Io`] (not found).
+pub fn load_from(
+    path: &Path,
+    files: impl FileSource + 'static,
+    options: &LoadOptions,
+) -> Result<SceneDescription, LoadError> {
+    let _installed = files::install(std::rc::Rc::new(files));
+    load_with(path, options)
+}
+
 /// Parses a TOML scene held in memory, as if it had been read from `source`: paths inside
 /// resolve relative to `source`'s parent directory, and errors name `source`. The scene must
 /// contain an emitter.
@@ -157,7 +187,7 @@ pub(crate) fn read_text(path: &Path) -> Result<String, LoadError> {
 
 /// Reads a whole file.
 pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, LoadError> {
-    std::fs::read(path).map_err(|source| LoadError::Io {
+    files::read(path).map_err(|source| LoadError::Io {
         path: path.to_path_buf(),
         source,
     })

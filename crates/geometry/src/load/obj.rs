@@ -199,8 +199,22 @@ fn prescan(path: &Path, text: &str) -> Result<Prescan, LoadError> {
         usemtl: BTreeSet::new(),
         skipped_points_lines: 0,
     };
+    let mut totals = [0usize; 3];
+    for line in text.lines() {
+        if let Some(kind) = vertex_kind(line.split_whitespace().next()) {
+            totals[kind] += 1;
+        }
+    }
+    let mut so_far = [0usize; 3];
     for (i, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
+        let keyword = words.clone().next();
+        if let Some(kind) = vertex_kind(keyword) {
+            so_far[kind] += 1;
+        }
+        if matches!(keyword, Some("f" | "l")) {
+            check_face_indices(path, line_number(i), line, so_far, totals)?;
+        }
         match words.next() {
             Some("v") => {
                 for word in words.take(3) {
@@ -227,6 +241,67 @@ fn prescan(path: &Path, text: &str) -> Result<Prescan, LoadError> {
         }
     }
     Ok(scan)
+}
+
+/// 0 for `v`, 1 for `vt`, 2 for `vn`.
+fn vertex_kind(keyword: Option<&str>) -> Option<usize> {
+    match keyword {
+        Some("v") => Some(0),
+        Some("vt") => Some(1),
+        Some("vn") => Some(2),
+        _ => None,
+    }
+}
+
+/// Checks the texture and normal indices of a face or line element (`v/vt/vn`): not 0, a
+/// relative (negative) index no further back than the first element of its kind, an absolute
+/// one no larger than the file's count. tobj 4.0.5 turns them into array offsets without
+/// checking for overflow (a relative index before the start wraps around and overflows when
+/// scaled). Vertex indices need no check (tobj bounds them with saturating arithmetic and
+/// reports them itself), nor do texture or normal indices when the file has none (tobj
+/// ignores them then).
+fn check_face_indices(
+    path: &Path,
+    line: u32,
+    text: &str,
+    so_far: [usize; 3],
+    totals: [usize; 3],
+) -> Result<(), LoadError> {
+    const NAMES: [&str; 3] = ["", "texture coordinate", "normal"];
+    for vertex in text.split_whitespace().skip(1) {
+        for (kind, word) in vertex.split('/').enumerate().take(3) {
+            if kind == 0 || word.is_empty() || totals[kind] == 0 {
+                continue;
+            }
+            let Ok(index) = word.parse::<i64>() else {
+                continue; // tobj reports what does not parse
+            };
+            let name = NAMES[kind];
+            let problem = if index == 0 {
+                Some(format!("{name} index 0 (OBJ indices start at 1)"))
+            } else if index < 0 && index.unsigned_abs() > so_far[kind] as u64 {
+                Some(format!(
+                    "relative {name} index {index}, but only {} are defined before it",
+                    so_far[kind]
+                ))
+            } else if index > 0 && index as u64 > totals[kind] as u64 {
+                Some(format!(
+                    "{name} index {index}, but the file defines {}",
+                    totals[kind]
+                ))
+            } else {
+                None
+            };
+            if let Some(message) = problem {
+                return Err(LoadError::Obj {
+                    path: path.to_path_buf(),
+                    line: Some(line),
+                    message,
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Finds the first line at which tobj fails, by bisection over prefixes of the text
@@ -263,7 +338,7 @@ fn line_number(index: usize) -> u32 {
 
 /// Reads and checks an MTL file. `Ok(None)` if it does not exist.
 fn read_mtl(path: &Path) -> Result<Option<tobj::MTLLoadResult>, LoadError> {
-    let bytes = match std::fs::read(path) {
+    let bytes = match super::files::read(path) {
         Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         Err(source) => {

@@ -68,6 +68,8 @@ pub(crate) fn parse_ply(path: &Path, bytes: &[u8]) -> Result<IndexedMesh, LoadEr
     let payload = bytes.len().saturating_sub(header_end);
     let mut minimum: u128 = 0;
     for element in header.elements.values() {
+        // An element without properties takes no bytes but still costs the parser one
+        // record each: it is counted as one byte, so that its count is bounded too.
         let per_element: usize = match header.encoding {
             Encoding::Ascii => element.properties.len().max(1) * 2,
             Encoding::BinaryBigEndian | Encoding::BinaryLittleEndian => element
@@ -77,7 +79,8 @@ pub(crate) fn parse_ply(path: &Path, bytes: &[u8]) -> Result<IndexedMesh, LoadEr
                     PropertyType::Scalar(t) => scalar_size(t),
                     PropertyType::List(count, _) => scalar_size(count),
                 })
-                .sum(),
+                .sum::<usize>()
+                .max(1),
         };
         minimum += element.count as u128 * per_element as u128;
     }

@@ -4,6 +4,7 @@
 
 mod bad_input;
 mod cylinder;
+mod fuzz_regressions;
 mod gltf;
 mod mitsuba;
 mod obj;

@@ -105,3 +105,86 @@ fn the_fingerprint_covers_textures() {
 }
 
 const PNG_HEX: &str = "89504e470d0a1a0a0000000d49484452000000010000000108060000001f15c4890000000d4944415478da636460f85f0f0002870180eb47ba920000000049454e44ae426082";
+
+/// A checkpoint with its columns changed by `edit` (decompressed, edited, recompressed, the
+/// checksum made right), so that the parser, not the checksum, has to refuse it.
+fn edited(bytes: &[u8], edit: impl FnOnce(&mut Vec<u8>, &mut Vec<u8>)) -> Vec<u8> {
+    let (mut head, mut body) = ppm::checkpoint_surgery::split(bytes).expect("a checkpoint");
+    edit(&mut head, &mut body);
+    ppm::checkpoint_surgery::join(&head, &body)
+}
+
+/// Found by the `checkpoint` fuzz target: a checkpoint whose checksum is right but whose slot
+/// radius is zero was restored, and the next pass's update rule failed its assertion (in a
+/// release build it divides by R² = 0). It is refused as corrupt.
+#[test]
+fn checkpoint_with_a_zero_radius_is_refused() {
+    let scene = cornell("CornellBox-Sphere.obj", 4, 4);
+    let mut p = params(Method::Ppm, 1);
+    // A radius no computation produces, to find a slot's radius in the columns: every slot
+    // that no photon reached still has it.
+    let radius = 0.012_345_678_9_f64;
+    p.initial_radius = Some(radius);
+    let mut renderer = Renderer::new(&scene, p).unwrap();
+    renderer.iterate();
+    let bytes = edited(&renderer.save_state(""), |_, body| {
+        let pattern = radius.to_le_bytes();
+        let at = body
+            .windows(8)
+            .position(|w| w == pattern)
+            .expect("a slot keeps the initial radius");
+        body[at..at + 8].copy_from_slice(&0.0f64.to_le_bytes());
+    });
+    match Renderer::restore(&scene, &bytes) {
+        Err(e) => assert_eq!(e, StateError::Corrupt),
+        Ok(mut restored) => {
+            restored.iterate();
+            panic!("a zero radius was restored and rendered");
+        }
+    }
+}
+
+/// Found by the `checkpoint` fuzz target: a checkpoint whose photon count was near `u64::MAX`
+/// was restored, and the next pass's photon indices overflowed (`photon_pass.rs`). The count
+/// must be the passes times the photons per pass.
+#[test]
+fn checkpoint_with_an_impossible_photon_count_is_refused() {
+    let scene = cornell("CornellBox-Sphere.obj", 4, 4);
+    let photons = 777;
+    let mut renderer = Renderer::new(&scene, params(Method::Ppm, photons)).unwrap();
+    renderer.iterate();
+    let bytes = edited(&renderer.save_state(""), |_, body| {
+        // The columns start with the photons emitted.
+        assert_eq!(body[..8], u64::from(photons).to_le_bytes());
+        body[..8].copy_from_slice(&(u64::MAX - 5).to_le_bytes());
+    });
+    match Renderer::restore(&scene, &bytes) {
+        Err(e) => assert_eq!(e, StateError::Corrupt),
+        Ok(mut restored) => {
+            restored.iterate();
+            panic!("an impossible photon count was restored and rendered");
+        }
+    }
+}
+
+/// Found by the `checkpoint` fuzz target: a path-tracer checkpoint claiming `u32::MAX` passes
+/// was restored, and the next pass overflowed the pass counter (`path.rs`).
+#[test]
+fn checkpoint_with_no_pass_left_is_refused() {
+    let scene = cornell("CornellBox-Sphere.obj", 4, 4);
+    let mut renderer = Renderer::new(&scene, params(Method::Path, 1)).unwrap();
+    renderer.iterate();
+    let bytes = edited(&renderer.save_state(""), |head, _| {
+        // The head ends with the pass count.
+        let at = head.len() - 4;
+        assert_eq!(head[at..], 1u32.to_le_bytes());
+        head[at..].copy_from_slice(&u32::MAX.to_le_bytes());
+    });
+    match Renderer::restore(&scene, &bytes) {
+        Err(e) => assert_eq!(e, StateError::Corrupt),
+        Ok(mut restored) => {
+            restored.iterate();
+            panic!("a checkpoint with u32::MAX passes was restored and rendered");
+        }
+    }
+}

@@ -175,8 +175,10 @@ impl<'a> Importer<'a> {
 
 /// Reads a `.spd` file: lines of `wavelength value`, `#` comments.
 pub(crate) fn read_spd(path: &Path) -> Result<(Vec<f64>, Vec<f64>), String> {
-    let text = std::fs::read_to_string(path)
+    let bytes = super::files::read(path)
         .map_err(|e| format!("cannot read spectrum file {}: {e}", path.display()))?;
+    let text = String::from_utf8(bytes)
+        .map_err(|_| format!("spectrum file {} is not UTF-8 text", path.display()))?;
     let mut w = Vec::new();
     let mut v = Vec::new();
     for (i, line) in text.lines().enumerate() {

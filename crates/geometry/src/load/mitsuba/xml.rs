@@ -114,7 +114,7 @@ impl Document {
         }
         for dir in &self.search {
             let candidate = dir.join(p);
-            if candidate.exists() {
+            if super::super::files::exists(&candidate) {
                 return candidate;
             }
         }
@@ -122,7 +122,7 @@ impl Document {
             .parent()
             .map(|d| d.join(p))
             .unwrap_or_else(|| p.to_path_buf());
-        if own.exists() {
+        if super::super::files::exists(&own) {
             return own;
         }
         self.search.last().map(|d| d.join(p)).unwrap_or(own)
@@ -180,7 +180,7 @@ impl Reader {
         path: &Path,
         included_from: Option<(&Path, u32, u32)>,
     ) -> Result<Vec<Node>, LoadError> {
-        let canonical = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
+        let canonical = super::super::files::canonical(path);
         if let Some((from, line, column)) = included_from {
             if self.stack.contains(&canonical) {
                 return Err(LoadError::Xml {
@@ -319,16 +319,16 @@ impl Reader {
                     return Err(located("needs a filename".to_owned()));
                 };
                 let own = path.parent().unwrap_or(Path::new("")).join(name);
-                let target = if own.exists() {
+                let target = if super::super::files::exists(&own) {
                     own
                 } else {
                     self.search
                         .iter()
                         .map(|d| d.join(name))
-                        .find(|p| p.exists())
+                        .find(|p| super::super::files::exists(p))
                         .unwrap_or(own)
                 };
-                if !target.exists() {
+                if !super::super::files::exists(&target) {
                     return Err(located(format!(
                         "included file {} not found",
                         target.display()

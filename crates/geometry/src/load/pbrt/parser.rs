@@ -5,7 +5,7 @@ use super::*;
 
 impl Parser {
     pub(super) fn parse_file(&mut self, path: &Path, from: Option<Loc>) -> Result<(), LoadError> {
-        let canonical = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
+        let canonical = super::super::files::canonical(path);
         if let Some(loc) = from {
             if self.include_stack.contains(&canonical) {
                 return Err(self.err(
@@ -19,7 +19,7 @@ impl Parser {
                     format!("includes nested deeper than {MAX_INCLUDE_DEPTH}"),
                 ));
             }
-            if !path.exists() {
+            if !super::super::files::exists(path) {
                 return Err(self.err(loc, format!("included file {} not found", path.display())));
             }
         }

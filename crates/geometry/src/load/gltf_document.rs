@@ -1,0 +1,131 @@
+//! A glTF or GLB file's document and buffers, read defensively: gltf 1.4.1 panics on some
+//! malformed files in its validation and binary header parsing, and its buffer importer reads
+//! the file system directly, so the loader checks those inputs first and reads buffers itself
+//! (through [`super::files`]). The mesh walk is in `gltf.rs`.
+
+use std::path::{Path, PathBuf};
+
+use super::gltf::gltf_error;
+use crate::error::LoadError;
+
+/// Parses and validates a glTF or GLB file's JSON.
+///
+/// gltf-json 1.4.1's validation indexes the accessor list with a primitive's `POSITION`
+/// accessor before checking that it exists (`mesh.rs`, `primitive_validate_hook`), so a file
+/// whose `"accessors"` key is misspelt panics there; those indices are checked first. The
+/// validation also runs under `catch_unwind`, the only way to contain a panic of the
+/// dependency that this check does not foresee: the user gets one line, not a crash.
+///
+/// A GLB header whose total length is shorter than the header itself makes gltf 1.4.1
+/// subtract with overflow (`binary.rs`, `Glb::from_slice`); it is refused first.
+pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<gltf::Gltf, LoadError> {
+    if let Some(length) = bytes
+        .strip_prefix(b"glTF")
+        .and_then(|rest| rest.get(4..8))
+        .and_then(|l| <[u8; 4]>::try_from(l).ok())
+        .map(u32::from_le_bytes)
+        && length < 12
+    {
+        return Err(gltf_error(
+            path,
+            format!(
+                "GLB header gives a total length of {length} bytes, less than the 12-byte header"
+            ),
+        ));
+    }
+    let unchecked =
+        gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| gltf_error(path, e))?;
+    let blob = unchecked.blob;
+    let json = unchecked.document.into_json();
+    let accessors = json.accessors.len();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
+            if let Some(index) = primitive.attributes.get(&position)
+                && index.value() >= accessors
+            {
+                return Err(gltf_error(
+                    path,
+                    format!(
+                        "mesh {m} primitive {p}: POSITION accessor {} does not exist (the file has {accessors} accessors)",
+                        index.value()
+                    ),
+                ));
+            }
+        }
+    }
+    let document = std::panic::catch_unwind(move || gltf::Document::from_json(json))
+        .map_err(|_| gltf_error(path, "the gltf crate failed while validating this file"))?
+        .map_err(|e| gltf_error(path, e))?;
+    Ok(gltf::Gltf { document, blob })
+}
+
+/// The data of every buffer of `doc`: the GLB binary chunk, a base64 `data:` URI, or a file
+/// relative to the glTF file read through [`super::files`] (not gltf's own importer, which
+/// reads the file system directly and panics on a percent-escape that is not UTF-8).
+/// Buffers are padded with zeros to a multiple of four bytes, as gltf's importer does.
+pub(super) fn import_buffers(
+    path: &Path,
+    doc: &gltf::Document,
+    mut blob: Option<Vec<u8>>,
+) -> Result<Vec<gltf::buffer::Data>, LoadError> {
+    let mut out = Vec::new();
+    for buffer in doc.buffers() {
+        let index = buffer.index();
+        let mut data = match buffer.source() {
+            gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
+                gltf_error(
+                    path,
+                    format!("buffer {index} refers to a missing GLB binary chunk"),
+                )
+            })?,
+            gltf::buffer::Source::Uri(uri) => buffer_uri(path, index, uri)?,
+        };
+        if data.len() < buffer.length() {
+            return Err(gltf_error(
+                path,
+                format!(
+                    "buffer {index} holds {} bytes, the file says {}",
+                    data.len(),
+                    buffer.length()
+                ),
+            ));
+        }
+        data.resize(data.len().next_multiple_of(4), 0);
+        out.push(gltf::buffer::Data(data));
+    }
+    Ok(out)
+}
+
+/// Reads a buffer URI: `data:[<media type>];base64,<data>` or a relative file name with
+/// percent-escapes. Other schemes (`file:`, `http:`) are refused.
+fn buffer_uri(path: &Path, index: usize, uri: &str) -> Result<Vec<u8>, LoadError> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let encoded = rest.split_once(";base64,").map_or(rest, |(_, data)| data);
+        return base64::decode(encoded).map_err(|e| {
+            gltf_error(
+                path,
+                format!("buffer {index}: data URI is not valid base64 ({e})"),
+            )
+        });
+    }
+    if uri.contains(':') {
+        return Err(gltf_error(
+            path,
+            format!("buffer {index}: unsupported URI scheme in {uri:?}"),
+        ));
+    }
+    let name = urlencoding::decode(uri).map_err(|_| {
+        gltf_error(
+            path,
+            format!("buffer {index}: URI {uri:?} has percent-escapes that are not UTF-8"),
+        )
+    })?;
+    let file: PathBuf = path.parent().unwrap_or(Path::new("")).join(&*name);
+    super::files::read(&file).map_err(|e| {
+        gltf_error(
+            path,
+            format!("buffer {index}: cannot read {}: {e}", file.display()),
+        )
+    })
+}
