@@ -113,15 +113,8 @@ pub(crate) struct PlanArgs {
     pub(crate) slurm: bool,
     #[command(flatten)]
     pub(crate) params: ParamArgs,
-    /// Film width in pixels (overrides the scene; alone, keeps the scene's aspect ratio).
-    #[arg(long, value_name = "PIXELS", help_heading = "Image")]
-    pub(crate) width: Option<u32>,
-    /// Film height in pixels (overrides the scene; alone, keeps the scene's aspect ratio).
-    #[arg(long, value_name = "PIXELS", help_heading = "Image")]
-    pub(crate) height: Option<u32>,
-    /// Light the scene with this equirectangular environment map (as for `fppm render`).
-    #[arg(long, value_name = "FILE", help_heading = "Image")]
-    pub(crate) env: Option<PathBuf>,
+    #[command(flatten)]
+    pub(crate) film: FilmArgs,
     #[command(flatten)]
     pub(crate) run: RunArgs,
 }
@@ -170,16 +163,8 @@ pub(crate) struct RenderArgs {
     pub(crate) params: ParamArgs,
     #[command(flatten)]
     pub(crate) budget: BudgetArgs,
-    /// Film width in pixels (overrides the scene; alone, keeps the scene's aspect ratio).
-    #[arg(long, value_name = "PIXELS", help_heading = "Image")]
-    pub(crate) width: Option<u32>,
-    /// Film height in pixels (overrides the scene; alone, keeps the scene's aspect ratio).
-    #[arg(long, value_name = "PIXELS", help_heading = "Image")]
-    pub(crate) height: Option<u32>,
-    /// Light the scene with this equirectangular environment map (.exr or .hdr, Mitsuba's
-    /// orientation: +y up), replacing the scene's own environment if it has one.
-    #[arg(long, value_name = "FILE", help_heading = "Image")]
-    pub(crate) env: Option<PathBuf>,
+    #[command(flatten)]
+    pub(crate) film: FilmArgs,
     #[command(flatten)]
     pub(crate) output: OutputArgs,
     /// Auxiliary outputs written as extra EXR channels, comma separated.
@@ -197,6 +182,22 @@ pub(crate) struct RenderArgs {
     pub(crate) checkpoint: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) run: RunArgs,
+}
+
+/// The film and the light around it: what `render` and `plan` share.
+#[derive(Debug, Args)]
+#[command(next_help_heading = "Image")]
+pub(crate) struct FilmArgs {
+    /// Film width in pixels (overrides the scene; alone, keeps the scene's aspect ratio).
+    #[arg(long, value_name = "PIXELS", help_heading = "Image")]
+    pub(crate) width: Option<u32>,
+    /// Film height in pixels (overrides the scene; alone, keeps the scene's aspect ratio).
+    #[arg(long, value_name = "PIXELS", help_heading = "Image")]
+    pub(crate) height: Option<u32>,
+    /// Light the scene with this equirectangular environment map (.exr or .hdr, Mitsuba's
+    /// orientation: +y up), replacing the scene's own environment if it has one.
+    #[arg(long, value_name = "FILE", help_heading = "Image")]
+    pub(crate) env: Option<PathBuf>,
 }
 
 /// Integrator parameters, one flag per entry of `ppm::PARAMS` (names, help and parsing are

@@ -66,6 +66,14 @@ pub(crate) enum Outcome {
 }
 
 fn main() -> ExitCode {
+    // A dependency's panic that a loader contains becomes that loader's one-line error: its
+    // panic message is not printed first. Any other panic is reported as Rust does.
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        if !geometry::containing_a_panic() {
+            default_hook(info);
+        }
+    }));
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(err) => return clap_error(&err),

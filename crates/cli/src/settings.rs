@@ -93,7 +93,7 @@ pub(crate) fn render_job(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Res
     let flagged = apply_flags(RenderParams::preview(), &args.params)?;
     flagged.validate().map_err(flag_error)?;
     let passes = passes_flag(args.budget.passes)?;
-    let film = film_flags(args.width, args.height)?;
+    let film = film_flags(args.film.width, args.film.height)?;
     let run = run_settings(&args.run)?;
     let outputs = outputs(&args.output, &args.aov, None)?;
     if let Some(checkpoint) = &args.checkpoint
@@ -109,7 +109,7 @@ pub(crate) fn render_job(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Res
     check_outputs(&outputs, args.checkpoint.as_deref())?;
 
     // The scene and its [render] defaults.
-    let mut description = load_scene(scene, args.env.as_deref())?;
+    let mut description = load_scene(scene, args.film.env.as_deref())?;
     apply_film(&mut description, film);
     let defaults = description.render.clone();
     let source = description.source.clone();
@@ -132,7 +132,7 @@ pub(crate) fn render_job(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Res
     };
     Ok(Job {
         scene_path: scene.map(absolute),
-        env_path: args.env.as_deref().map(absolute),
+        env_path: args.film.env.as_deref().map(absolute),
         description,
         params,
         budget,

@@ -67,9 +67,7 @@ pub(crate) fn plan(args: PlanArgs) -> anyhow::Result<Outcome> {
             passes: Some(i64::from(passes)),
             time: None,
         },
-        width: args.width,
-        height: args.height,
-        env: args.env,
+        film: args.film,
         output: OutputArgs {
             exr: None,
             png: None,

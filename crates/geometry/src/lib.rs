@@ -54,6 +54,7 @@ mod camera;
 mod description;
 mod error;
 mod frame;
+mod guard;
 mod light;
 mod load;
 mod ray;
@@ -74,6 +75,7 @@ pub use description::{
 };
 pub use error::LoadError;
 pub use frame::Frame;
+pub use guard::containing_a_panic;
 pub use light::{
     EmissionSample, EmitterShape, Environment, EnvironmentMap, EnvironmentRadiance, LightSample,
     LightSampler,

@@ -54,8 +54,8 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<gltf::Gltf, LoadError> 
             }
         }
     }
-    let document = std::panic::catch_unwind(move || gltf::Document::from_json(json))
-        .map_err(|_| gltf_error(path, "the gltf crate failed while validating this file"))?
+    let document = crate::guard::contain(move || gltf::Document::from_json(json))
+        .map_err(|()| gltf_error(path, "the gltf crate failed while validating this file"))?
         .map_err(|e| gltf_error(path, e))?;
     Ok(gltf::Gltf { document, blob })
 }
