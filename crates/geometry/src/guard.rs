@@ -18,8 +18,9 @@ pub(crate) fn contain<R>(f: impl FnOnce() -> R) -> Result<R, ()> {
     result
 }
 
-/// Whether this thread is inside [`contain`]: a panic hook may then stay silent, as the panic
-/// will become an error the caller reports.
+/// Whether this thread is running a call whose panic a loader contains (a dependency's
+/// validation, say): a panic hook may then stay silent, as the panic will become the loader's
+/// one-line error.
 #[must_use]
 pub fn containing_a_panic() -> bool {
     CONTAINING.with(Cell::get) > 0
