@@ -117,6 +117,7 @@ fn material(m: &Mat, i: usize) -> Material {
         name: format!("m{i}"),
         kind,
         emission: m.emission.as_ref().map_or(Vec3::ZERO, V::get),
+        textures: None,
     }
 }
 
@@ -147,6 +148,7 @@ fn description(input: &Input) -> SceneDescription {
         spheres: Vec::new(),
         cylinders: Vec::new(),
         lights: Vec::new(),
+        environment: None,
         render: RenderDefaults::default(),
         notes: LoadNotes::default(),
     };
@@ -156,6 +158,7 @@ fn description(input: &Input) -> SceneDescription {
                 positions: [p[0].get(), p[1].get(), p[2].get()],
                 normals: n.as_ref().map(|n| [n[0].get(), n[1].get(), n[2].get()]),
                 material: u32::from(*m % 5),
+                uv: None,
             }),
             Shape::Sphere(c, r, m) => d.spheres.push(Sphere {
                 center: c.get(),
