@@ -380,6 +380,7 @@ impl Progress {
                 "max_radius": finite_or_null(stats.max_radius),
                 "frequency_held": finite_or_null(stats.frequency_held),
                 "photons_stored": stats.photons_stored,
+                "light_connections": stats.light_connections,
                 "non_finite": stats.non_finite,
                 "timings": {
                     "camera": stats.timings.camera,

@@ -68,7 +68,7 @@ mod validate;
 
 pub use aabb::Aabb;
 pub use bsdf::{Bsdf, BsdfSample, Lobe, TransportMode, fresnel_dielectric};
-pub use camera::CameraModel;
+pub use camera::{CameraModel, LensConnection};
 pub use description::{
     Camera, Cylinder, Film, Light, LoadNotes, Material, MaterialKind, RenderDefaults, Rgb,
     SceneDescription, Sphere, Triangle,

@@ -57,7 +57,10 @@ pub fn pointwise_reference_paths(
     paths: std::ops::Range<u32>,
     emission_passes: u32,
 ) -> Result<Vec<[f32; 3]>, ParamError> {
-    if params.method.is_stochastic() || !params.method.is_photon_mapper() || params.direct_lighting
+    if params.method.is_stochastic()
+        || !params.method.is_photon_mapper()
+        || params.direct_lighting
+        || params.light_tracing
     {
         return Err(ParamError::NoFixedHitpoints {
             method: params.method.name(),

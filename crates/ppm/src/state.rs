@@ -23,7 +23,7 @@ use crate::update::FrequencyFloor;
 const MAGIC: &[u8; 8] = b"FPPMSTAT";
 /// Version of the checkpoint layout; bump it whenever the layout or the meaning of a field
 /// changes, so that old checkpoints are refused rather than misread.
-pub const STATE_VERSION: u32 = 5;
+pub const STATE_VERSION: u32 = 6;
 /// zstd level of the columns: the fastest; higher levels gain a few per cent for several times
 /// the time.
 const ZSTD_LEVEL: i32 = 1;
@@ -254,6 +254,8 @@ fn write_params(w: &mut Writer, p: &RenderParams) {
     w.f64(p.freq_hold_alpha);
     w.u32(p.freq_pilot);
     w.u32(u32::from(p.freq_clear_cap));
+    w.u32(u32::from(p.light_tracing));
+    w.u32(u32::from(p.freq_probe_share));
 }
 
 fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
@@ -284,6 +286,8 @@ fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
     let freq_hold_alpha = r.f64()?;
     let freq_pilot = r.u32()?;
     let freq_clear_cap = r.bool()?;
+    let light_tracing = r.bool()?;
+    let freq_probe_share = r.bool()?;
     Ok(RenderParams {
         method,
         photons_per_pass,
@@ -304,6 +308,8 @@ fn read_params(r: &mut Reader<'_>) -> Result<RenderParams, StateError> {
         freq_hold_alpha,
         freq_pilot,
         freq_clear_cap,
+        light_tracing,
+        freq_probe_share,
     })
 }
 

@@ -56,7 +56,7 @@ impl GatherStats {
     /// keep-or-shrink rule (§8.3):
     ///
     /// ```text
-    /// if M = 0:                        nothing
+    /// if M = 0:                        τ′ = τ + Φ (Φ is then light-traced flux, or zero)
     /// keep = has_freq ∧ R ≤ r_freq
     /// if ¬keep (shrink, as PPM):       N′ = N + αM
     ///                                  R′ = R·√((N + αM)/(N + M))
@@ -105,6 +105,8 @@ impl GatherStats {
             self.radius
         );
         if n_new == 0 {
+            // Flux without photons (light-traced contributions) counts at the current radius.
+            self.flux = add(self.flux, flux_new);
             return;
         }
         let (r, n, m) = (self.radius, self.photon_count, f64::from(n_new));

@@ -7,6 +7,17 @@ use crate::{Camera, Film, Ray, sampling::concentric_disk};
 #[cfg(test)]
 mod tests;
 
+/// A light-tracing connection to the lens ([`CameraModel::connect`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LensConnection {
+    /// Film position in pixels.
+    pub film: Vec2,
+    /// The point on the lens.
+    pub lens: Vec3,
+    /// (du/dω)/d² of the connecting ray, in pixels per unit area at normal incidence.
+    pub density: f32,
+}
+
 /// A camera ready to generate rays for a film.
 ///
 /// Film coordinates are in pixels: pixel (i, j) covers `[i, i+1] × [j, j+1]`, (0, 0) is the top-left
@@ -99,6 +110,67 @@ impl CameraModel {
         let inside =
             film.x >= 0.0 && film.x <= self.width && film.y >= 0.0 && film.y <= self.height;
         inside.then_some(film)
+    }
+
+    /// Film pixels per unit area of a surface at `point` with normal `normal`, as seen through
+    /// the lens centre: F²·|n·(c − x)| / ((x − c)·forward)³ with F the focal length in pixels
+    /// (`height / (2 tan(fov_y/2))`), i.e. (du/dω)·|cos θₓ|/d², the density of one camera sample
+    /// per pixel on that surface. `0` behind the camera. Light tracing multiplies a photon's
+    /// reflected flux by it (for a pinhole), and its MIS weight against photon merging compares
+    /// it with the kernel's area.
+    #[inline]
+    pub fn film_density(&self, point: Vec3, normal: Vec3) -> f32 {
+        let v = self.position - point;
+        let z = -v.dot(self.forward);
+        if z.is_nan() || z <= 0.0 {
+            return 0.0;
+        }
+        let f = self.focal_pixels();
+        f * f * normal.dot(v).abs() / (z * z * z)
+    }
+
+    /// The focal length in pixels: the distance from the lens to the film plane in units of
+    /// one pixel's side.
+    #[inline]
+    pub fn focal_pixels(&self) -> f32 {
+        0.5 * self.height / self.tan_half_fov_y
+    }
+
+    /// A light-tracing connection from `point` to the lens (the lens sample `u_lens` in [0, 1)²,
+    /// ignored by a pinhole): the film position the ray from the lens point through `point`
+    /// lands on, the lens point, and `du/dω / d²` of that ray (F² / (cos³θ · d²), θ from the
+    /// view axis, d the distance), so that flux reflected toward the lens with |cos θₓ| at
+    /// `point` lands on the film as (du/dω)·|cos θₓ|/d² per unit area. `None` if the point is
+    /// behind the lens plane or its film position is off the film.
+    pub fn connect(&self, point: Vec3, u_lens: Vec2) -> Option<LensConnection> {
+        let lens = if self.aperture_radius > 0.0 {
+            let l = self.aperture_radius * concentric_disk(u_lens);
+            self.position + l.x * self.right + l.y * self.up
+        } else {
+            self.position
+        };
+        let d = point - lens;
+        let z = d.dot(self.forward);
+        if z.is_nan() || z <= 0.0 {
+            return None;
+        }
+        // Where the ray lens → point crosses the focus plane (for a pinhole, any plane), seen
+        // through the lens centre.
+        let through = if self.aperture_radius > 0.0 {
+            lens + d * (self.focus_distance / z)
+        } else {
+            point
+        };
+        let film = self.project(through)?;
+        let distance2 = d.length_squared();
+        let cos = z / distance2.sqrt();
+        let f = self.focal_pixels();
+        let density = f * f / (cos * cos * cos * distance2);
+        density.is_finite().then_some(LensConnection {
+            film,
+            lens,
+            density,
+        })
     }
 
     /// Eye position (centre of the lens).

@@ -160,6 +160,16 @@ pub struct RenderParams {
     /// edges the kernel then shrinks at once to the distance where the disc leaves the
     /// surface, which removes most of photon mapping's corner bias.
     pub freq_clear_cap: bool,
+    /// Whether the candidates of a 2 × 2 block of pixels share one clear-disc probe where
+    /// their visible points lie in one plane well inside the probed disc
+    /// (`PhotonMapper::probe_clear_radii`); otherwise every candidate probes its own.
+    pub freq_probe_share: bool,
+    /// Whether the photon mappers also connect every stored photon to the camera (light
+    /// tracing) and combine the two estimates of what the camera sees directly on a
+    /// non-specular surface by multiple importance sampling, as vertex connection and merging
+    /// does: a photon merged at a directly seen hitpoint of radius R counts with weight
+    /// N/(1 + N) and its connection with 1/(1 + N), N = πR²·(camera samples per unit area).
+    pub light_tracing: bool,
 }
 
 /// A parameter outside its domain.
@@ -219,8 +229,11 @@ pub enum ParamError {
         samples_per_pixel: u32,
     },
     /// A pointwise reference was asked for a method without fixed hitpoints, or with direct
-    /// lighting at the hitpoints (whose estimate re-jitters every pass).
-    #[error("a pointwise reference needs ppm or freq without direct lighting, not {method}")]
+    /// lighting at the hitpoints (whose estimate re-jitters every pass), or with light tracing
+    /// (which converges to the pixel's average).
+    #[error(
+        "a pointwise reference needs ppm or freq without direct lighting or light tracing, not {method}"
+    )]
     NoFixedHitpoints {
         /// The method's name.
         method: &'static str,
@@ -261,6 +274,8 @@ impl RenderParams {
             freq_hold_alpha: 0.9,
             freq_pilot: 4,
             freq_clear_cap: false,
+            freq_probe_share: true,
+            light_tracing: false,
         }
     }
 

@@ -305,6 +305,28 @@ pub const PARAMS: &[Param] = &[
         },
     },
     Param {
+        name: "freq_probe_share",
+        flag: "no-freq-probe-share",
+        help: "Let every candidate of a frequency method probe its own clear disc (by default the candidates of a 2x2 block of pixels share one probe where their points lie in one plane inside it)",
+        kind: ParamKind::Switch { sets: false },
+        get: |p| on_off(p.freq_probe_share),
+        set: |p, v| {
+            p.freq_probe_share = parse_switch(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "light_tracing",
+        flag: "light-tracing",
+        help: "Photon mappers: connect every stored photon to the camera too and weight that against merging by multiple importance sampling (vertex connection and merging for directly seen surfaces)",
+        kind: ParamKind::Switch { sets: true },
+        get: |p| on_off(p.light_tracing),
+        set: |p, v| {
+            p.light_tracing = parse_switch(v)?;
+            Ok(())
+        },
+    },
+    Param {
         name: "max_depth",
         flag: "max-depth",
         help: "Maximum number of scattering events on a light path, in [1, 1024] [default: scene, else 1024: in effect unlimited, paths end by Russian roulette]",
@@ -510,6 +532,8 @@ mod tests {
         params.freq_hold_alpha = 1.0;
         params.freq_pilot = 0;
         params.freq_clear_cap = true;
+        params.light_tracing = true;
+        params.freq_probe_share = false;
         for base in [RenderParams::preview(), params] {
             let mut copy = RenderParams::preview();
             copy.method = Method::Path;

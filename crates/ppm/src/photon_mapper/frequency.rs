@@ -650,40 +650,114 @@ pub(super) fn scatter_spectrum(
     spectrum.reflect_axes(mu_i, mu_o, curvature, lobe, caps)
 }
 
+/// Whether the disc of radius `r_top` around `slot`'s visible point lies inside the clear disc
+/// of radius `clear` around `leader`'s: the same plane (normals within about 0.8°, the offset
+/// along the normal within the probes' own lift), and centres at most `clear − r_top` apart.
+fn shares_disc(
+    slots: &HitPoints<SlotFrequency>,
+    leader: usize,
+    slot: usize,
+    clear: f64,
+    r_top: f64,
+) -> bool {
+    let (a, b) = (slots.position()[leader], slots.position()[slot]);
+    let (na, nb) = (
+        slots.geometric_normal()[leader],
+        slots.geometric_normal()[slot],
+    );
+    let offset = b - a;
+    let lift = 1e-3 * r_top as f32 + 1e-5 * a.abs().max_element();
+    na.dot(nb) >= 0.9999
+        && na.dot(offset).abs() <= lift
+        && f64::from(offset.length()) + r_top <= clear
+}
+
 impl PhotonMapper<'_> {
     /// Probes the clear radius ([`crate::disc::clear_level`]) of every valid slot that has
     /// become a candidate for holding (R ≤ r_freq; with `all`, every slot with a frequency
     /// radius) and has not been probed at its visible point, in parallel. Deterministic: the
-    /// probes use no random numbers.
+    /// probes use no random numbers, and which slots share a probe depends only on the pass's
+    /// visible points.
+    ///
+    /// With `freq_probe_share` (and not `all`) the slots of each 2 × 2 block of pixels share
+    /// one probe: the block's first slot that needs one probes out to four times the largest
+    /// kernel R_max, and a slot of the block whose visible point lies in the same plane, at a
+    /// distance δ with δ + R_max within that clear radius, is clear at R_max without probes of
+    /// its own (its disc lies inside the probed one). The others, and the first slot where its
+    /// wide disc is not clear out to R_max, probe as before.
     pub(super) fn probe_clear_radii(&mut self, all: bool) {
         let k = self.setup.params.kernel_k;
         let r_top = self.setup.kernel_max();
         let slots = &self.slots;
         let scene = self.setup.scene;
-        let probed: Vec<(usize, u8)> = (0..slots.len())
-            .into_par_iter()
-            .with_min_len(SLOT_CHUNK)
-            .filter_map(|slot| {
-                let freq = slots.freq()[slot];
-                if !self.is_valid(slot) || freq.clear_level != GEOMETRY_UNKNOWN {
-                    return None;
-                }
-                // Not probed yet, so this is the unbounded frequency radius.
-                if !all {
-                    let r_freq = freq.hold_radius(k, r_top)?;
-                    if slots.radius()[slot] > r_freq {
-                        return None;
+        let needs_probe = |slot: usize| {
+            let freq = slots.freq()[slot];
+            if !self.is_valid(slot) || freq.clear_level != GEOMETRY_UNKNOWN {
+                return false;
+            }
+            // Not probed yet, so this is the unbounded frequency radius.
+            all || freq
+                .hold_radius(k, r_top)
+                .is_some_and(|r_freq| slots.radius()[slot] <= r_freq)
+        };
+        let probe = |slot: usize, r0: f64| {
+            crate::disc::clear_level(
+                scene,
+                slots.position()[slot],
+                slots.geometric_normal()[slot],
+                r0 as f32,
+            )
+        };
+        let probed: Vec<(usize, u8)> = if all || !self.setup.params.freq_probe_share {
+            (0..slots.len())
+                .into_par_iter()
+                .with_min_len(SLOT_CHUNK)
+                .filter(|&slot| needs_probe(slot))
+                .map(|slot| (slot, probe(slot, r_top)))
+                .collect()
+        } else {
+            let (width, height) = (self.setup.width as usize, self.setup.height as usize);
+            let spp = self.setup.params.samples_per_pixel as usize;
+            let blocks_x = width.div_ceil(2);
+            let block_slots = move |block: usize| {
+                let (bx, by) = (2 * (block % blocks_x), 2 * (block / blocks_x));
+                (by..(by + 2).min(height))
+                    .flat_map(move |y| (bx..(bx + 2).min(width)).map(move |x| y * width + x))
+                    .flat_map(move |pixel| pixel * spp..(pixel + 1) * spp)
+            };
+            let n_blocks = blocks_x * height.div_ceil(2);
+            (0..n_blocks)
+                .into_par_iter()
+                .with_min_len(SLOT_CHUNK / 4)
+                .flat_map_iter(|block| {
+                    let mut out = Vec::new();
+                    let mut leader: Option<(usize, f64)> = None;
+                    for slot in block_slots(block).filter(|&s| needs_probe(s)) {
+                        let Some((first, clear)) = leader else {
+                            let wide = probe(slot, 4.0 * r_top);
+                            let clear = crate::disc::level_radius(wide, 4.0 * r_top);
+                            leader = Some((slot, clear));
+                            // Near an edge the wide ladder stops short of the smallest levels:
+                            // the leader probes its own as every slot does.
+                            let own = if clear >= r_top {
+                                0
+                            } else {
+                                probe(slot, r_top)
+                            };
+                            out.push((slot, own));
+                            continue;
+                        };
+                        let level = if shares_disc(slots, first, slot, clear, r_top) {
+                            0
+                        } else {
+                            probe(slot, r_top)
+                        };
+                        out.push((slot, level));
                     }
-                }
-                let level = crate::disc::clear_level(
-                    scene,
-                    slots.position()[slot],
-                    slots.geometric_normal()[slot],
-                    r_top as f32,
-                );
-                Some((slot, level))
-            })
-            .collect();
+                    out
+                })
+                .collect()
+        };
         let columns = self.slots.columns_mut();
         for (slot, level) in probed {
             columns.freq[slot].clear_level = level;

@@ -176,10 +176,11 @@ impl PhotonMapper<'_> {
                 let mut image = [0.0f64; 3];
                 for slot in pixel * spp..(pixel + 1) * spp {
                     let (_, flux) = deposits.deposit_of(slot);
+                    let light = deposits.light_of(slot);
                     let area = std::f64::consts::PI * radius[slot] * radius[slot];
                     let gathered = bounces[slot] != NO_VISIBLE_POINT && area > 0.0;
                     for c in 0..3 {
-                        image[c] += direct[slot][c];
+                        image[c] += direct[slot][c] + light[c] / photons;
                         if gathered {
                             image[c] += flux[c] / (area * photons);
                         }

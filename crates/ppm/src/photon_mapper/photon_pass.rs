@@ -10,8 +10,8 @@ use photon::{AcceptParams, GatherScratch, MortonScratch, Photon};
 use rayon::prelude::*;
 
 use super::frequency::FrequencyPhoton;
-use super::trace::TracedPhotons;
-use super::{PHOTON_CHUNK, PassStats, PhotonMapper};
+use super::trace::{LightTracing, TracedPhotons};
+use super::{NO_VISIBLE_POINT, PHOTON_CHUNK, PassStats, PhotonMapper};
 
 /// `PhotonPass::slot_entry` of a slot the grid does not index.
 pub(super) const NOT_IN_GRID: u32 = u32::MAX;
@@ -36,6 +36,12 @@ pub(super) struct PhotonPass {
     per_entry: Vec<(u32, [f64; 3])>,
     /// Per slot: its grid entry, or [`NOT_IN_GRID`].
     slot_entry: Vec<u32>,
+    /// Per slot: the light-traced radiance of the pass times the photons emitted
+    /// (`light_tracing` only; empty otherwise).
+    light: Vec<[f64; 3]>,
+    /// Per slot: camera samples per unit area at its visible point if the camera sees it
+    /// directly, else infinity (light tracing cannot reach it; merging takes all its weight).
+    vm_density: Vec<f32>,
 }
 
 impl PhotonPass {
@@ -47,6 +53,11 @@ impl PhotonPass {
         }
     }
 
+    /// The light-traced radiance of `slot` in the last pass, times the photons emitted.
+    pub(super) fn light_of(&self, slot: usize) -> [f64; 3] {
+        self.light.get(slot).copied().unwrap_or([0.0; 3])
+    }
+
     /// Heap bytes of the buffers sized by the photons, and of those sized by the hitpoints.
     pub(super) fn heap_bytes(&self) -> (usize, usize) {
         use std::mem::size_of;
@@ -56,6 +67,7 @@ impl PhotonPass {
             .map(|t| {
                 t.photons.capacity() * size_of::<Photon>()
                     + t.frequency.capacity() * size_of::<FrequencyPhoton>()
+                    + t.splats.capacity() * size_of::<(u32, [f32; 3])>()
             })
             .sum::<usize>()
             + self.traced.capacity() * size_of::<TracedPhotons>();
@@ -66,7 +78,9 @@ impl PhotonPass {
                 + self.gather.heap_bytes()
                 + self.tagged_gather.heap_bytes(),
             self.per_entry.capacity() * size_of::<(u32, [f64; 3])>()
-                + self.slot_entry.capacity() * size_of::<u32>(),
+                + self.slot_entry.capacity() * size_of::<u32>()
+                + self.light.capacity() * size_of::<[f64; 3]>()
+                + self.vm_density.capacity() * size_of::<f32>(),
         )
     }
 }
@@ -85,6 +99,10 @@ impl PhotonMapper<'_> {
         let n_chunks = usize::try_from(n.div_ceil(PHOTON_CHUNK)).unwrap_or(usize::MAX);
         buffers.traced.resize_with(n_chunks, TracedPhotons::default);
         let layout = self.frequency.layout(n_chunks, setup.params.max_depth);
+        let light = setup.params.light_tracing.then(|| LightTracing {
+            radii: self.slots.radius(),
+            samples_per_pixel: setup.params.samples_per_pixel,
+        });
         buffers
             .traced
             .par_iter_mut()
@@ -95,10 +113,38 @@ impl PhotonMapper<'_> {
                 let end = (start + PHOTON_CHUNK).min(n);
                 let tag_base = layout.chunk_base(chunk);
                 for idx in start..end {
-                    setup.trace_photon(pass, first_index + idx, tag_base, out);
+                    setup.trace_photon(pass, first_index + idx, tag_base, light, out);
                 }
             });
         self.n_emitted += n;
+        if light.is_some() {
+            // In chunk order, whatever the thread count.
+            let n_slots = self.slots.len();
+            buffers.light.clear();
+            buffers.light.resize(n_slots, [0.0; 3]);
+            for chunk in &buffers.traced {
+                stats.light_connections += chunk.connections;
+                for &(slot, v) in &chunk.splats {
+                    let sum = &mut buffers.light[slot as usize];
+                    for c in 0..3 {
+                        sum[c] += f64::from(v[c]);
+                    }
+                }
+            }
+            let camera = setup.scene.camera();
+            let direct_budget = u16::try_from(setup.params.max_depth - 1).unwrap_or(u16::MAX);
+            let (positions, normals) = (self.slots.position(), self.slots.geometric_normal());
+            let budgets = &self.photon_bounces;
+            buffers.vm_density.clear();
+            buffers.vm_density.extend((0..n_slots).map(|slot| {
+                let budget = budgets[slot];
+                if budget == NO_VISIBLE_POINT || budget < direct_budget {
+                    f32::INFINITY
+                } else {
+                    camera.film_density(positions[slot], normals[slot])
+                }
+            }));
+        }
         let frequency_photons = buffers.traced.iter().map(|c| c.frequency_photons).sum();
         stats.non_finite += buffers.traced.iter().map(|c| c.non_finite).sum::<u64>();
         let trace_seconds = clock.elapsed().as_secs_f64();
@@ -134,6 +180,7 @@ impl PhotonMapper<'_> {
 
         let slots = &self.slots;
         let photon_bounces = &self.photon_bounces;
+        let vm_density = &buffers.vm_density;
         // Fluxes dropped for being NaN or infinite (a BSDF value at a grazing angle, say):
         // rare, so an atomic counter costs nothing on the common path.
         let non_finite_fluxes = AtomicU64::new(0);
@@ -161,7 +208,20 @@ impl PhotonMapper<'_> {
                     }
                     kind => Bsdf::from_normal(kind, normal, true).eval(outgoing, photon.incoming),
                 };
-                let flux = f * photon.power * slots.weight()[slot];
+                let mut flux = f * photon.power * slots.weight()[slot];
+                if let Some(light) = light {
+                    // The balance heuristic against the photon's connection to the camera
+                    // (`trace.rs`): N/(q + N), N = πR²ρ; 1 where the camera sees the hitpoint
+                    // only through specular bounces (ρ = ∞).
+                    let rho = f64::from(vm_density[slot]);
+                    if rho.is_finite() {
+                        let r = slots.radius()[slot];
+                        let n = std::f64::consts::PI * r * r * rho;
+                        let spp = setup.params.samples_per_pixel as usize;
+                        let q = light.connection_rate((slot / spp) as u32, rho);
+                        flux *= (n / (q + n)) as f32;
+                    }
+                }
                 if flux.is_finite() {
                     Some(flux)
                 } else {

@@ -29,6 +29,9 @@ pub struct PassStats {
     pub frequency_held: f64,
     /// Photons stored on non-specular surfaces this pass: the gather queries.
     pub photons_stored: u64,
+    /// Stored photons connected to the camera (`light_tracing`): visible from the lens, on
+    /// the film, with a non-zero BSDF toward it.
+    pub light_connections: u64,
     /// Values dropped this pass because they were NaN or infinite where they would have entered
     /// a sum: photon powers (the path ends), photon–hitpoint fluxes, directly seen emission and
     /// camera weights (the visible point is dropped), path-tracer samples. Zero in a healthy
@@ -77,6 +80,7 @@ impl PassStats {
             max_radius: 0.0,
             frequency_held: 0.0,
             photons_stored: 0,
+            light_connections: 0,
             non_finite: 0,
             timings: PassTimings::default(),
         }

@@ -1,7 +1,7 @@
 //! Tracing one photon path: emission, Russian roulette, scattering, and the photons it stores
 //! on non-specular surfaces (with the frequency steps of `frequency.rs` for frequency photons).
 
-use geometry::{Hit, MaterialKind, Rgb, TransportMode};
+use geometry::{Bsdf, Hit, MaterialKind, Rgb, TransportMode};
 use glam::Vec3;
 use photon::Photon;
 
@@ -16,9 +16,53 @@ pub(super) struct TracedPhotons {
     /// The frequency records of the chunk's frequency photons, in trace order.
     pub(super) frequency: Vec<FrequencyPhoton>,
     pub(super) frequency_photons: u64,
-    /// Photon paths ended because their power became NaN or infinite.
+    /// Photon paths ended because their power became NaN or infinite (and light-traced
+    /// contributions dropped for it).
     pub(super) non_finite: u64,
+    /// Light-traced contributions (`light_tracing`), in trace order: the hitpoint slot whose
+    /// image they add to, and the radiance they add there times the photons emitted, MIS
+    /// weight and 1/spp included.
+    pub(super) splats: Vec<(u32, [f32; 3])>,
+    /// Photons connected to the camera.
+    pub(super) connections: u64,
 }
+
+/// What light tracing needs of the current pass: every slot's gather radius, which its MIS
+/// weight against merging depends on.
+#[derive(Clone, Copy)]
+pub(super) struct LightTracing<'a> {
+    pub(super) radii: &'a [f64],
+    pub(super) samples_per_pixel: u32,
+}
+
+impl LightTracing<'_> {
+    /// N = πR²ρ of every slot of `pixel` for a point with `rho` camera samples per unit area:
+    /// how many of the slot's camera samples a merge at that radius covers.
+    fn kernel_samples(&self, pixel: u32, rho: f64) -> impl Iterator<Item = f64> + '_ {
+        let spp = self.samples_per_pixel;
+        let slots = (pixel * spp) as usize..((pixel + 1) * spp) as usize;
+        self.radii[slots]
+            .iter()
+            .map(move |&r| std::f64::consts::PI * r * r * rho)
+    }
+
+    /// The probability q that a photon at a point is connected to the camera, given the N of
+    /// its pixel's slots: min(1, 1/min N). Where kernels cover many camera samples merging
+    /// takes nearly all the weight (1/(1 + N) is small), so most connections are skipped and
+    /// the survivors count 1/q; the balance heuristic then weighs the connection strategy by
+    /// its rate q: q/(q + N) for the connection, N/(q + N) for the merge.
+    pub(super) fn connection_rate(&self, pixel: u32, rho: f64) -> f64 {
+        let n = self
+            .kernel_samples(pixel, rho)
+            .fold(f64::INFINITY, f64::min);
+        if n > 1.0 { 1.0 / n } else { 1.0 }
+    }
+}
+
+/// The sampler dimension where a photon's connection samples start (three per bounce: the
+/// connection decision and the lens point), far beyond
+/// what its path draws, so that light tracing leaves the photon paths as they are.
+const LENS_DIMENSION: u64 = 1 << 40;
 
 impl TracedPhotons {
     /// Empties the chunk for the next pass, keeping the allocations.
@@ -27,6 +71,8 @@ impl TracedPhotons {
         self.frequency.clear();
         self.frequency_photons = 0;
         self.non_finite = 0;
+        self.splats.clear();
+        self.connections = 0;
     }
 }
 
@@ -49,6 +95,7 @@ impl Setup<'_> {
         pass: u32,
         index: u64,
         tag_base: u32,
+        light: Option<LightTracing<'_>>,
         out: &mut TracedPhotons,
     ) {
         let mut sampler = Sampler::new(self.params.seed, pass, index);
@@ -104,6 +151,11 @@ impl Setup<'_> {
                     bounces: depth,
                     tag,
                 });
+                if let Some(light) = light {
+                    self.connect_to_camera(
+                        &hit, &bsdf, incoming, power, &sampler, depth, light, out,
+                    );
+                }
             }
             // Scatter, unless no later hit could count.
             if depth + 1 == self.params.max_depth {
@@ -165,6 +217,74 @@ impl Setup<'_> {
                 ));
             }
             ray = hit.spawn_ray(sample.incoming);
+        }
+    }
+}
+
+impl Setup<'_> {
+    /// Light tracing: the photon stored at `hit` (power `power`, arriving along −`incoming`)
+    /// reflected toward the lens, added to the slots of the pixel it lands on.
+    ///
+    /// The radiance it adds to a pixel is f·Φ·|cos θₓ|·(du/dω)/d² (per photon emitted; the
+    /// pixel is one unit of film area, `CameraModel::connect`), the same flux per unit area as
+    /// a merge evaluates with f·Φ/(πR²). The photon is connected with probability q
+    /// ([`LightTracing::connection_rate`]); slot s of the pixel takes the connection with the
+    /// balance heuristic's weight q/(q + N), N = πR_s²·ρ(x), ρ the camera samples per unit
+    /// area at the photon (`CameraModel::film_density`), divided by q and by spp; a merge at a
+    /// directly seen hitpoint takes N/(q + N) with ρ and q at the hitpoint (`photon_pass.rs`),
+    /// so that the two weights of a path sum to one as the kernel shrinks onto it.
+    #[allow(clippy::too_many_arguments)]
+    fn connect_to_camera(
+        &self,
+        hit: &Hit,
+        bsdf: &Bsdf,
+        incoming: Vec3,
+        power: Rgb,
+        sampler: &Sampler,
+        depth: u32,
+        light: LightTracing<'_>,
+        out: &mut TracedPhotons,
+    ) {
+        let camera = self.scene.camera();
+        let mut lens = sampler.clone();
+        lens.skip_to(LENS_DIMENSION + 3 * u64::from(depth));
+        let u_connect = lens.next_f32();
+        let u_lens = lens.next_2d();
+        let Some(connection) = camera.connect(hit.position, u_lens) else {
+            return;
+        };
+        let rho = f64::from(camera.film_density(hit.position, hit.geometric_normal));
+        // The film position is on the film (`connect`); its far edges belong to the last pixel.
+        let x = (connection.film.x as u32).min(self.width - 1);
+        let y = (connection.film.y as u32).min(self.height - 1);
+        let pixel = y * self.width + x;
+        let rate = light.connection_rate(pixel, rho);
+        if f64::from(u_connect) >= rate {
+            return;
+        }
+        let to_lens = connection.lens - hit.position;
+        let distance = to_lens.length();
+        if distance.is_nan() || distance <= 0.0 {
+            return;
+        }
+        let toward = to_lens / distance;
+        let f = bsdf.eval(toward, incoming);
+        if f == Rgb::ZERO || !self.scene.visible(hit, connection.lens) {
+            return;
+        }
+        let cos = toward.dot(hit.geometric_normal).abs();
+        let value = f * power * (cos * connection.density);
+        if !value.is_finite() {
+            out.non_finite += 1;
+            return;
+        }
+        out.connections += 1;
+        let spp = light.samples_per_pixel;
+        for (i, n) in light.kernel_samples(pixel, rho).enumerate() {
+            // Weight q/(q + N) over the connection's probability q.
+            let weight = 1.0 / ((rate + n) * f64::from(spp));
+            let v = value * weight as f32;
+            out.splats.push((pixel * spp + i as u32, [v.x, v.y, v.z]));
         }
     }
 }

@@ -37,23 +37,35 @@ impl PhotonMapper<'_> {
             .zip(columns.photon_count.par_iter_mut())
             .zip(columns.flux.par_iter_mut())
             .zip(columns.freq.par_iter())
-            .zip((0..n_slots).into_par_iter().map(|s| photons.deposit_of(s)))
-            .map(|((((radius, photon_count), tau), freq), (m, phi))| {
-                let (r_freq, held) = frequency::hold(freq, *radius, uses_frequency, k, r_top);
-                let mut stats = GatherStats {
-                    radius: *radius,
-                    photon_count: *photon_count,
-                    flux: *tau,
-                };
-                stats.update_with_hold(m, phi, alpha, r_freq, floor, hold_alpha);
-                if clear_cap && let Some(clear) = freq.clear_radius(r_top) {
-                    stats.cap_radius(clear.max(r_min));
-                }
-                *radius = stats.radius;
-                *photon_count = stats.photon_count;
-                *tau = stats.flux;
-                held
-            })
+            .zip(
+                (0..n_slots)
+                    .into_par_iter()
+                    .map(|s| (s, photons.deposit_of(s))),
+            )
+            .map(
+                |((((radius, photon_count), tau), freq), (slot, (m, mut phi)))| {
+                    // Light-traced radiance enters τ as the flux that radiance is at this radius.
+                    let light = photons.light_of(slot);
+                    let area = std::f64::consts::PI * *radius * *radius;
+                    for c in 0..3 {
+                        phi[c] += light[c] * area;
+                    }
+                    let (r_freq, held) = frequency::hold(freq, *radius, uses_frequency, k, r_top);
+                    let mut stats = GatherStats {
+                        radius: *radius,
+                        photon_count: *photon_count,
+                        flux: *tau,
+                    };
+                    stats.update_with_hold(m, phi, alpha, r_freq, floor, hold_alpha);
+                    if clear_cap && let Some(clear) = freq.clear_radius(r_top) {
+                        stats.cap_radius(clear.max(r_min));
+                    }
+                    *radius = stats.radius;
+                    *photon_count = stats.photon_count;
+                    *tau = stats.flux;
+                    held
+                },
+            )
             .collect();
 
         stats.timings.frequency += probe_seconds;

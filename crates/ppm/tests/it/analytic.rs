@@ -153,7 +153,7 @@ intensity = [10.0, 10.0, 10.0]
 
 /// The exact pixel averages of the plane scene: 8×8 sub-pixel rays per pixel through the
 /// camera model, intersected with y = 0 analytically.
-fn plane_reference(scene: &geometry::Scene) -> Vec<f64> {
+pub(crate) fn plane_reference(scene: &geometry::Scene) -> Vec<f64> {
     let (width, height) = scene.camera().resolution();
     let light = glam::Vec3::new(0.0, 1.0, 0.0);
     let mut out = Vec::new();

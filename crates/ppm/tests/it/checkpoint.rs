@@ -7,8 +7,14 @@ use crate::support::{cornell, params};
 #[test]
 fn resumed_render_is_bit_identical_to_an_uninterrupted_one() {
     let scene = cornell("CornellBox-Sphere.obj", 20, 20);
-    for method in Method::ALL {
-        let p = params(method, 5_000);
+    let cases = Method::ALL.into_iter().map(|m| (m, false)).chain([
+        (Method::Sppm, true),
+        (Method::FreqPpm, true),
+        (Method::Appm, true),
+    ]);
+    for (method, light_tracing) in cases {
+        let mut p = params(method, 5_000);
+        p.light_tracing = light_tracing;
         let mut straight = Renderer::new(&scene, p).unwrap();
         for _ in 0..4 {
             straight.iterate();
@@ -34,7 +40,10 @@ fn resumed_render_is_bit_identical_to_an_uninterrupted_one() {
             .iter()
             .zip(&b)
             .all(|(x, y)| x.map(f32::to_bits) == y.map(f32::to_bits));
-        assert!(same, "{method}: resumed image differs");
+        assert!(
+            same,
+            "{method} (light tracing {light_tracing}): resumed image differs"
+        );
         assert_eq!(straight.photons_emitted(), resumed.photons_emitted());
     }
 }

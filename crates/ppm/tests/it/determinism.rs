@@ -2,9 +2,13 @@
 
 use ppm::{Method, Renderer};
 
-use crate::support::{cornell, params};
+use crate::support::{PHOTON_METHODS, cornell, params};
 
-fn render_with_threads(threads: usize, method: Method) -> (Vec<[f32; 3]>, Vec<u8>) {
+fn render_with_threads(
+    threads: usize,
+    method: Method,
+    light_tracing: bool,
+) -> (Vec<[f32; 3]>, Vec<u8>) {
     let scene = cornell("CornellBox-Sphere.obj", 24, 24);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -13,6 +17,7 @@ fn render_with_threads(threads: usize, method: Method) -> (Vec<[f32; 3]>, Vec<u8
     pool.install(|| {
         let mut p = params(method, 6_000);
         p.samples_per_pixel = 2;
+        p.light_tracing = light_tracing;
         let mut renderer = Renderer::new(&scene, p).unwrap();
         for _ in 0..3 {
             renderer.iterate();
@@ -23,21 +28,26 @@ fn render_with_threads(threads: usize, method: Method) -> (Vec<[f32; 3]>, Vec<u8
 
 #[test]
 fn images_are_bit_identical_for_1_2_and_8_threads() {
-    for method in Method::ALL {
-        let (one, state_one) = render_with_threads(1, method);
+    let light_tracing = Method::ALL
+        .into_iter()
+        .map(|m| (m, false))
+        .chain(PHOTON_METHODS.into_iter().map(|m| (m, true)));
+    for (method, light) in light_tracing {
+        let method_name = format!("{method}{}", if light { " + light tracing" } else { "" });
+        let (one, state_one) = render_with_threads(1, method, light);
         for threads in [2, 8] {
-            let (many, state_many) = render_with_threads(threads, method);
+            let (many, state_many) = render_with_threads(threads, method, light);
             let same = one
                 .iter()
                 .zip(&many)
                 .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits));
             assert!(
                 same,
-                "{method}: image differs between 1 and {threads} threads"
+                "{method_name}: image differs between 1 and {threads} threads"
             );
             assert!(
                 state_one == state_many,
-                "{method}: state differs between 1 and {threads} threads"
+                "{method_name}: state differs between 1 and {threads} threads"
             );
         }
     }

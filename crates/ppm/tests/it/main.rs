@@ -15,6 +15,7 @@ mod determinism;
 mod environment;
 mod frequency;
 mod kernels;
+mod light_tracing;
 mod memory;
 mod non_finite;
 mod statistics;
