@@ -680,7 +680,7 @@ impl PhotonMapper<'_> {
     /// visible points.
     ///
     /// With `freq_probe_share` (and not `all`) the slots of each 2 × 2 block of pixels share
-    /// one probe: the block's first slot that needs one probes out to four times the largest
+    /// one probe: the block's first slot that needs one probes out to eight times the largest
     /// kernel R_max, and a slot of the block whose visible point lies in the same plane, at a
     /// distance δ with δ + R_max within that clear radius, is clear at R_max without probes of
     /// its own (its disc lies inside the probed one). The others, and the first slot where its
@@ -734,8 +734,8 @@ impl PhotonMapper<'_> {
                     let mut leader: Option<(usize, f64)> = None;
                     for slot in block_slots(block).filter(|&s| needs_probe(s)) {
                         let Some((first, clear)) = leader else {
-                            let wide = probe(slot, 4.0 * r_top);
-                            let clear = crate::disc::level_radius(wide, 4.0 * r_top);
+                            let wide = probe(slot, 8.0 * r_top);
+                            let clear = crate::disc::level_radius(wide, 8.0 * r_top);
                             leader = Some((slot, clear));
                             // Near an edge the wide ladder stops short of the smallest levels:
                             // the leader probes its own as every slot does.
