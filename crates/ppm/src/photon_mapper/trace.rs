@@ -47,20 +47,28 @@ impl LightTracing<'_> {
     }
 
     /// The probability q that a photon at a point is connected to the camera, given the N of
-    /// its pixel's slots: min(1, 1/min N). Where kernels cover many camera samples merging
-    /// takes nearly all the weight (1/(1 + N) is small), so most connections are skipped and
-    /// the survivors count 1/q; the balance heuristic then weighs the connection strategy by
-    /// its rate q: q/(q + N) for the connection, N/(q + N) for the merge.
+    /// its pixel's slots: 1 where the smallest N is at most [`CONNECT_BELOW`], else 0. The
+    /// balance heuristic weighs the connection strategy by its rate: q/(q + N) for the
+    /// connection, N/(q + N) for the merge, so that where q = 0 merging takes all the weight.
+    ///
+    /// Why a threshold: per photon landing in a pixel, the combined variance goes as
+    /// 1/(q + N) and the cost as t + q·c (t the photon's own cost, c a connection's), so the
+    /// efficiency (q + N)/(t + q·c) grows with q exactly when N < t/c: connect always or never.
+    /// A connection costs about a third of a stored photon's share of the pass (its shadow ray
+    /// against the photon's tracing, gathering and the pass's overhead), hence a few.
     pub(super) fn connection_rate(&self, pixel: u32, rho: f64) -> f64 {
         let n = self
             .kernel_samples(pixel, rho)
             .fold(f64::INFINITY, f64::min);
-        if n > 1.0 { 1.0 / n } else { 1.0 }
+        if n <= CONNECT_BELOW { 1.0 } else { 0.0 }
     }
 }
 
-/// The sampler dimension where a photon's connection samples start (three per bounce: the
-/// connection decision and the lens point), far beyond
+/// Photons are connected to the camera where a kernel covers at most this many camera
+/// samples ([`LightTracing::connection_rate`]).
+const CONNECT_BELOW: f64 = 2.0;
+
+/// The sampler dimension where a photon's lens samples start (two per bounce), far beyond
 /// what its path draws, so that light tracing leaves the photon paths as they are.
 const LENS_DIMENSION: u64 = 1 << 40;
 
@@ -247,8 +255,7 @@ impl Setup<'_> {
     ) {
         let camera = self.scene.camera();
         let mut lens = sampler.clone();
-        lens.skip_to(LENS_DIMENSION + 3 * u64::from(depth));
-        let u_connect = lens.next_f32();
+        lens.skip_to(LENS_DIMENSION + 2 * u64::from(depth));
         let u_lens = lens.next_2d();
         let Some(connection) = camera.connect(hit.position, u_lens) else {
             return;
@@ -259,7 +266,7 @@ impl Setup<'_> {
         let y = (connection.film.y as u32).min(self.height - 1);
         let pixel = y * self.width + x;
         let rate = light.connection_rate(pixel, rho);
-        if f64::from(u_connect) >= rate {
+        if rate == 0.0 {
             return;
         }
         let to_lens = connection.lens - hit.position;
@@ -281,7 +288,7 @@ impl Setup<'_> {
         out.connections += 1;
         let spp = light.samples_per_pixel;
         for (i, n) in light.kernel_samples(pixel, rho).enumerate() {
-            // Weight q/(q + N) over the connection's probability q.
+            // Weight q/(q + N) over the connection's probability q (q = 1 here).
             let weight = 1.0 / ((rate + n) * f64::from(spp));
             let v = value * weight as f32;
             out.splats.push((pixel * spp + i as u32, [v.x, v.y, v.z]));
