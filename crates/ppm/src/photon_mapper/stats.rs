@@ -154,6 +154,13 @@ const GRID_BYTES_PER_SLOT: u64 = 48;
 /// Per-pass buffers per slot: M and Φ per grid entry and the slot's entry (36 bytes), plus a
 /// frequency estimate per entry for the frequency-guided methods (32 more).
 const PASS_BYTES_PER_SLOT: u64 = 36;
+/// Light tracing's buffers per slot: the pass's connected radiance (24 bytes) and the camera
+/// sample density at the visible point (4).
+const LIGHT_BYTES_PER_SLOT: u64 = 28;
+/// Light tracing's buffers per photon emitted and slot per pixel: one 16-byte contribution per
+/// slot of the pixel per connected photon, for up to the 4.8 stored photons per emitted one of
+/// [`PHOTON_BYTES`] (rounded up).
+const LIGHT_BYTES_PER_PHOTON: u64 = 80;
 const FREQUENCY_PASS_BYTES_PER_SLOT: u64 = 32;
 /// Output bytes per pixel: the image, its copy in the EXR writer, the PNG, and up to ten AOV
 /// channels.
@@ -187,6 +194,11 @@ impl MemoryEstimate {
                 FREQUENCY_PASS_BYTES_PER_SLOT
             } else {
                 0
+            }
+            + if params.light_tracing {
+                LIGHT_BYTES_PER_SLOT
+            } else {
+                0
             };
         // appm: each slot's kernel, and each pixel's exact sums (3 × i128).
         let independent = if method.is_pass_independent() {
@@ -198,7 +210,15 @@ impl MemoryEstimate {
         };
         Self {
             hitpoints: slots.saturating_mul(per_slot).saturating_add(independent),
-            photons: Self::photon_bytes(u64::from(params.photons_per_pass)),
+            photons: Self::photon_bytes(u64::from(params.photons_per_pass)).saturating_add(
+                if params.light_tracing {
+                    u64::from(params.photons_per_pass)
+                        .saturating_mul(LIGHT_BYTES_PER_PHOTON)
+                        .saturating_mul(u64::from(params.samples_per_pixel))
+                } else {
+                    0
+                },
+            ),
             film,
             checkpoint: slots.saturating_mul(CHECKPOINT_BYTES_PER_SLOT),
         }
