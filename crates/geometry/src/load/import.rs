@@ -215,7 +215,15 @@ impl Builder {
 
     /// Adds a mesh transformed by `to_world`. A transform that mirrors (negative determinant)
     /// swaps the winding so that the front face follows the transformed normals.
+    ///
+    /// Texture coordinates are kept only for a textured material, so that an untextured scene's
+    /// description (and its checkpoint fingerprint) is what it was before importers read uv.
     pub(crate) fn mesh(&mut self, mesh: &IndexedMesh, to_world: Mat4, material: u32) {
+        let textured = self
+            .materials
+            .get(material as usize)
+            .is_some_and(|m| m.textures.is_some());
+        let uvs = mesh.uvs.as_ref().filter(|_| textured);
         if to_world == Mat4::IDENTITY {
             // Keep the file's numbers bit for bit (no renormalised normals).
             for face in &mesh.indices {
@@ -234,7 +242,7 @@ impl Builder {
                         })
                     })
                     .filter(|n| n.iter().all(|v| *v != Vec3::ZERO));
-                let uv = mesh.uvs.as_ref().map(|uvs| face.map(|i| uvs[i as usize]));
+                let uv = uvs.map(|uvs| face.map(|i| uvs[i as usize]));
                 self.triangle(positions, n, uv, material);
             }
             return;
@@ -261,7 +269,7 @@ impl Builder {
                 .as_ref()
                 .map(|ns| f.map(|i| ns[i as usize]))
                 .filter(|n| n.iter().all(|v| *v != Vec3::ZERO));
-            let uv = mesh.uvs.as_ref().map(|uvs| f.map(|i| uvs[i as usize]));
+            let uv = uvs.map(|uvs| f.map(|i| uvs[i as usize]));
             self.triangle(positions, n, uv, material);
         }
     }

@@ -322,3 +322,20 @@ fn shared_textured_scenes_load_their_images() {
         assert!((spread.1 - spread.0).min_element() > 0.5, "{spread:?}");
     }
 }
+
+/// Untextured scenes keep no texture coordinates, although their meshes have some (the
+/// matpreview `.serialized` shapes do, as the textured scene above shows): their descriptions
+/// are what they were before the importers read uv.
+#[test]
+fn untextured_scenes_carry_no_uv() {
+    let mitsuba = shared_scenes().join("mitsuba3/docs/scenes");
+    for scene in ["bsdf_dielectric_diamond.xml", "shape_ply_bunny.xml"] {
+        let description =
+            load_with(&mitsuba.join(scene), &LoadOptions::allow_no_emitter()).unwrap();
+        assert!(description.materials.iter().all(|m| m.textures.is_none()));
+        assert!(
+            description.triangles.iter().all(|t| t.uv.is_none()),
+            "{scene}"
+        );
+    }
+}
