@@ -248,6 +248,42 @@ fn pbrt_plymesh_uv_follow_the_same_flip() {
     assert_colours("plymesh", &got, [BLUE, WHITE, RED, GREEN]);
 }
 
+#[test]
+fn pbrt_bilinearmesh_uv_follow_the_same_flip() {
+    // pbrt's patch order p00 p10 p01 p11.
+    let scene = pbrt_scene(
+        PBRT_IMAGEMAP,
+        r#"Shape "bilinearmesh" "point3 P" [-1 -1 0 1 -1 0 -1 1 0 1 1 0] "point2 uv" [0 0 1 0 0 1 1 1]"#,
+    );
+    let got = colours_at_quarters("scene.pbrt", &scene, &[("checker.png", checker_png())]);
+    assert_colours("bilinearmesh", &got, [BLUE, WHITE, RED, GREEN]);
+}
+
+#[test]
+fn mitsuba_plastic_textures_its_diffuse_part_with_a_warning() {
+    let scene = mitsuba_scene(
+        r#"<shape type="rectangle"><bsdf type="roughplastic">
+            <texture type="bitmap" name="diffuse_reflectance"><string name="filename" value="checker.png"/></texture>
+        </bsdf></shape>"#,
+    );
+    let got = colours_at_quarters("scene.xml", &scene, &[("checker.png", checker_png())]);
+    assert_colours("roughplastic", &got, [RED, GREEN, BLUE, WHITE]);
+    let dir = PathBuf::from("/mem");
+    let memory = MemoryFiles::new()
+        .with(dir.join("scene.xml"), scene.into_bytes())
+        .with(dir.join("checker.png"), checker_png());
+    let description = load_from(&dir.join("scene.xml"), memory, &LoadOptions::default()).unwrap();
+    assert!(
+        description
+            .notes
+            .warnings
+            .iter()
+            .any(|w| w.contains("tints the coating's reflection too")),
+        "{:?}",
+        description.notes.warnings
+    );
+}
+
 /// Width and height of an image file, read by the `image` crate's header decoder.
 fn dimensions(path: &Path) -> [u32; 2] {
     let (w, h) = image::image_dimensions(path).unwrap();
