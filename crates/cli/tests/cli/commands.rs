@@ -111,6 +111,33 @@ fn info_describes_the_cornell_box() {
     assert!(default.stdout.contains("cylinder"), "{}", default.stdout);
 }
 
+/// `fppm info` lists the images of imported scenes, with the sizes the files have (SOURCE.md
+/// of the shared scenes: wood.jpg 2048x1571, lines.png 1024x1024).
+#[test]
+fn info_lists_the_textures_of_imported_scenes() {
+    let dir = temp_dir("info_textures");
+    let shared = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/scenes");
+    for (scene, needles) in [
+        (
+            "mitsuba3/docs/scenes/bsdf_diffuse_textured.xml",
+            ["textures   1", "wood.jpg 2048x1571", "textured (color)"],
+        ),
+        (
+            "pbrt-v4/killeroos/killeroo-gold.pbrt",
+            ["textures   1", "lines.png 1024x1024", "textured (color)"],
+        ),
+    ] {
+        let run = fppm(&dir, &["info", &format!("{shared}/{scene}")]).ok();
+        for needle in needles {
+            assert!(
+                run.stdout.contains(needle),
+                "{needle:?} not in:\n{}",
+                run.stdout
+            );
+        }
+    }
+}
+
 #[test]
 fn info_accepts_a_scene_without_emitters_and_says_so() {
     let dir = temp_dir("info_dark");

@@ -1,13 +1,13 @@
 //! What the importers of other renderers' formats (Mitsuba 3 XML, pbrt-v4) share: a builder
 //! that gathers world-space geometry, materials and lights, indexed meshes with their
 //! transforms, the primitive shapes both formats define, and the stand-ins for what fppm
-//! cannot render yet (textures, environment lights). Each stand-in is one small function so
+//! cannot render yet (textures where fppm cannot use an image, environment lights). Each stand-in is one small function so
 //! that it can be replaced by the real thing later.
 
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
-use glam::{Mat3, Mat4, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3};
 
 use super::{LoadOptions, SceneParts, finish, is_degenerate};
 use crate::description::{
@@ -32,6 +32,10 @@ const MAX_TEXTURE_PIXELS: u64 = 64 << 20;
 pub(crate) struct IndexedMesh {
     pub(crate) positions: Vec<Vec3>,
     pub(crate) normals: Option<Vec<Vec3>>,
+    /// Per-vertex texture coordinates in fppm's convention (v = 0 at the image's top row, see
+    /// [`crate::texture`]): Mitsuba's own uv as read (its bitmaps put v = 0 at the top), pbrt's
+    /// with v flipped by [`IndexedMesh::flip_v`].
+    pub(crate) uvs: Option<Vec<Vec2>>,
     pub(crate) indices: Vec<[u32; 3]>,
 }
 
@@ -50,6 +54,17 @@ impl IndexedMesh {
             && normals.len() != n
         {
             return Err(format!("{} normals for {n} vertices", normals.len()));
+        }
+        if let Some(uvs) = &self.uvs {
+            if uvs.len() != n {
+                return Err(format!(
+                    "{} texture coordinates for {n} vertices",
+                    uvs.len()
+                ));
+            }
+            if let Some(uv) = uvs.iter().find(|uv| !uv.is_finite()) {
+                return Err(format!("non-finite texture coordinate {uv}"));
+            }
         }
         if let Some(p) = self.positions.iter().find(|p| !p.is_finite()) {
             return Err(format!("non-finite vertex position {p}"));
@@ -77,7 +92,9 @@ impl IndexedMesh {
         self.normals = Some(normals.into_iter().map(Vec3::normalize_or_zero).collect());
     }
 
-    /// Mitsuba's `rectangle`: [−1, 1]² in the z = 0 plane, front face +z.
+    /// Mitsuba's `rectangle`: [−1, 1]² in the z = 0 plane, front face +z, with Mitsuba's
+    /// texture coordinates uv = ((x + 1)/2, (y + 1)/2) (`src/shapes/rectangle.cpp`, its vertex
+    /// records), which its bitmaps read with v = 0 at the image's top row, as fppm does.
     pub(crate) fn rectangle() -> Self {
         Self {
             positions: vec![
@@ -87,7 +104,23 @@ impl IndexedMesh {
                 Vec3::new(-1.0, 1.0, 0.0),
             ],
             normals: None,
+            uvs: Some(vec![
+                Vec2::new(0.0, 0.0),
+                Vec2::new(1.0, 0.0),
+                Vec2::new(1.0, 1.0),
+                Vec2::new(0.0, 1.0),
+            ]),
             indices: vec![[0, 1, 2], [0, 2, 3]],
+        }
+    }
+
+    /// Flips every texture coordinate's v (v → 1 − v): from a format whose v = 0 is the
+    /// image's bottom row (pbrt) to fppm's convention.
+    pub(crate) fn flip_v(&mut self) {
+        if let Some(uvs) = &mut self.uvs {
+            for uv in uvs {
+                uv.y = 1.0 - uv.y;
+            }
         }
     }
 
@@ -115,8 +148,7 @@ impl IndexedMesh {
     pub(crate) fn disk() -> Self {
         let mut mesh = Self {
             positions: vec![Vec3::ZERO],
-            normals: None,
-            indices: Vec::new(),
+            ..Self::default()
         };
         for i in 0..DISK_SEGMENTS {
             let phi = std::f32::consts::TAU * i as f32 / DISK_SEGMENTS as f32;
@@ -183,7 +215,15 @@ impl Builder {
 
     /// Adds a mesh transformed by `to_world`. A transform that mirrors (negative determinant)
     /// swaps the winding so that the front face follows the transformed normals.
+    ///
+    /// Texture coordinates are kept only for a textured material, so that an untextured scene's
+    /// description (and its checkpoint fingerprint) is what it was before importers read uv.
     pub(crate) fn mesh(&mut self, mesh: &IndexedMesh, to_world: Mat4, material: u32) {
+        let textured = self
+            .materials
+            .get(material as usize)
+            .is_some_and(|m| m.textures.is_some());
+        let uvs = mesh.uvs.as_ref().filter(|_| textured);
         if to_world == Mat4::IDENTITY {
             // Keep the file's numbers bit for bit (no renormalised normals).
             for face in &mesh.indices {
@@ -202,7 +242,8 @@ impl Builder {
                         })
                     })
                     .filter(|n| n.iter().all(|v| *v != Vec3::ZERO));
-                self.triangle(positions, n, material);
+                let uv = uvs.map(|uvs| face.map(|i| uvs[i as usize]));
+                self.triangle(positions, n, uv, material);
             }
             return;
         }
@@ -228,7 +269,8 @@ impl Builder {
                 .as_ref()
                 .map(|ns| f.map(|i| ns[i as usize]))
                 .filter(|n| n.iter().all(|v| *v != Vec3::ZERO));
-            self.triangle(positions, n, material);
+            let uv = uvs.map(|uvs| f.map(|i| uvs[i as usize]));
+            self.triangle(positions, n, uv, material);
         }
     }
 
@@ -237,6 +279,7 @@ impl Builder {
         &mut self,
         positions: [Vec3; 3],
         normals: Option<[Vec3; 3]>,
+        uv: Option<[Vec2; 3]>,
         material: u32,
     ) {
         if is_degenerate(positions) {
@@ -248,7 +291,7 @@ impl Builder {
             positions,
             normals,
             material,
-            uv: None,
+            uv,
         });
     }
 

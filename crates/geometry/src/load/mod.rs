@@ -14,7 +14,7 @@
 //!   [`MAX_FILM_SIDE`].
 //! - Triangles with zero area are skipped and counted, never an error.
 
-mod files;
+pub(crate) mod files;
 mod frame;
 mod gltf;
 mod gltf_document;

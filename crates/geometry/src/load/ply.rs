@@ -1,16 +1,18 @@
 //! PLY meshes (ASCII and binary, little- or big-endian; gzip'd `.ply.gz` too) through the
 //! ply-rs-bw crate, for Mitsuba's `ply` shape and pbrt's `plymesh`.
 //!
-//! Read: `vertex` x, y, z (any numeric type), nx, ny, nz when all three are present, and
-//! `face` index lists (`vertex_indices` or `vertex_index`; polygons become fans, as Mitsuba and
-//! pbrt do for quads). Other elements and properties (colours, uv) are ignored. Before the
+//! Read: `vertex` x, y, z (any numeric type), nx, ny, nz when all three are present, texture
+//! coordinates under the names Mitsuba and pbrt read (u/v, s/t, texture_u/texture_v,
+//! texture_s/texture_t), kept as in the file, and `face` index lists (`vertex_indices` or
+//! `vertex_index`; polygons become fans, as Mitsuba and pbrt do for quads). Other elements and
+//! properties (colours) are ignored. Before the
 //! payload is parsed the header's element counts are checked against the file's size, so a
 //! header that lies about its size is an error rather than a huge allocation.
 
 use std::io::{Cursor, Read};
 use std::path::Path;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Encoding, Property, PropertyType, ScalarType};
 
@@ -104,13 +106,29 @@ pub(crate) fn parse_ply(path: &Path, bytes: &[u8]) -> Result<IndexedMesh, LoadEr
 
     let mut mesh = IndexedMesh::default();
     if let Some(vertices) = ply.payload.get("vertex") {
-        let has_normals = ["nx", "ny", "nz"].iter().all(|k| {
+        let has = |k: &str| {
             header
                 .elements
                 .get("vertex")
-                .is_some_and(|e| e.properties.contains_key(*k))
-        });
+                .is_some_and(|e| e.properties.contains_key(k))
+        };
+        let has_normals = ["nx", "ny", "nz"].iter().all(|k| has(k));
+        // The pairs Mitsuba (`src/shapes/ply.cpp`, `has_uv_fields`) and pbrt-v4
+        // (`src/pbrt/util/mesh.cpp`, `TriQuadMesh::ReadPLY`) accept, in their order.
+        let uv_names = [
+            ("u", "v"),
+            ("s", "t"),
+            ("texture_u", "texture_v"),
+            ("texture_s", "texture_t"),
+        ]
+        .into_iter()
+        .find(|(u, v)| has(u) && has(v));
         let mut normals = Vec::with_capacity(if has_normals { vertices.len() } else { 0 });
+        let mut uvs = Vec::with_capacity(if uv_names.is_some() {
+            vertices.len()
+        } else {
+            0
+        });
         mesh.positions.reserve(vertices.len());
         for (i, v) in vertices.iter().enumerate() {
             let get = |k: &str| -> Result<f32, LoadError> {
@@ -123,9 +141,15 @@ pub(crate) fn parse_ply(path: &Path, bytes: &[u8]) -> Result<IndexedMesh, LoadEr
             if has_normals {
                 normals.push(Vec3::new(get("nx")?, get("ny")?, get("nz")?));
             }
+            if let Some((u, v)) = uv_names {
+                uvs.push(Vec2::new(get(u)?, get(v)?));
+            }
         }
         if has_normals {
             mesh.normals = Some(normals);
+        }
+        if uv_names.is_some() {
+            mesh.uvs = Some(uvs);
         }
     } else {
         return Err(ply_error(path, "no `vertex` element"));
@@ -206,6 +230,39 @@ mod tests {
         assert_eq!(mesh.positions.len(), 4);
         assert_eq!(mesh.indices, vec![[0, 1, 2], [0, 2, 3]]);
         assert!(mesh.normals.is_none());
+    }
+
+    #[test]
+    fn texture_coordinates_are_read_under_each_name() {
+        for (u, v) in [
+            ("u", "v"),
+            ("s", "t"),
+            ("texture_u", "texture_v"),
+            ("texture_s", "texture_t"),
+        ] {
+            let text = ASCII_QUAD
+                .replace(
+                    "property float z\n",
+                    &format!("property float z\nproperty float {u}\nproperty float {v}\n"),
+                )
+                .replace(
+                    "0 0 0\n1 0 0\n1 1 0\n0 1 0\n",
+                    "0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 0.5\n0 1 0 0 0.5\n",
+                );
+            let mesh = parse_ply(Path::new("q.ply"), text.as_bytes()).unwrap();
+            assert_eq!(
+                mesh.uvs,
+                Some(vec![
+                    Vec2::new(0.0, 0.0),
+                    Vec2::new(1.0, 0.0),
+                    Vec2::new(1.0, 0.5),
+                    Vec2::new(0.0, 0.5)
+                ]),
+                "{u}/{v}"
+            );
+        }
+        let plain = parse_ply(Path::new("q.ply"), ASCII_QUAD.as_bytes()).unwrap();
+        assert!(plain.uvs.is_none());
     }
 
     #[test]

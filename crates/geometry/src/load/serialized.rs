@@ -144,9 +144,13 @@ pub(crate) fn parse_serialized(
     } else {
         None
     };
-    if flags & HAS_TEXCOORDS != 0 {
-        z.skip(vertex_count * 2 * if double { 8 } else { 4 })?;
-    }
+    // Mitsuba reads these texture coordinates as they are (no flip), with v = 0 at the image's
+    // top row: fppm's convention.
+    let uvs = if flags & HAS_TEXCOORDS != 0 {
+        Some(z.vec2s(vertex_count, double)?)
+    } else {
+        None
+    };
     if flags & HAS_COLORS != 0 {
         z.skip(vertex_count * 3 * if double { 8 } else { 4 })?;
     }
@@ -157,6 +161,7 @@ pub(crate) fn parse_serialized(
     let mesh = IndexedMesh {
         positions,
         normals,
+        uvs,
         indices,
     };
     mesh.check_indices()
@@ -204,6 +209,13 @@ impl<R: Read> Stream<'_, R> {
                 self.float(double)?,
                 self.float(double)?,
             ));
+        }
+        Ok(out)
+    }
+    fn vec2s(&mut self, n: usize, double: bool) -> Result<Vec<glam::Vec2>, LoadError> {
+        let mut out = Vec::with_capacity(n.min(1 << 24));
+        for _ in 0..n {
+            out.push(glam::Vec2::new(self.float(double)?, self.float(double)?));
         }
         Ok(out)
     }

@@ -43,7 +43,7 @@ impl TextureCache {
         if let Some(image) = self.images.get(path) {
             return Ok(Arc::clone(image));
         }
-        let bytes = std::fs::read(path).map_err(|e| {
+        let bytes = crate::load::files::read(path).map_err(|e| {
             texture_error(
                 path,
                 format!(

@@ -6,6 +6,7 @@ mod bad_input;
 mod cylinder;
 mod fuzz_regressions;
 mod gltf;
+mod import_textures;
 mod mitsuba;
 mod obj;
 mod pbrt;

@@ -348,7 +348,7 @@ fn missing_texture_file() {
             "line 4",
             "<texture type=\"bitmap\"",
             "wood.png",
-            "cannot read file",
+            "cannot read texture",
         ],
     );
 }

@@ -46,8 +46,14 @@ impl<'a> Importer<'a> {
             .attr("id")
             .map(str::to_owned)
             .unwrap_or_else(|| format!("{}@{}", node.attr("type").unwrap_or("bsdf"), node.line));
-        let kind = self.bsdf_kind(node, &name)?;
-        let c = ConvertedBsdf { name, kind };
+        let mut textures = MaterialTextures::default();
+        let kind = self.bsdf_kind(node, &name, &mut textures)?;
+        let textures = (!textures.is_empty()).then(|| std::sync::Arc::new(textures));
+        let c = ConvertedBsdf {
+            name,
+            kind,
+            textures,
+        };
         self.bsdf_cache.insert(key, c.clone());
         Ok(c)
     }
@@ -118,34 +124,48 @@ impl<'a> Importer<'a> {
         Ok(alpha as f32)
     }
 
+    /// The scattering model of a BSDF; its image textures go to `textures`.
     pub(super) fn bsdf_kind(
         &mut self,
         node: &'a Node,
         name: &str,
+        textures: &mut MaterialTextures,
     ) -> Result<Option<MaterialKind>, LoadError> {
         let label = node.label();
         let ty = node.attr("type").unwrap_or("");
         let refl = SpectrumUse::Reflectance;
         Ok(Some(match ty {
-            "diffuse" => MaterialKind::Diffuse {
-                albedo: self
-                    .colour(node, "reflectance", refl)?
-                    .unwrap_or(Rgb::splat(DEFAULT_REFLECTANCE)),
-            },
+            "diffuse" => {
+                let (albedo, texture) = self
+                    .textured_colour(node, "reflectance", refl)?
+                    .unwrap_or((Rgb::splat(DEFAULT_REFLECTANCE), None));
+                textures.color = texture;
+                MaterialKind::Diffuse { albedo }
+            }
             "twosided" => {
                 let inner = self.inner_bsdf(node)?;
-                return Ok(self.bsdf(inner)?.kind);
+                let inner = self.bsdf(inner)?;
+                *textures = inner.textures.as_deref().cloned().unwrap_or_default();
+                return Ok(inner.kind);
             }
-            "mask" | "bumpmap" | "normalmap" | "blendbsdf" => {
+            "mask" => {
+                let inner = self.inner_bsdf(node)?;
+                let inner = self.bsdf(inner)?;
+                *textures = inner.textures.as_deref().cloned().unwrap_or_default();
+                textures.alpha = Some(self.mask_opacity(node)?);
+                return Ok(inner.kind);
+            }
+            "bumpmap" | "normalmap" | "blendbsdf" => {
                 let what = match ty {
-                    "mask" => "its opacity is ignored (the surface is opaque)",
                     "blendbsdf" => "only its first BSDF is used",
                     _ => "the normal perturbation is ignored",
                 };
                 self.builder
                     .warn(format!("{label}: {what}; the nested BSDF stands in"));
                 let inner = self.inner_bsdf(node)?;
-                return Ok(self.bsdf(inner)?.kind);
+                let inner = self.bsdf(inner)?;
+                *textures = inner.textures.as_deref().cloned().unwrap_or_default();
+                return Ok(inner.kind);
             }
             "conductor" | "roughconductor" => {
                 let reflectance = self.conductor_reflectance(node, &label)?;
@@ -191,9 +211,16 @@ impl<'a> Importer<'a> {
                 let specular = self
                     .colour(node, "specular_reflectance", refl)?
                     .unwrap_or(Rgb::ONE);
-                let diffuse = self
-                    .colour(node, "diffuse_reflectance", refl)?
-                    .unwrap_or(Rgb::splat(DEFAULT_REFLECTANCE));
+                let (diffuse, texture) = self
+                    .textured_colour(node, "diffuse_reflectance", refl)?
+                    .unwrap_or((Rgb::splat(DEFAULT_REFLECTANCE), None));
+                if texture.is_some() {
+                    self.builder.warn(format!(
+                        "{label}: the diffuse_reflectance bitmap tints the coating's reflection too \
+                         (fppm's colour texture multiplies its whole glossy-over-diffuse material)"
+                    ));
+                }
+                textures.color = texture;
                 let alpha = if ty == "roughplastic" {
                     self.alpha(node, &label)?
                 } else {

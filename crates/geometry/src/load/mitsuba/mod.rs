@@ -8,8 +8,10 @@
 //!   so they apply in document order; `<matrix>` is row-major; `<lookat>` builds the frame
 //!   (left, up, forward) with the camera looking down its +z;
 //! - `<spectrum>` values become RGB as Mitsuba's RGB variants do ([`super::spectrum`]);
-//! - colours given by a texture stand in as a constant (`Importer::texture_standin`); environment
-//!   emitters are skipped with a warning ([`super::import::environment_light_standin`]);
+//! - `bitmap` textures of a diffuse reflectance, a plastic's diffuse reflectance and a `mask`'s
+//!   opacity become image textures (`textures.rs`); other textured colours stand in as a
+//!   constant (`Importer::texture_standin`); environment emitters that fppm cannot render are
+//!   skipped with a warning ([`super::import::environment_light_standin`]);
 //! - the integrator's `max_depth` (longest path in segments, Mitsuba's convention) becomes
 //!   fppm's `max_depth` (scattering events) minus one; its `rr_depth` is carried as is.
 
@@ -18,6 +20,7 @@ mod emitters;
 mod properties;
 mod sensor;
 mod shapes;
+mod textures;
 mod transforms;
 mod xml;
 
@@ -34,6 +37,7 @@ use crate::description::{
     Camera, Film, Light, Material, MaterialKind, RenderDefaults, Rgb, SceneDescription,
 };
 use crate::error::LoadError;
+use crate::texture::MaterialTextures;
 
 /// Reflectance of Mitsuba's default BSDF (a shape without one) and of `diffuse` without one.
 const DEFAULT_REFLECTANCE: f32 = 0.5;
@@ -56,6 +60,7 @@ pub(crate) fn load_mitsuba(
         ids,
         builder: Builder::default(),
         bsdf_cache: HashMap::new(),
+        images: crate::texture::TextureCache::default(),
     };
     let mut camera = None;
     let mut film = DEFAULT_FILM;
@@ -120,6 +125,8 @@ fn collect_ids<'a>(
 struct ConvertedBsdf {
     name: String,
     kind: Option<MaterialKind>,
+    /// Its image textures (diffuse colour, cut-out), if any.
+    textures: Option<std::sync::Arc<crate::texture::MaterialTextures>>,
 }
 
 struct Importer<'a> {
@@ -128,6 +135,8 @@ struct Importer<'a> {
     builder: Builder,
     /// BSDFs by node address, so that shared BSDFs convert (and warn) once.
     bsdf_cache: HashMap<usize, ConvertedBsdf>,
+    /// The images of the scene's bitmaps, each decoded once.
+    images: crate::texture::TextureCache,
 }
 
 /// The property child named `name`.

@@ -215,7 +215,7 @@ impl<'a> Importer<'a> {
                 let (rgb, what) = import::image_texture_standin(&path)
                     .map_err(|e| self.err(tex, e.to_string()))?;
                 self.builder.warn(format!(
-                    "{label} ({file}): textures are not supported yet; {what} {} stands in",
+                    "{label} ({file}): this property cannot be textured in fppm; {what} {} stands in",
                     super::super::fmt_vec(rgb)
                 ));
                 Ok(rgb)
@@ -229,7 +229,7 @@ impl<'a> Importer<'a> {
                     .unwrap_or(Rgb::splat(0.2));
                 let rgb = 0.5 * (a + b);
                 self.builder.warn(format!(
-                    "{label}: textures are not supported yet; the mean of its two colours {} stands in",
+                    "{label}: procedural textures are not supported; the mean of its two colours {} stands in",
                     super::super::fmt_vec(rgb)
                 ));
                 Ok(rgb)

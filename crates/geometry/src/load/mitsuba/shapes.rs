@@ -74,6 +74,7 @@ impl<'a> Importer<'a> {
                 kind: Some(MaterialKind::Diffuse {
                     albedo: Rgb::splat(DEFAULT_REFLECTANCE),
                 }),
+                textures: None,
             },
         };
         let Some(kind) = bsdf.kind else {
@@ -96,7 +97,7 @@ impl<'a> Importer<'a> {
             name,
             kind,
             emission,
-            textures: None,
+            textures: bsdf.textures.clone(),
         });
         let to_world = parent * self.transform(node, "to_world")?;
         let m = to_world.as_mat4();
@@ -114,7 +115,9 @@ impl<'a> Importer<'a> {
                         let data = super::super::obj::load_obj(&path).map_err(wrap)?;
                         let mut mesh = IndexedMesh::default();
                         let mut all_normals = true;
+                        let mut all_uvs = true;
                         let mut normals = Vec::new();
+                        let mut uvs = Vec::new();
                         for t in &data.triangles {
                             let base = mesh.positions.len() as u32;
                             mesh.positions.extend_from_slice(&t.positions);
@@ -122,10 +125,19 @@ impl<'a> Importer<'a> {
                                 Some(n) => normals.extend_from_slice(&n),
                                 None => all_normals = false,
                             }
+                            match t.uv {
+                                Some(uv) => uvs.extend_from_slice(&uv),
+                                None => all_uvs = false,
+                            }
                             mesh.indices.push([base, base + 1, base + 2]);
                         }
                         if all_normals && !data.triangles.is_empty() {
                             mesh.normals = Some(normals);
+                        }
+                        if all_uvs && !data.triangles.is_empty() {
+                            // fppm's OBJ reader flips v as Mitsuba's does by default
+                            // (`flip_tex_coords`, true for OBJ in src/shapes/obj.cpp).
+                            mesh.uvs = Some(uvs);
                         }
                         mesh
                     }
@@ -137,6 +149,17 @@ impl<'a> Importer<'a> {
                         super::super::serialized::load_serialized(&path, index).map_err(wrap)?
                     }
                 };
+                // Mitsuba's `flip_tex_coords` (v → 1 − v): true by default for OBJ, false for
+                // PLY; `.serialized` meshes have no such option.
+                let flip_default = ty == "obj";
+                if ty != "serialized"
+                    && self
+                        .boolean(node, "flip_tex_coords")?
+                        .unwrap_or(flip_default)
+                        != flip_default
+                {
+                    mesh.flip_v();
+                }
                 if face_normals {
                     mesh.normals = None;
                 } else if mesh.normals.is_none() && ty != "obj" {

@@ -49,7 +49,11 @@ impl Parser {
             }
             None => (None, DMat4::IDENTITY),
         };
-        let mut material_cache: HashMap<String, Option<MaterialKind>> = HashMap::new();
+        type Converted = Option<(
+            MaterialKind,
+            Option<std::sync::Arc<crate::texture::MaterialTextures>>,
+        )>;
+        let mut material_cache: HashMap<String, Converted> = HashMap::new();
         let shapes = std::mem::take(&mut self.shapes);
         for (n, shape) in shapes.iter().enumerate() {
             let (key, def) = match &shape.state.material {
@@ -69,23 +73,35 @@ impl Parser {
                 MaterialRef::Anonymous(i) => format!("#{i}"),
                 _ => key.clone(),
             };
-            let kind = match material_cache.get(&cache_key) {
-                Some(k) => *k,
+            let converted = match material_cache.get(&cache_key) {
+                Some(k) => k.clone(),
                 None => {
                     let k = match &def {
                         Some(def) => {
                             let label = format!("Material \"{}\" ({key})", def.kind);
-                            self.material(def, &label)?
+                            let mut color = None;
+                            self.material(def, &label, &mut color)?.map(|kind| {
+                                let textures = color.map(|c| {
+                                    std::sync::Arc::new(crate::texture::MaterialTextures {
+                                        color: Some(c),
+                                        ..Default::default()
+                                    })
+                                });
+                                (kind, textures)
+                            })
                         }
-                        None => Some(MaterialKind::Diffuse {
-                            albedo: Rgb::splat(0.5),
-                        }),
+                        None => Some((
+                            MaterialKind::Diffuse {
+                                albedo: Rgb::splat(0.5),
+                            },
+                            None,
+                        )),
                     };
-                    material_cache.insert(cache_key, k);
+                    material_cache.insert(cache_key, k.clone());
                     k
                 }
             };
-            let Some(kind) = kind else {
+            let Some((kind, textures)) = converted else {
                 continue;
             };
             let emission = match &shape.state.area {
@@ -120,7 +136,7 @@ impl Parser {
                 name,
                 kind,
                 emission,
-                textures: None,
+                textures,
             });
             let to_world = fix * shape.state.ctm;
             self.shape(

@@ -155,6 +155,7 @@ pub(crate) fn subdivide(positions: &[Vec3], faces: &[[u32; 3]], levels: u32) -> 
     let mut mesh = IndexedMesh {
         positions: limit,
         normals: None,
+        uvs: None,
         indices: f,
     };
     mesh.compute_vertex_normals();

@@ -1,4 +1,4 @@
-//! Materials and the constant colours standing in for their textures.
+//! Materials and the constant colours standing in for the textures fppm cannot use.
 
 use super::*;
 
@@ -37,7 +37,7 @@ impl Parser {
                 let (rgb, what) = import::image_texture_standin(&path)
                     .map_err(|e| self.err(def.loc, e.to_string()))?;
                 self.warn(format!(
-                    "Texture \"{name}\" (imagemap {file}): textures are not supported yet; {what} {} stands in",
+                    "Texture \"{name}\" (imagemap {file}): this use cannot be textured in fppm; {what} {} stands in",
                     super::super::fmt_vec(rgb)
                 ));
                 rgb
@@ -61,7 +61,7 @@ impl Parser {
                 let b = self.sub_texture(&def, "tex2", depth)?.unwrap_or(Rgb::ZERO);
                 let rgb = 0.5 * (a + b);
                 self.warn(format!(
-                    "Texture \"{name}\" (checkerboard): textures are not supported yet; the mean of its two colours {} stands in",
+                    "Texture \"{name}\" (checkerboard): procedural textures are not supported; the mean of its two colours {} stands in",
                     super::super::fmt_vec(rgb)
                 ));
                 rgb
@@ -134,21 +134,25 @@ impl Parser {
         Ok(if remap { r.sqrt() } else { r })
     }
 
-    /// Converts a material definition; `None` for `interface` (invisible).
+    /// Converts a material definition; `None` for `interface` (invisible). An image texture
+    /// of its (diffuse) reflectance goes to `color`.
     pub(super) fn material(
         &mut self,
         def: &MaterialDef,
         label: &str,
+        color: &mut Option<crate::texture::TextureRef>,
     ) -> Result<Option<MaterialKind>, LoadError> {
         let p = def.params.clone();
         let refl = SpectrumUse::Reflectance;
         let remap = self.boolean(&p, "remaproughness")?.unwrap_or(true);
         Ok(Some(match def.kind.as_str() {
-            "diffuse" => MaterialKind::Diffuse {
-                albedo: self
-                    .colour(&p, "reflectance", refl)?
-                    .unwrap_or(Rgb::splat(0.5)),
-            },
+            "diffuse" => {
+                let (albedo, texture) = self
+                    .textured_colour(&p, "reflectance")?
+                    .unwrap_or((Rgb::splat(0.5), None));
+                *color = texture;
+                MaterialKind::Diffuse { albedo }
+            }
             "conductor" | "coatedconductor" => {
                 let prefix = if def.kind == "coatedconductor" {
                     "conductor."
@@ -223,9 +227,16 @@ impl Parser {
                 MaterialKind::Dielectric { ior: eta }
             }
             "coateddiffuse" => {
-                let reflectance = self
-                    .colour(&p, "reflectance", refl)?
-                    .unwrap_or(Rgb::splat(0.5));
+                let (reflectance, texture) = self
+                    .textured_colour(&p, "reflectance")?
+                    .unwrap_or((Rgb::splat(0.5), None));
+                if texture.is_some() {
+                    self.warn(format!(
+                        "{label}: the reflectance texture tints the coating's reflection too \
+                         (fppm's colour texture multiplies its whole glossy-over-diffuse material)"
+                    ));
+                }
+                *color = texture;
                 let alpha = self.alpha(&p, "roughness", remap)?;
                 let alpha = if alpha > 0.0 {
                     alpha

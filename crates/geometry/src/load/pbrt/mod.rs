@@ -25,6 +25,7 @@ mod materials;
 mod params;
 mod parser;
 mod shapes;
+mod textures;
 mod tokenizer;
 
 use std::collections::HashMap;
@@ -60,6 +61,7 @@ pub(crate) fn load_pbrt(path: &Path, options: &LoadOptions) -> Result<SceneDescr
         materials: Vec::new(),
         named_materials: HashMap::new(),
         textures: HashMap::new(),
+        images: crate::texture::TextureCache::default(),
         shapes: Vec::new(),
         objects: HashMap::new(),
         current_object: None,
@@ -191,6 +193,8 @@ struct Parser {
     materials: Vec<MaterialDef>,
     named_materials: HashMap<String, MaterialDef>,
     textures: HashMap<String, TextureDef>,
+    /// The images of the imagemap textures, each decoded once.
+    images: crate::texture::TextureCache,
     shapes: Vec<ShapeRecord>,
     objects: HashMap<String, Vec<ShapeRecord>>,
     current_object: Option<(String, Vec<ShapeRecord>)>,

@@ -153,6 +153,35 @@ impl Parser {
         ))
     }
 
+    /// A list of 2D points (`point2 uv`).
+    pub(super) fn vec2s(
+        &self,
+        params: &Params,
+        name: &str,
+        types: &[&str],
+    ) -> Result<Option<Vec<glam::Vec2>>, LoadError> {
+        let Some(p) = params.get(name) else {
+            return Ok(None);
+        };
+        self.expect_type(p, types)?;
+        let v = self.nums(p)?;
+        if v.len() % 2 != 0 {
+            return Err(self.err(
+                Self::loc_of_param(p),
+                format!(
+                    "parameter \"{} {name}\" needs a multiple of 2 values, got {}",
+                    p.ty,
+                    v.len()
+                ),
+            ));
+        }
+        Ok(Some(
+            v.chunks(2)
+                .map(|c| glam::Vec2::new(c[0] as f32, c[1] as f32))
+                .collect(),
+        ))
+    }
+
     pub(super) fn ints(&self, params: &Params, name: &str) -> Result<Option<Vec<i64>>, LoadError> {
         let Some(p) = params.get(name) else {
             return Ok(None);

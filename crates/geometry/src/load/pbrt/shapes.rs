@@ -21,6 +21,7 @@ impl Parser {
                     .vec3s(p, "P", &["point3", "point"])?
                     .ok_or_else(|| self.err(loc, format!("{label} needs \"point3 P\"")))?;
                 let normals = self.vec3s(p, "N", &["normal", "normal3"])?;
+                let uvs = self.vec2s(p, "uv", &["point2", "float"])?;
                 let indices = match self.ints(p, "indices")? {
                     Some(i) => i,
                     None if positions.len() == 3 && shape.kind == "trianglemesh" => vec![0, 1, 2],
@@ -62,6 +63,7 @@ impl Parser {
                 let mesh = IndexedMesh {
                     positions,
                     normals: normals.filter(|_| shape.kind == "trianglemesh"),
+                    uvs: uvs.filter(|_| shape.kind != "loopsubdiv"),
                     indices: faces,
                 };
                 mesh.check_indices()
@@ -160,6 +162,21 @@ impl Parser {
         if shape.state.reverse {
             mesh.flip();
         }
+        let textured = builder
+            .materials
+            .get(material as usize)
+            .is_some_and(|m| m.textures.is_some());
+        if textured && mesh.uvs.is_none() {
+            builder.warn(format!(
+                "{label} at {}:{}: a textured material on a mesh without uv; fppm's default \
+                 (the barycentrics) stands in for pbrt's",
+                self.files[loc.file].display(),
+                loc.line
+            ));
+        }
+        // pbrt's image textures look up (s, 1 − t) with (0, 0) the image's top-left texel
+        // (`SpectrumImageTexture::Evaluate`, src/pbrt/textures.cpp): v = 0 is the bottom row.
+        mesh.flip_v();
         builder.mesh(&mesh, m, material);
         Ok(())
     }
