@@ -30,7 +30,7 @@ independent halves of --reference-seconds / 2 each (kept in DIR/SCENE/ and reuse
 to re-render). Reports relMSE (mean of (x - ref)^2 / (ref^2 + 0.01)) over all pixels and over
 the pixels whose first hit is diffuse, the reference's own noise in the same units, and the
 image mean over the reference's. A method may carry switches of its own after `+`:
-`sppm+light-tracing` renders `--method sppm --light-tracing`. Writes DIR/SCENE/*.exr and DIR/table.md; DIR defaults to
+`sppm+no-light-tracing` renders `--method sppm --no-light-tracing`. Writes DIR/SCENE/*.exr and DIR/table.md; DIR defaults to
 target/peers. The Mitsuba venv is created in target/peers-venv on first use (pip install
 mitsuba drjit numpy; the llvm_ad_rgb variant needs Debian's libllvm19).";
 
@@ -181,7 +181,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         for method in &flags.methods {
             let file = dir.join(format!("fppm-{method}.exr"));
             eprintln!("{name}: fppm {method} for {} s", flags.seconds);
-            // `sppm+light-tracing`: the method, then switches of its own.
+            // `sppm+no-light-tracing`: the method, then switches of its own.
             let mut parts = method.split('+');
             let method_name = parts.next().unwrap_or(method);
             let switches: Vec<String> = parts.map(|s| format!("--{s}")).collect();

@@ -28,7 +28,9 @@ const SLOT_CHUNK: usize = 64;
 /// as PPM weights the slot, plus the directly seen emission averaged over `emission_passes`
 /// camera passes with PPM's own jitter (those of its passes 0, 1, …).
 ///
-/// Deterministic for any thread count. Cost: `paths_per_point` paths per slot.
+/// Deterministic for any thread count. Cost: `paths_per_point` paths per slot. It is what
+/// PPM converges to when it only gathers: with `light_tracing` the connections converge to
+/// the pixel's average instead, so compare renders made without them.
 ///
 /// # Errors
 ///
@@ -57,10 +59,7 @@ pub fn pointwise_reference_paths(
     paths: std::ops::Range<u32>,
     emission_passes: u32,
 ) -> Result<Vec<[f32; 3]>, ParamError> {
-    if params.method.is_stochastic()
-        || !params.method.is_photon_mapper()
-        || params.direct_lighting
-        || params.light_tracing
+    if params.method.is_stochastic() || !params.method.is_photon_mapper() || params.direct_lighting
     {
         return Err(ParamError::NoFixedHitpoints {
             method: params.method.name(),

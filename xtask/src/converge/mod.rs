@@ -263,6 +263,11 @@ fn base_params(
 ) -> Result<ppm::RenderParams> {
     let mut params = suite::params(entry, scene, method, flags.seed)?;
     params.photons_per_pass = flags.photons;
+    // Against the pointwise reference (the radiance at PPM's fixed hitpoints) the renders
+    // gather only: light-traced connections converge to the pixel's average instead.
+    if flags.pointwise.is_some() {
+        params.light_tracing = false;
+    }
     flags.overrides.apply(&mut params)?;
     Ok(params)
 }

@@ -229,11 +229,8 @@ pub enum ParamError {
         samples_per_pixel: u32,
     },
     /// A pointwise reference was asked for a method without fixed hitpoints, or with direct
-    /// lighting at the hitpoints (whose estimate re-jitters every pass), or with light tracing
-    /// (which converges to the pixel's average).
-    #[error(
-        "a pointwise reference needs ppm or freq without direct lighting or light tracing, not {method}"
-    )]
+    /// lighting at the hitpoints (whose estimate re-jitters every pass).
+    #[error("a pointwise reference needs ppm or freq without direct lighting, not {method}")]
     NoFixedHitpoints {
         /// The method's name.
         method: &'static str,
@@ -275,7 +272,7 @@ impl RenderParams {
             freq_pilot: 4,
             freq_clear_cap: false,
             freq_probe_share: true,
-            light_tracing: false,
+            light_tracing: true,
         }
     }
 

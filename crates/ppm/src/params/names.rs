@@ -317,9 +317,9 @@ pub const PARAMS: &[Param] = &[
     },
     Param {
         name: "light_tracing",
-        flag: "light-tracing",
-        help: "Photon mappers: connect every stored photon to the camera too and weight that against merging by multiple importance sampling (vertex connection and merging for directly seen surfaces)",
-        kind: ParamKind::Switch { sets: true },
+        flag: "no-light-tracing",
+        help: "Photon mappers: do not connect stored photons to the camera (by default they are, where kernels cover at most two camera samples, and weighted against merging by multiple importance sampling)",
+        kind: ParamKind::Switch { sets: false },
         get: |p| on_off(p.light_tracing),
         set: |p, v| {
             p.light_tracing = parse_switch(v)?;
@@ -532,7 +532,7 @@ mod tests {
         params.freq_hold_alpha = 1.0;
         params.freq_pilot = 0;
         params.freq_clear_cap = true;
-        params.light_tracing = true;
+        params.light_tracing = false;
         params.freq_probe_share = false;
         for base in [RenderParams::preview(), params] {
             let mut copy = RenderParams::preview();

@@ -71,11 +71,24 @@ fn the_estimate_covers_what_a_render_holds() {
 #[test]
 fn the_estimate_follows_the_flags() {
     let mut p = params(Method::FreqSppm, 100_000);
+    // Light tracing's buffers grow with the slots per pixel too (below).
+    p.light_tracing = false;
     let base = MemoryEstimate::of(100, 100, &p);
     p.samples_per_pixel = 4;
     let spp = MemoryEstimate::of(100, 100, &p);
     assert_eq!(spp.hitpoints, 4 * base.hitpoints);
     assert_eq!(spp.photons, base.photons);
+    p.light_tracing = true;
+    let light = MemoryEstimate::of(100, 100, &p);
+    assert!(light.hitpoints > spp.hitpoints);
+    p.samples_per_pixel = 1;
+    let light_one = MemoryEstimate::of(100, 100, &p);
+    assert_eq!(
+        light.photons - base.photons,
+        4 * (light_one.photons - base.photons)
+    );
+    p.samples_per_pixel = 4;
+    p.light_tracing = false;
     p.photons_per_pass = 1_000_000;
     assert_eq!(MemoryEstimate::of(100, 100, &p).photons, 10 * base.photons);
     let path = params(Method::Path, 100_000);
