@@ -42,6 +42,7 @@ use crate::error::LoadError;
 use crate::validate;
 pub(crate) use crate::validate::fmt_vec;
 
+pub(crate) use files::read as read_file;
 pub use files::{FileSource, MemoryFiles};
 pub use frame::FRAMED_FOV_Y_DEGREES;
 pub(crate) use frame::{bounds, frame_camera};

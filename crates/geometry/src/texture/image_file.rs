@@ -43,7 +43,9 @@ impl TextureCache {
         if let Some(image) = self.images.get(path) {
             return Ok(Arc::clone(image));
         }
-        let bytes = std::fs::read(path).map_err(|e| {
+        // Through the loader's file source, so that scenes loaded from memory
+        // (`geometry::load_from`) find their textures there too.
+        let bytes = crate::load::read_file(path).map_err(|e| {
             texture_error(
                 path,
                 format!(

@@ -47,6 +47,32 @@ fn memory_files_load_a_scene_and_its_references() {
     assert_eq!(d.triangles[0].positions[1], glam::Vec3::X);
 }
 
+/// Textures are read through the file source too (the `texture` fuzz target serves them from
+/// memory); before, the texture cache read the file system whatever the source.
+#[test]
+fn memory_files_serve_the_textures_of_a_scene() {
+    let mut png = io::Cursor::new(Vec::new());
+    image::RgbImage::from_pixel(2, 1, image::Rgb([255, 0, 0]))
+        .write_to(&mut png, image::ImageFormat::Png)
+        .unwrap();
+    let toml = "format = 1\n[materials.red]\ntype = \"diffuse\"\n\
+                albedo = { texture = \"tex/red.png\" }\n\
+                [[shapes]]\ntype = \"quad\"\ncorner = [0, 0, 0]\nedge1 = [1, 0, 0]\n\
+                edge2 = [0, 1, 0]\nmaterial = \"red\"\n";
+    let files = MemoryFiles::new()
+        .with("/mem/scene.toml", toml)
+        .with("/mem/tex/red.png", png.into_inner());
+    let d = load_memory("/mem/scene.toml", files).unwrap();
+    let textures = d.materials[0]
+        .textures
+        .as_deref()
+        .expect("a textured material");
+    let color = textures.color.as_ref().expect("an albedo texture");
+    assert_eq!(color.image.resolution(), (2, 1));
+    // An 8-bit colour texture is sRGB-decoded: 255 is 1, 0 is 0.
+    assert_eq!(color.color(glam::Vec2::new(0.5, 0.5)), glam::Vec3::X);
+}
+
 #[test]
 fn a_resolver_closure_serves_files_and_missing_ones_name_the_path() {
     let obj = "mtllib nowhere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
