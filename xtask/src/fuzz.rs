@@ -345,13 +345,13 @@ fn report_line(name: &str, s: &Stats) -> String {
 fn table(results: &[(String, Stats)]) -> String {
     let opt = |v: Option<u64>| v.map_or_else(|| "?".to_owned(), |v| v.to_string());
     let mut out = format!(
-        "{:<14} {:>12} {:>8} {:>7} {:>8} {:>12} {:>8}\n",
+        "{:<18} {:>12} {:>8} {:>7} {:>8} {:>12} {:>8}\n",
         "target", "executions", "exec/s", "cov", "ft", "corpus", "crashes"
     );
     for (name, s) in results {
         let _ = writeln!(
             out,
-            "{:<14} {:>12} {:>8} {:>7} {:>8} {:>12} {:>8}",
+            "{:<18} {:>12} {:>8} {:>7} {:>8} {:>12} {:>8}",
             name,
             opt(s.executions),
             opt(s.exec_per_sec),
