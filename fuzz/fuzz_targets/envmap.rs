@@ -1,12 +1,14 @@
 //! An environment map loaded from bytes and sampled. The input's first byte chooses how:
 //!
-//! - 0 (mod 3): the rest is an OpenEXR file, served as `sky.exr` to a tiny TOML scene
+//! - 0 (mod 4): the rest is an OpenEXR file, served as `sky.exr` to a tiny TOML scene
 //!   (`fuzz/stubs/envmap_scene.toml`) through the in-memory file source;
 //! - 1: the same as a Radiance `sky.hdr`;
 //! - 2: the rest is raw texels: a height byte (1 to 16 rows, twice as many columns), a scale
 //!   (f32), a rotation (three f32, degrees), then f32 texel channels (little-endian, repeated to
 //!   fill the map), whatever their bits: zero, NaN, negative, subnormal, huge. They replace the
-//!   scene's environment before `Scene::new`, which must refuse what it cannot sample.
+//!   scene's environment before `Scene::new`, which must refuse what it cannot sample;
+//! - 3: the rest is a square equal-area map (OpenEXR) of a pbrt `infinite` light
+//!   (`fuzz/stubs/envmap_scene.pbrt`), which the importer resamples to an equirectangular map.
 //!
 //! If the scene builds, the environment is sampled for next-event estimation (`sample_direct`),
 //! evaluated (`environment_radiance`), its density asked (`pdf_environment`), and photons leave
@@ -15,7 +17,7 @@
 
 use std::sync::{Arc, LazyLock};
 
-use fppm_fuzz::{envmap_files, fuzzed};
+use fppm_fuzz::{envmap_files, envmap_pbrt_files, fuzzed};
 use geometry::{
     Environment, EnvironmentMap, EnvironmentRadiance, LoadOptions, Scene, SceneDescription,
 };
@@ -81,7 +83,14 @@ fuzz_target!(|data: &[u8]| {
     let Some((&mode, rest)) = data.split_first() else {
         return;
     };
-    let description = match mode % 3 {
+    let description = match mode % 4 {
+        3 => {
+            let (path, files) = envmap_pbrt_files(rest.to_vec());
+            match geometry::load_from(&path, files, &LoadOptions::allow_no_emitter()) {
+                Ok(d) => d,
+                Err(_) => return,
+            }
+        }
         m @ (0 | 1) => {
             let (path, files) = envmap_files(rest.to_vec(), m == 1);
             match geometry::load_from(&path, files, &LoadOptions::allow_no_emitter()) {

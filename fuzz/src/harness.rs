@@ -143,6 +143,26 @@ pub fn envmap_files(
     })
 }
 
+/// The pbrt scene of the `envmap` target's mode 3: an `infinite` light of `sky.exr`.
+pub const ENVMAP_PBRT_SCENE: &str = include_str!("../stubs/envmap_scene.pbrt");
+
+/// [`ENVMAP_PBRT_SCENE`] with `image` served as its (square, equal-area) map.
+pub fn envmap_pbrt_files(
+    image: Vec<u8>,
+) -> (PathBuf, impl Fn(&Path) -> io::Result<Vec<u8>> + 'static) {
+    let scene = fuzzed("envmap_scene.pbrt");
+    let served = scene.clone();
+    (scene, move |p: &Path| {
+        if p == served {
+            Ok(ENVMAP_PBRT_SCENE.as_bytes().to_vec())
+        } else if p.file_name().is_some_and(|n| n == "sky.exr") {
+            Ok(image.clone())
+        } else {
+            Err(io::ErrorKind::NotFound.into())
+        }
+    })
+}
+
 /// The plan fingerprint the `part` target reads its parts for.
 pub const PART_PLAN: u64 = 0x5eed_f022_0000_0019;
 

@@ -639,8 +639,9 @@ mod seeds {
     }
 
     /// Inputs of the `envmap` target: 2:1 maps as OpenEXR (mode 0) and Radiance HDR (mode 1),
-    /// one written by `film` as `fppm` writes its images, and raw texels (mode 2) with zero,
-    /// negative, subnormal, huge and NaN values.
+    /// one written by `film` as `fppm` writes its images, raw texels (mode 2) with zero,
+    /// negative, subnormal, huge and NaN values, and a square map of a pbrt `infinite` light
+    /// (mode 3).
     pub(super) fn environment_maps(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
         use image::{DynamicImage, ImageFormat, Rgb, Rgb32FImage};
         let sky = Rgb32FImage::from_fn(8, 4, |x, y| {
@@ -654,6 +655,12 @@ mod seeds {
             let mut out = std::io::Cursor::new(Vec::new());
             DynamicImage::ImageRgb32F(sky.clone()).write_to(&mut out, format)?;
             Ok(out.into_inner())
+        };
+        let square = {
+            let mut out = std::io::Cursor::new(Vec::new());
+            let map = Rgb32FImage::from_fn(4, 4, |x, y| Rgb([x as f32, y as f32, 0.5]));
+            DynamicImage::ImageRgb32F(map).write_to(&mut out, ImageFormat::OpenExr)?;
+            out.into_inner()
         };
         let with_mode = |mode: u8, bytes: Vec<u8>| {
             let mut seed = vec![mode];
@@ -674,6 +681,7 @@ mod seeds {
             ),
             ("sky-hdr".into(), with_mode(1, encode(ImageFormat::Hdr)?)),
             ("film-exr".into(), with_mode(0, tiny_exr_2to1(root)?)),
+            ("pbrt-square-exr".into(), with_mode(3, square)),
             (
                 "raw-sun".into(),
                 raw(1, 1.0, &[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1e4, 1e4, 1e4]),
@@ -812,13 +820,18 @@ mod tests {
                 continue;
             }
             files += 1;
-            let (path, files) = harness::envmap_files(bytes.to_vec(), *mode == 1);
-            let d = load_from(&path, files, &LoadOptions::default())
-                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let d = if *mode == 3 {
+                let (path, files) = harness::envmap_pbrt_files(bytes.to_vec());
+                load_from(&path, files, &LoadOptions::default())
+            } else {
+                let (path, files) = harness::envmap_files(bytes.to_vec(), *mode == 1);
+                load_from(&path, files, &LoadOptions::default())
+            }
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
             let scene = geometry::Scene::new(d).unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(scene.lights().has_environment(), "{name}");
         }
-        assert_eq!(files, 3);
+        assert_eq!(files, 4);
     }
 
     /// The part seeds decode through the `part` target's framing, each as the part it was made
