@@ -289,3 +289,21 @@ fn gltf_accessor_layouts_gltf_cannot_read_are_errors() {
         "no items (count 0)",
     );
 }
+
+/// Found by the `envmap` fuzz target: a 453-byte EXR declaring a data window of
+/// 520 093 700 × 2 texels was decoded (two seconds and 2 GB of memory) before the map was found
+/// not to be 2:1. Its size is now checked from the header, before anything is decoded.
+#[test]
+fn environment_map_declaring_a_huge_image_is_refused_from_its_header() {
+    let exr = include_bytes!("../fuzz/envmap-huge-data-window.exr");
+    let toml = "format = 1\n[materials.grey]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n\
+                [[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"grey\"\n\
+                [[lights]]\ntype = \"environment\"\nfile = \"sky.exr\"\n";
+    let files = MemoryFiles::new()
+        .with("/mem/scene.toml", toml)
+        .with("/mem/sky.exr", exr.to_vec());
+    let err = load_memory("/mem/scene.toml", files).expect_err("the map must be refused");
+    assert!(matches!(err, LoadError::EnvironmentMap { .. }), "{err:?}");
+    assert_names_file(&err, Path::new("/mem/sky.exr"));
+    assert!(err.to_string().contains("520093700×2, not 2:1"), "{err}");
+}
