@@ -1,7 +1,8 @@
 //! The parts of the fuzz harness that need neither libFuzzer nor `arbitrary`: the stub files
-//! served for the files a fuzzed scene refers to, and the checkpoint framing. `xtask` includes
-//! this file too (`xtask/src/fuzz.rs`), to build the checkpoint seeds with the same framing and
-//! to test, in the normal test suite, that the stubs load.
+//! served for the files a fuzzed scene refers to, the fixed scenes of the texture and
+//! environment-map targets, and the framing of checkpoints, checkpoint columns and work-unit
+//! parts. `xtask` includes this file too (`xtask/src/fuzz.rs`), to build the seeds with the same
+//! framing and to test, in the normal test suite, that the stubs and seeds load.
 
 use std::io;
 use std::path::{Path, PathBuf};

@@ -23,8 +23,9 @@ and prints per target the executions, executions per second, coverage (libFuzzer
 (`rustup toolchain install nightly`, `cargo install cargo-fuzz`).
 
 Seeds are built at every run into target/fuzz-seeds/<target>/ from the repository's scenes,
-tests/golden/ and ../shared/scenes (small files only, read in place), and checkpoints of the
-checkpoint target's scene; what the fuzzer finds accumulates in fuzz/corpus/<target>/, crashing
+tests/golden/ and ../shared/scenes (small files only, read in place), checkpoints (and their
+columns) and work-unit parts of the checkpoint target's scene, and small images and environment
+maps it writes; what the fuzzer finds accumulates in fuzz/corpus/<target>/, crashing
 inputs in fuzz/artifacts/<target>/, libFuzzer's log in target/fuzz-logs/<target>.log.
 Exit status 1 if a target crashed.
 
