@@ -165,6 +165,7 @@ impl EnvironmentMap {
                 );
                 Self::check_size(w, h, square).map_err(bad)?;
             }
+            crate::texture::check_exr_header(&bytes, MAX_MAP_TEXELS).map_err(bad)?;
         }
         let (width, height) = image::ImageReader::with_format(std::io::Cursor::new(&bytes), format)
             .into_dimensions()

@@ -307,3 +307,26 @@ fn environment_map_declaring_a_huge_image_is_refused_from_its_header() {
     assert_names_file(&err, Path::new("/mem/sky.exr"));
     assert!(err.to_string().contains("520093700×2, not 2:1"), "{err}");
 }
+
+/// Found by the `texture` fuzz target (as a timeout of the dev-profile build): a 519-byte EXR
+/// texture whose display window is 16 252 927 × 2 texels was decoded into an image that large,
+/// 3.7 s and 1 GB in a release build. Its windows are now bounded by the file's size before
+/// decoding, as `film`'s EXR reader bounds its samples.
+#[test]
+fn texture_declaring_a_huge_data_window_is_refused_from_its_header() {
+    let exr = include_bytes!("../fuzz/texture-huge-data-window.exr");
+    let toml = "format = 1\n[materials.t]\ntype = \"diffuse\"\nalbedo = { texture = \"t.exr\" }\n\
+                [[shapes]]\ntype = \"quad\"\ncorner = [0, 0, 0]\nedge1 = [1, 0, 0]\n\
+                edge2 = [0, 1, 0]\nmaterial = \"t\"\n";
+    let files = MemoryFiles::new()
+        .with("/mem/scene.toml", toml)
+        .with("/mem/t.exr", exr.to_vec());
+    let err = load_memory("/mem/scene.toml", files).expect_err("the texture must be refused");
+    assert!(matches!(err, LoadError::Texture { .. }), "{err:?}");
+    assert_names_file(&err, Path::new("/mem/t.exr"));
+    assert!(
+        err.to_string()
+            .contains("more than a 519-byte file can hold"),
+        "{err}"
+    );
+}
