@@ -23,8 +23,9 @@ and prints per target the executions, executions per second, coverage (libFuzzer
 (`rustup toolchain install nightly`, `cargo install cargo-fuzz`).
 
 Seeds are built at every run into target/fuzz-seeds/<target>/ from the repository's scenes,
-tests/golden/ and ../shared/scenes (small files only, read in place), and checkpoints of the
-checkpoint target's scene; what the fuzzer finds accumulates in fuzz/corpus/<target>/, crashing
+tests/golden/ and ../shared/scenes (small files only, read in place), checkpoints (and their
+columns) and work-unit parts of the checkpoint target's scene, and small images and environment
+maps it writes; what the fuzzer finds accumulates in fuzz/corpus/<target>/, crashing
 inputs in fuzz/artifacts/<target>/, libFuzzer's log in target/fuzz-logs/<target>.log.
 Exit status 1 if a target crashed.
 
@@ -39,7 +40,7 @@ Exit status 1 if a target crashed.
   --list           print the targets and exit";
 
 /// The targets: (name, dictionary in fuzz/dict/ or none).
-const TARGETS: [(&str, Option<&str>); 10] = [
+const TARGETS: [(&str, Option<&str>); 14] = [
     ("toml_scene", Some("toml.dict")),
     ("obj", Some("obj.dict")),
     ("gltf", Some("gltf.dict")),
@@ -50,10 +51,18 @@ const TARGETS: [(&str, Option<&str>); 10] = [
     ("checkpoint", None),
     ("exr", None),
     ("scene_render", None),
+    ("part", None),
+    ("texture", Some("image.dict")),
+    ("envmap", Some("image.dict")),
+    ("checkpoint_columns", None),
 ];
 
 /// Largest seed file taken from the scenes: the fuzzer mutates small inputs much faster.
 const MAX_SEED_BYTES: u64 = 64 << 10;
+
+/// Largest image taken from the scenes as a texture seed: a few kilobytes of PNG can hold a
+/// large image, whose decoding slows every execution.
+const MAX_IMAGE_SEED_BYTES: u64 = 8 << 10;
 
 struct Flags {
     seconds: u64,
@@ -337,13 +346,13 @@ fn report_line(name: &str, s: &Stats) -> String {
 fn table(results: &[(String, Stats)]) -> String {
     let opt = |v: Option<u64>| v.map_or_else(|| "?".to_owned(), |v| v.to_string());
     let mut out = format!(
-        "{:<14} {:>12} {:>8} {:>7} {:>8} {:>12} {:>8}\n",
+        "{:<18} {:>12} {:>8} {:>7} {:>8} {:>12} {:>8}\n",
         "target", "executions", "exec/s", "cov", "ft", "corpus", "crashes"
     );
     for (name, s) in results {
         let _ = writeln!(
             out,
-            "{:<14} {:>12} {:>8} {:>7} {:>8} {:>12} {:>8}",
+            "{:<18} {:>12} {:>8} {:>7} {:>8} {:>12} {:>8}",
             name,
             opt(s.executions),
             opt(s.exec_per_sec),
@@ -427,6 +436,28 @@ mod seeds {
                     seeds.insert(name, bytes);
                 }
             }
+            "part" => seeds.extend(parts()?),
+            "texture" => {
+                seeds.extend(images()?);
+                for f in find(&shared, &["png", "jpg", "jpeg", "exr", "hdr"]) {
+                    if std::fs::metadata(&f).is_ok_and(|m| m.len() <= MAX_IMAGE_SEED_BYTES)
+                        && let Ok(bytes) = std::fs::read(&f)
+                    {
+                        seeds.insert(seed_name(&f), bytes);
+                    }
+                }
+            }
+            "envmap" => seeds.extend(environment_maps(root)?),
+            "checkpoint_columns" => {
+                let scene = harness::checkpoint_scene();
+                for (i, (name, _, columns)) in
+                    harness::column_checkpoints(&scene).into_iter().enumerate()
+                {
+                    let mut seed = vec![i as u8];
+                    seed.extend_from_slice(&columns);
+                    seeds.insert(name, seed);
+                }
+            }
             _ => {}
         }
         seeds.retain(|_, bytes| bytes.len() as u64 <= MAX_SEED_BYTES);
@@ -495,6 +526,190 @@ mod seeds {
         let mut frame = film::Frame::new(film::Image::new(3, 2, pixels));
         frame.add_aov(&["depth"], &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
         film::write_exr(&path, &frame)?;
+        let bytes = std::fs::read(&path)?;
+        std::fs::remove_file(&path)?;
+        Ok(bytes)
+    }
+
+    /// Parts for the `part` target (its mode 2, fields and decompressed sums, and the same parts
+    /// as files in modes 0 and 1): the exact sums of two `appm` passes of the checkpoint
+    /// target's scene, and hand-made parts with zero, negative and extreme sums.
+    pub(super) fn parts() -> Result<Vec<(String, Vec<u8>)>> {
+        let scene = harness::checkpoint_scene();
+        let mut params = ppm::RenderParams::preview();
+        params.method = ppm::Method::Appm;
+        params.photons_per_pass = 64;
+        params.max_depth = 8;
+        let mut renderer = ppm::Renderer::new(&scene, params)?;
+        renderer.iterate();
+        renderer.iterate();
+        let rendered = renderer
+            .pass_sums()
+            .context("an appm renderer has pass sums")?
+            .clone();
+        let part = |unit, first_pass, passes, sums: Vec<[i128; 3]>| ppm::Part {
+            plan: harness::PART_PLAN,
+            unit,
+            first_pass,
+            sums: ppm::PassSums { passes, sums },
+        };
+        let parts = [
+            (
+                "rendered",
+                part(1, 2, rendered.passes, rendered.sums.clone()),
+            ),
+            ("zero", part(0, 0, 0, vec![[0; 3]])),
+            ("small", part(3, 7, 2, vec![[1, -1, 1 << 64]; 4])),
+            (
+                "extreme",
+                part(
+                    u32::MAX,
+                    u32::MAX,
+                    u64::MAX,
+                    vec![[i128::MAX, i128::MIN, -1]; 2],
+                ),
+            ),
+        ];
+        let mut out = Vec::new();
+        for (name, p) in parts {
+            let pixels = u8::try_from(p.sums.sums.len() - 1)?;
+            out.push((format!("{name}-fields"), harness::part_input(&p, pixels)));
+            let file = p.to_bytes();
+            let mut raw = vec![0, pixels];
+            raw.extend_from_slice(&file);
+            out.push((format!("{name}-file"), raw));
+            // Mode 1: the file without its magic, version, plan and checksum.
+            let mut framed = vec![1, pixels];
+            framed.extend_from_slice(&file[20..file.len() - 8]);
+            out.push((format!("{name}-compressed"), framed));
+        }
+        Ok(out)
+    }
+
+    /// Small images of every kind the texture loader reads: 8- and 16-bit PNG (grey, RGB,
+    /// RGBA with a mask), JPEG, OpenEXR (half and float) and Radiance HDR. The JPEG, EXR and HDR
+    /// encoders are the `image` features `geometry` enables (Cargo unifies them).
+    pub(super) fn images() -> Result<Vec<(String, Vec<u8>)>> {
+        use image::{DynamicImage, ImageBuffer, ImageFormat, Luma, Rgb, Rgb32FImage, Rgba};
+        let encode = |img: DynamicImage, format: ImageFormat| -> Result<Vec<u8>> {
+            let mut out = std::io::Cursor::new(Vec::new());
+            img.write_to(&mut out, format)?;
+            Ok(out.into_inner())
+        };
+        let rgb8 = ImageBuffer::from_fn(3, 2, |x, y| Rgb([(x * 80) as u8, (y * 200) as u8, 30]));
+        let rgba8 = ImageBuffer::from_fn(2, 2, |x, y| {
+            Rgba([200, 100, 50, if x == y { 255 } else { 0 }])
+        });
+        let grey = ImageBuffer::from_fn(4, 4, |x, y| Luma([((x + y) * 30) as u8]));
+        let rgb16: ImageBuffer<Rgb<u16>, Vec<u16>> =
+            ImageBuffer::from_fn(2, 1, |x, _| Rgb([x as u16 * 40000, 1000, 65535]));
+        let float = Rgb32FImage::from_fn(3, 2, |x, y| Rgb([x as f32 * 0.5, y as f32 * 2.0, 0.25]));
+        Ok(vec![
+            (
+                "rgb8.png".into(),
+                encode(DynamicImage::ImageRgb8(rgb8.clone()), ImageFormat::Png)?,
+            ),
+            (
+                "rgba8.png".into(),
+                encode(DynamicImage::ImageRgba8(rgba8), ImageFormat::Png)?,
+            ),
+            (
+                "grey.png".into(),
+                encode(DynamicImage::ImageLuma8(grey), ImageFormat::Png)?,
+            ),
+            (
+                "rgb16.png".into(),
+                encode(DynamicImage::ImageRgb16(rgb16), ImageFormat::Png)?,
+            ),
+            (
+                "rgb8.jpg".into(),
+                encode(DynamicImage::ImageRgb8(rgb8), ImageFormat::Jpeg)?,
+            ),
+            (
+                "float.exr".into(),
+                encode(
+                    DynamicImage::ImageRgb32F(float.clone()),
+                    ImageFormat::OpenExr,
+                )?,
+            ),
+            (
+                "float.hdr".into(),
+                encode(DynamicImage::ImageRgb32F(float), ImageFormat::Hdr)?,
+            ),
+        ])
+    }
+
+    /// Inputs of the `envmap` target: 2:1 maps as OpenEXR (mode 0) and Radiance HDR (mode 1),
+    /// one written by `film` as `fppm` writes its images, raw texels (mode 2) with zero,
+    /// negative, subnormal, huge and NaN values, and a square map of a pbrt `infinite` light
+    /// (mode 3).
+    pub(super) fn environment_maps(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
+        use image::{DynamicImage, ImageFormat, Rgb, Rgb32FImage};
+        let sky = Rgb32FImage::from_fn(8, 4, |x, y| {
+            Rgb([
+                1.0 + x as f32,
+                0.5 * (y as f32),
+                if x == 3 && y == 1 { 50.0 } else { 0.2 },
+            ])
+        });
+        let encode = |format: ImageFormat| -> Result<Vec<u8>> {
+            let mut out = std::io::Cursor::new(Vec::new());
+            DynamicImage::ImageRgb32F(sky.clone()).write_to(&mut out, format)?;
+            Ok(out.into_inner())
+        };
+        let square = {
+            let mut out = std::io::Cursor::new(Vec::new());
+            let map = Rgb32FImage::from_fn(4, 4, |x, y| Rgb([x as f32, y as f32, 0.5]));
+            DynamicImage::ImageRgb32F(map).write_to(&mut out, ImageFormat::OpenExr)?;
+            out.into_inner()
+        };
+        let with_mode = |mode: u8, bytes: Vec<u8>| {
+            let mut seed = vec![mode];
+            seed.extend(bytes);
+            seed
+        };
+        let raw = |rows: u8, scale: f32, texels: &[f32]| {
+            let mut seed = vec![2, rows];
+            for v in [scale, 0.0, 30.0, 0.0].iter().chain(texels) {
+                seed.extend_from_slice(&v.to_le_bytes());
+            }
+            seed
+        };
+        Ok(vec![
+            (
+                "sky-exr".into(),
+                with_mode(0, encode(ImageFormat::OpenExr)?),
+            ),
+            ("sky-hdr".into(), with_mode(1, encode(ImageFormat::Hdr)?)),
+            ("film-exr".into(), with_mode(0, tiny_exr_2to1(root)?)),
+            ("pbrt-square-exr".into(), with_mode(3, square)),
+            (
+                "raw-sun".into(),
+                raw(1, 1.0, &[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1e4, 1e4, 1e4]),
+            ),
+            (
+                "raw-mixed".into(),
+                raw(2, 2.0, &[0.0, -1.0, 1e-40, 3e38, 1.0, f32::NAN, 0.5]),
+            ),
+            ("raw-huge".into(), raw(0, 1e30, &[1e30, 2e30, 3e30])),
+        ])
+    }
+
+    /// A 4 × 2 EXR written by `film` (half the texels black).
+    fn tiny_exr_2to1(root: &Path) -> Result<Vec<u8>> {
+        let dir = root.join("target/fuzz-seeds");
+        std::fs::create_dir_all(&dir)?;
+        let path = dir.join("sky.exr");
+        let pixels = (0..8)
+            .map(|i| {
+                if i % 2 == 0 {
+                    [0.0; 3]
+                } else {
+                    [i as f32, 1.0, 0.5]
+                }
+            })
+            .collect();
+        film::write_exr(&path, &film::Frame::new(film::Image::new(4, 2, pixels)))?;
         let bytes = std::fs::read(&path)?;
         std::fs::remove_file(&path)?;
         Ok(bytes)
@@ -572,6 +787,78 @@ mod tests {
         assert_eq!(seeds.len(), 2 * ppm::Method::ALL.len());
         for (name, body) in &seeds {
             let bytes = harness::checkpoint_bytes(&scene, body);
+            let restored = ppm::Renderer::restore(&scene, &bytes);
+            assert!(restored.is_ok(), "{name}: {:?}", restored.err());
+        }
+    }
+
+    /// Every texture seed loads through the `texture` target's scene: a harness whose seeds
+    /// failed to load would only fuzz the decoders' error paths.
+    #[test]
+    fn texture_seeds_load_as_textures() {
+        let seeds = seeds::images().unwrap();
+        assert_eq!(seeds.len(), 7);
+        for (name, bytes) in seeds {
+            let (path, files) = harness::texture_files(bytes);
+            let d = load_from(&path, files, &LoadOptions::default())
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let textured = d.materials.iter().filter(|m| m.textures.is_some()).count();
+            assert_eq!(textured, 2, "{name}: the floor and the sign are textured");
+            geometry::Scene::new(d).unwrap_or_else(|e| panic!("{name}: {e}"));
+        }
+    }
+
+    /// The file seeds of the `envmap` target load as the scene's environment; the raw-texel
+    /// seeds are what the target decodes (mode byte 2).
+    #[test]
+    fn environment_map_seeds_load() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let seeds = seeds::environment_maps(&root).unwrap();
+        let mut files = 0;
+        for (name, seed) in &seeds {
+            let (mode, bytes) = seed.split_first().unwrap();
+            if *mode == 2 {
+                continue;
+            }
+            files += 1;
+            let d = if *mode == 3 {
+                let (path, files) = harness::envmap_pbrt_files(bytes.to_vec());
+                load_from(&path, files, &LoadOptions::default())
+            } else {
+                let (path, files) = harness::envmap_files(bytes.to_vec(), *mode == 1);
+                load_from(&path, files, &LoadOptions::default())
+            }
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let scene = geometry::Scene::new(d).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(scene.lights().has_environment(), "{name}");
+        }
+        assert_eq!(files, 4);
+    }
+
+    /// The part seeds decode through the `part` target's framing, each as the part it was made
+    /// from, in all three modes.
+    #[test]
+    fn part_seeds_decode_through_the_harness_framing() {
+        let seeds = seeds::parts().unwrap();
+        assert_eq!(seeds.len(), 4 * 3);
+        for (name, seed) in &seeds {
+            let (bytes, pixels) = harness::part_bytes(seed);
+            let part = ppm::Part::from_bytes(&bytes, harness::PART_PLAN, pixels)
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(part.sums.sums.len(), pixels, "{name}");
+            assert_eq!(part.to_bytes(), bytes, "{name}: the same part");
+        }
+    }
+
+    /// The column seeds, joined to their heads as the `checkpoint_columns` target does,
+    /// restore.
+    #[test]
+    fn checkpoint_column_seeds_restore() {
+        let scene = harness::checkpoint_scene();
+        let split = harness::column_checkpoints(&scene);
+        assert_eq!(split.len(), 2 * ppm::Method::ALL.len());
+        for (name, head, columns) in &split {
+            let bytes = ppm::checkpoint_surgery::join(head, columns);
             let restored = ppm::Renderer::restore(&scene, &bytes);
             assert!(restored.is_ok(), "{name}: {:?}", restored.err());
         }

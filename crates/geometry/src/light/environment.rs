@@ -144,28 +144,35 @@ impl EnvironmentMap {
             }
         };
         let bytes = crate::load::read_bytes(path)?;
-        let (width, height, rgb) = decode_hdr_image(&bytes, format).map_err(|e| {
+        let cannot_decode = |e: String| {
             bad(format!(
                 "cannot decode image: {}",
                 crate::error::lower_first(&e)
             ))
-        })?;
-        if width == 0 || height == 0 {
-            return Err(bad(format!("image has zero size ({width}×{height})")));
+        };
+        // The size the header declares is checked before anything is decoded: a file of a few
+        // hundred bytes can declare a billion texels.
+        // `image` reports an EXR's display window, so the data windows (what is decoded) are
+        // read with `exr`.
+        if format == image::ImageFormat::OpenExr {
+            let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(&bytes), false)
+                .map_err(|e| cannot_decode(e.to_string()))?;
+            for header in &meta.headers {
+                let size = header.layer_size;
+                let (w, h) = (
+                    u32::try_from(size.0).unwrap_or(u32::MAX),
+                    u32::try_from(size.1).unwrap_or(u32::MAX),
+                );
+                Self::check_size(w, h, square).map_err(bad)?;
+            }
+            crate::texture::check_exr_header(&bytes, MAX_MAP_TEXELS).map_err(bad)?;
         }
-        if !(if square {
-            width == height
-        } else {
-            width == 2 * height
-        }) {
-            return Err(bad(if square {
-                format!("image is {width}×{height}, not square (an equal-area octahedral map)")
-            } else {
-                format!(
-                    "image is {width}×{height}, not 2:1 (an equirectangular map is twice as wide as high)"
-                )
-            }));
-        }
+        let (width, height) = image::ImageReader::with_format(std::io::Cursor::new(&bytes), format)
+            .into_dimensions()
+            .map_err(|e| cannot_decode(e.to_string()))?;
+        Self::check_size(width, height, square).map_err(bad)?;
+        let (width, height, rgb) = decode_hdr_image(&bytes, format).map_err(cannot_decode)?;
+        Self::check_size(width, height, square).map_err(bad)?;
         let mut negative = 0;
         let mut texels = Vec::with_capacity(rgb.len() / 3);
         for (i, c) in rgb.chunks_exact(3).enumerate() {
@@ -198,6 +205,45 @@ impl EnvironmentMap {
         ))
     }
 }
+
+impl EnvironmentMap {
+    /// Whether a map of `width` × `height` texels can be used: not empty, 2:1 (square when
+    /// `square`), and at most [`MAX_MAP_TEXELS`] texels once resampled (a square map of side n
+    /// becomes 4n × 2n).
+    fn check_size(width: u32, height: u32, square: bool) -> Result<(), String> {
+        if width == 0 || height == 0 {
+            return Err(format!("image has zero size ({width}×{height})"));
+        }
+        if !(if square {
+            width == height
+        } else {
+            width == 2 * height
+        }) {
+            return Err(if square {
+                format!("image is {width}×{height}, not square (an equal-area octahedral map)")
+            } else {
+                format!(
+                    "image is {width}×{height}, not 2:1 (an equirectangular map is twice as wide as high)"
+                )
+            });
+        }
+        let texels = u64::from(width) * u64::from(height) * if square { 8 } else { 1 };
+        if texels > MAX_MAP_TEXELS {
+            return Err(format!(
+                "image of {width}×{height} texels is larger than the {MAX_MAP_TEXELS} texels accepted{}",
+                if square {
+                    " once resampled to 4n × 2n"
+                } else {
+                    ""
+                }
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Largest environment map accepted, in texels (the image textures' bound: 8192 × 8192).
+const MAX_MAP_TEXELS: u64 = 64 << 20;
 
 /// Decodes an HDR image file into linear RGB floats (width, height, 3 values per texel).
 /// The one place this module touches an image decoder.

@@ -43,6 +43,8 @@ impl TextureCache {
         if let Some(image) = self.images.get(path) {
             return Ok(Arc::clone(image));
         }
+        // Through the loader's file source, so that scenes loaded from memory
+        // (`geometry::load_from`) find their textures there too.
         let bytes = crate::load::files::read(path).map_err(|e| {
             texture_error(
                 path,
@@ -69,6 +71,50 @@ impl TextureCache {
         self.images.insert(key.to_path_buf(), Arc::clone(&image));
         Ok(image)
     }
+}
+
+/// Largest ratio of pixel data to file size an EXR can have (as `film`'s EXR reader bounds it:
+/// deflate expands at most 1032 times, RLE 64 times, B44 is fixed-rate).
+const MAX_EXR_COMPRESSION_RATIO: u64 = 2048;
+
+/// Checks an EXR's headers before `image` decodes it: `image` allocates the display window and
+/// decodes the data windows, either of which a file of a few hundred bytes can declare a billion texels
+/// large. Each window must hold at most `max_texels` texels, and no more sample bytes (and
+/// no more texels) than the file's size allows at the largest compression ratio of EXR.
+pub(crate) fn check_exr_header(bytes: &[u8], max_texels: u64) -> Result<(), String> {
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
+        .map_err(|e| {
+            format!(
+                "corrupt exr image: {}",
+                crate::error::lower_first(&e.to_string())
+            )
+        })?;
+    for header in &meta.headers {
+        let (w, h) = (header.layer_size.0 as u64, header.layer_size.1 as u64);
+        let display = header.shared_attributes.display_window.size;
+        for (w, h) in [(w, h), (display.0 as u64, display.1 as u64)] {
+            if w * h > max_texels {
+                return Err(format!(
+                    "image of {w}x{h} texels is larger than the {max_texels} accepted"
+                ));
+            }
+        }
+        let samples: u64 = header.channels.list.iter().fold(0, |sum, c| {
+            let n = (w / c.sampling.0.max(1) as u64) * (h / c.sampling.1.max(1) as u64);
+            sum.saturating_add(n.saturating_mul(c.sample_type.bytes_per_sample() as u64))
+        });
+        // Subsampled channels hold fewer samples, but `image` decodes every texel of the
+        // window: at least one byte each counts too.
+        let display = header.shared_attributes.display_window.size;
+        let samples = samples.max(w * h).max(display.0 as u64 * display.1 as u64);
+        if samples / MAX_EXR_COMPRESSION_RATIO > bytes.len() as u64 {
+            return Err(format!(
+                "its header declares a {w}x{h} image ({samples} bytes of samples), more than a {}-byte file can hold",
+                bytes.len()
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Decodes an image file's bytes (PNG, JPEG, EXR, Radiance HDR, told apart by their contents).
@@ -106,6 +152,9 @@ pub(crate) fn decode(path: &Path, bytes: &[u8]) -> Result<Image, LoadError> {
             ),
         )
     };
+    if format == ImageFormat::OpenExr {
+        check_exr_header(bytes, MAX_TEXELS).map_err(|e| texture_error(path, e))?;
+    }
     let (width, height) = reader.into_dimensions().map_err(corrupt)?;
     if width == 0 || height == 0 {
         return Err(texture_error(

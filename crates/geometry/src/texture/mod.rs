@@ -18,7 +18,7 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3, Vec4};
 
-pub(crate) use image_file::TextureCache;
+pub(crate) use image_file::{TextureCache, check_exr_header};
 
 /// A decoded image, loaded once per file and shared by every material that uses it.
 #[derive(Clone)]
@@ -128,13 +128,16 @@ impl Image {
         if !(fx.is_finite() && fy.is_finite()) {
             return self.texel(0, 0, srgb);
         }
+        // `as` saturates a coordinate beyond the range of i64 (a texture coordinate of 10³⁰ from
+        // a mesh file), and so must the next texel's index.
+        let (x0, y0) = (x0 as i64, y0 as i64);
         let xs = [
-            wrap[0].index(x0 as i64, self.width),
-            wrap[0].index(x0 as i64 + 1, self.width),
+            wrap[0].index(x0, self.width),
+            wrap[0].index(x0.saturating_add(1), self.width),
         ];
         let ys = [
-            wrap[1].index(y0 as i64, self.height),
-            wrap[1].index(y0 as i64 + 1, self.height),
+            wrap[1].index(y0, self.height),
+            wrap[1].index(y0.saturating_add(1), self.height),
         ];
         let t = |i: usize, j: usize| self.texel(xs[i], ys[j], srgb);
         (t(0, 0) * (1.0 - fx) + t(1, 0) * fx) * (1.0 - fy)

@@ -25,6 +25,34 @@ fn wrap_modes_index_as_gltf_defines_them() {
     assert_eq!(got, [0, 0, 0, 1, 2, 3, 3, 3]);
 }
 
+/// Found by the `texture` fuzz target: a texture coordinate beyond the range of i64 overflowed
+/// the index of the next texel.
+#[test]
+fn huge_texture_coordinates_look_up_an_edge_texel() {
+    // A 2x1 image, black then white (data, not sRGB).
+    let img = image(2, 1, vec![[0, 0, 0, 255], [255, 255, 255, 255]]);
+    let mut t = TextureRef::new(img, false);
+    for wrap in [Wrap::Repeat, Wrap::Mirror, Wrap::Clamp] {
+        t.wrap = [wrap; 2];
+        for uv in [
+            (1e30, -1e30),
+            (-1e30, 1e30),
+            (f32::MAX, 0.5),
+            (f32::MIN, 0.5),
+        ] {
+            let c = t.color(Vec2::new(uv.0, uv.1));
+            assert!(
+                c.is_finite() && c.x >= 0.0 && c.x <= 1.0,
+                "{c} at {uv:?}, {wrap:?}"
+            );
+        }
+    }
+    // Clamped, far right is the white texel and far left the black one.
+    t.wrap = [Wrap::Clamp; 2];
+    assert_eq!(t.color(Vec2::new(1e30, -1e30)).x, 1.0);
+    assert_eq!(t.color(Vec2::new(-1e30, 1e30)).x, 0.0);
+}
+
 #[test]
 fn bilinear_lookup_interpolates_between_texel_centres() {
     // A 2x1 image, black then white (data, not sRGB): texel centres at u = 1/4 and 3/4.

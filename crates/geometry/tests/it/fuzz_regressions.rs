@@ -47,6 +47,32 @@ fn memory_files_load_a_scene_and_its_references() {
     assert_eq!(d.triangles[0].positions[1], glam::Vec3::X);
 }
 
+/// Textures are read through the file source too (the `texture` fuzz target serves them from
+/// memory); before, the texture cache read the file system whatever the source.
+#[test]
+fn memory_files_serve_the_textures_of_a_scene() {
+    let mut png = io::Cursor::new(Vec::new());
+    image::RgbImage::from_pixel(2, 1, image::Rgb([255, 0, 0]))
+        .write_to(&mut png, image::ImageFormat::Png)
+        .unwrap();
+    let toml = "format = 1\n[materials.red]\ntype = \"diffuse\"\n\
+                albedo = { texture = \"tex/red.png\" }\n\
+                [[shapes]]\ntype = \"quad\"\ncorner = [0, 0, 0]\nedge1 = [1, 0, 0]\n\
+                edge2 = [0, 1, 0]\nmaterial = \"red\"\n";
+    let files = MemoryFiles::new()
+        .with("/mem/scene.toml", toml)
+        .with("/mem/tex/red.png", png.into_inner());
+    let d = load_memory("/mem/scene.toml", files).unwrap();
+    let textures = d.materials[0]
+        .textures
+        .as_deref()
+        .expect("a textured material");
+    let color = textures.color.as_ref().expect("an albedo texture");
+    assert_eq!(color.image.resolution(), (2, 1));
+    // An 8-bit colour texture is sRGB-decoded: 255 is 1, 0 is 0.
+    assert_eq!(color.color(glam::Vec2::new(0.5, 0.5)), glam::Vec3::X);
+}
+
 #[test]
 fn a_resolver_closure_serves_files_and_missing_ones_name_the_path() {
     let obj = "mtllib nowhere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
@@ -261,5 +287,46 @@ fn gltf_accessor_layouts_gltf_cannot_read_are_errors() {
         load_memory("/mem/t.gltf", files),
         "/mem/t.gltf",
         "no items (count 0)",
+    );
+}
+
+/// Found by the `envmap` fuzz target: a 453-byte EXR declaring a data window of
+/// 520 093 700 × 2 texels was decoded (two seconds and 2 GB of memory) before the map was found
+/// not to be 2:1. Its size is now checked from the header, before anything is decoded.
+#[test]
+fn environment_map_declaring_a_huge_image_is_refused_from_its_header() {
+    let exr = include_bytes!("../fuzz/envmap-huge-data-window.exr");
+    let toml = "format = 1\n[materials.grey]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n\
+                [[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"grey\"\n\
+                [[lights]]\ntype = \"environment\"\nfile = \"sky.exr\"\n";
+    let files = MemoryFiles::new()
+        .with("/mem/scene.toml", toml)
+        .with("/mem/sky.exr", exr.to_vec());
+    let err = load_memory("/mem/scene.toml", files).expect_err("the map must be refused");
+    assert!(matches!(err, LoadError::EnvironmentMap { .. }), "{err:?}");
+    assert_names_file(&err, Path::new("/mem/sky.exr"));
+    assert!(err.to_string().contains("520093700×2, not 2:1"), "{err}");
+}
+
+/// Found by the `texture` fuzz target (as a timeout of the dev-profile build): a 519-byte EXR
+/// texture whose display window is 16 252 927 × 2 texels was decoded into an image that large,
+/// 3.7 s and 1 GB in a release build. Its windows are now bounded by the file's size before
+/// decoding, as `film`'s EXR reader bounds its samples.
+#[test]
+fn texture_declaring_a_huge_data_window_is_refused_from_its_header() {
+    let exr = include_bytes!("../fuzz/texture-huge-data-window.exr");
+    let toml = "format = 1\n[materials.t]\ntype = \"diffuse\"\nalbedo = { texture = \"t.exr\" }\n\
+                [[shapes]]\ntype = \"quad\"\ncorner = [0, 0, 0]\nedge1 = [1, 0, 0]\n\
+                edge2 = [0, 1, 0]\nmaterial = \"t\"\n";
+    let files = MemoryFiles::new()
+        .with("/mem/scene.toml", toml)
+        .with("/mem/t.exr", exr.to_vec());
+    let err = load_memory("/mem/scene.toml", files).expect_err("the texture must be refused");
+    assert!(matches!(err, LoadError::Texture { .. }), "{err:?}");
+    assert_names_file(&err, Path::new("/mem/t.exr"));
+    assert!(
+        err.to_string()
+            .contains("more than a 519-byte file can hold"),
+        "{err}"
     );
 }
