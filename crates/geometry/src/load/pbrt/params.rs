@@ -23,6 +23,18 @@ impl Parser {
         }
     }
 
+    /// The texture a `"texture NAME"` parameter names, with where it stands.
+    pub(super) fn texture_name(&self, p: &Param, name: &str) -> Result<(String, Loc), LoadError> {
+        let loc = Self::loc_of_param(p);
+        match p.values.as_slice() {
+            [Value::Str(t)] => Ok((t.clone(), loc)),
+            _ => Err(self.err(
+                loc,
+                format!("parameter \"texture {name}\" expects one texture name"),
+            )),
+        }
+    }
+
     pub(super) fn nums(&self, p: &Param) -> Result<Vec<f64>, LoadError> {
         p.values
             .iter()

@@ -26,14 +26,7 @@ impl Parser {
     ) -> Result<Option<Textured>, LoadError> {
         match params.get(name) {
             Some(p) if p.ty == "texture" => {
-                let loc = Self::loc_of_param(p);
-                let [Value::Str(t)] = p.values.as_slice() else {
-                    return Err(self.err(
-                        loc,
-                        format!("parameter \"texture {name}\" expects one texture name"),
-                    ));
-                };
-                let t = t.clone();
+                let (t, loc) = self.texture_name(p, name)?;
                 self.texture_value(&t, loc, 0).map(Some)
             }
             _ => Ok(self
@@ -89,14 +82,7 @@ impl Parser {
     ) -> Result<Option<Textured>, LoadError> {
         match def.params.get(name) {
             Some(p) if p.ty == "texture" => {
-                let loc = Self::loc_of_param(p);
-                let [Value::Str(t)] = p.values.as_slice() else {
-                    return Err(self.err(
-                        loc,
-                        format!("parameter \"texture {name}\" expects one texture name"),
-                    ));
-                };
-                let t = t.clone();
+                let (t, loc) = self.texture_name(p, name)?;
                 self.texture_value(&t, loc, depth + 1).map(Some)
             }
             _ => Ok(self
