@@ -264,6 +264,16 @@ fn fnv1a(bytes: &[u8]) -> u64 {
     hash
 }
 
+/// The parameters of the seed checkpoints of `method`: tiny passes, a short depth.
+#[must_use]
+pub fn checkpoint_params(method: ppm::Method) -> ppm::RenderParams {
+    let mut params = ppm::RenderParams::preview();
+    params.method = method;
+    params.photons_per_pass = 64;
+    params.max_depth = 8;
+    params
+}
+
 /// Checkpoints of the `checkpoint` target's scene split into their head and decompressed
 /// columns ([`ppm::checkpoint_surgery::split`]): one per method, after one and after two
 /// passes, named `method-passes`. The `checkpoint_columns` target joins its input's columns to
@@ -276,11 +286,7 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 pub fn column_checkpoints(scene: &geometry::Scene) -> Vec<(String, Vec<u8>, Vec<u8>)> {
     let mut out = Vec::new();
     for method in ppm::Method::ALL {
-        let mut params = ppm::RenderParams::preview();
-        params.method = method;
-        params.photons_per_pass = 64;
-        params.max_depth = 8;
-        let Ok(mut renderer) = ppm::Renderer::new(scene, params) else {
+        let Ok(mut renderer) = ppm::Renderer::new(scene, checkpoint_params(method)) else {
             continue;
         };
         for pass in 1..=2 {

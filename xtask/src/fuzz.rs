@@ -721,11 +721,7 @@ mod seeds {
         let scene = harness::checkpoint_scene();
         let mut out = Vec::new();
         for method in ppm::Method::ALL {
-            let mut params = ppm::RenderParams::preview();
-            params.method = method;
-            params.photons_per_pass = 64;
-            params.max_depth = 8;
-            let mut renderer = ppm::Renderer::new(&scene, params)?;
+            let mut renderer = ppm::Renderer::new(&scene, harness::checkpoint_params(method))?;
             for pass in 1..=2 {
                 renderer.iterate();
                 let saved = renderer.save_state("seed");

@@ -3,7 +3,7 @@
 //! the plain queries of `mod.rs`, untouched.
 
 use super::wide::{Leaf, Leaves};
-use super::{Accel, CYLINDER_BIT, LANES, RawHit, SPHERE_BIT, simd::F8};
+use super::{Accel, LANES, RawHit, simd::F8};
 use crate::Ray;
 
 /// The alpha test: whether triangle `index` is present at barycentrics (b1, b2).
@@ -110,26 +110,7 @@ impl Accel {
         };
         bvh.closest(&box_ray, &mut tmax, &mut query);
         let slot = query.closest?;
-        let t = tmax / self.scale;
-        let id = self.ids[slot];
-        Some(if id & SPHERE_BIT != 0 {
-            RawHit::Sphere {
-                index: id & !SPHERE_BIT,
-                t,
-            }
-        } else if id & CYLINDER_BIT != 0 {
-            RawHit::Cylinder {
-                index: id & !CYLINDER_BIT,
-                t,
-            }
-        } else {
-            RawHit::Triangle {
-                index: id,
-                t,
-                b1: query.uv.0,
-                b2: query.uv.1,
-            }
-        })
+        Some(self.raw_hit(slot, tmax, || query.uv))
     }
 
     /// [`Accel::occluded`] where cut-out triangles count only where `covered` says so.

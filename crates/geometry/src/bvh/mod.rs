@@ -350,9 +350,21 @@ impl Accel {
         };
         bvh.closest(&box_ray, &mut tmax, &mut query);
         let slot = query.closest?;
+        Some(self.raw_hit(slot, tmax, || {
+            (
+                query.uv.0.to_array()[slot % LANES],
+                query.uv.1.to_array()[slot % LANES],
+            )
+        }))
+    }
+
+    /// The hit of the primitive in `slot` at internal distance `tmax`; `uv` gives a triangle's
+    /// barycentrics (read only for triangles).
+    #[inline(always)]
+    fn raw_hit(&self, slot: usize, tmax: f32, uv: impl FnOnce() -> (f32, f32)) -> RawHit {
         let t = tmax / self.scale;
         let id = self.ids[slot];
-        Some(if id & SPHERE_BIT != 0 {
+        if id & SPHERE_BIT != 0 {
             RawHit::Sphere {
                 index: id & !SPHERE_BIT,
                 t,
@@ -363,17 +375,14 @@ impl Accel {
                 t,
             }
         } else {
-            let (b1, b2) = (
-                query.uv.0.to_array()[slot % LANES],
-                query.uv.1.to_array()[slot % LANES],
-            );
+            let (b1, b2) = uv();
             RawHit::Triangle {
                 index: id,
                 t,
                 b1,
                 b2,
             }
-        })
+        }
     }
 
     /// Whether anything is hit with 0 ≤ t < `ray.t_max` (t > 0 for spheres). Never inlined, as

@@ -39,9 +39,9 @@ pub(super) struct PhotonPass {
     /// Per slot: the light-traced radiance of the pass times the photons emitted
     /// (`light_tracing` only; empty otherwise).
     light: Vec<[f64; 3]>,
-    /// Per slot: camera samples per unit area at its visible point if the camera sees it
-    /// directly, else infinity (light tracing cannot reach it; merging takes all its weight).
-    vm_density: Vec<f32>,
+    /// Per slot: the MIS weight of a merge at its visible point against the photon's
+    /// connection to the camera (`light_tracing` only; empty otherwise).
+    merge_weight: Vec<f32>,
 }
 
 impl PhotonPass {
@@ -80,7 +80,7 @@ impl PhotonPass {
             self.per_entry.capacity() * size_of::<(u32, [f64; 3])>()
                 + self.slot_entry.capacity() * size_of::<u32>()
                 + self.light.capacity() * size_of::<[f64; 3]>()
-                + self.vm_density.capacity() * size_of::<f32>(),
+                + self.merge_weight.capacity() * size_of::<f32>(),
         )
     }
 }
@@ -117,7 +117,7 @@ impl PhotonMapper<'_> {
                 }
             });
         self.n_emitted += n;
-        if light.is_some() {
+        if let Some(light) = light {
             // In chunk order, whatever the thread count.
             let n_slots = self.slots.len();
             buffers.light.clear();
@@ -131,18 +131,25 @@ impl PhotonMapper<'_> {
                     }
                 }
             }
+            // The balance heuristic against the photon's connection to the camera
+            // (`trace.rs`): N/(q + N), N = πR²ρ, ρ the camera samples per unit area at the
+            // visible point; 1 where the camera sees it only through specular bounces (a
+            // connection cannot reach it).
             let camera = setup.scene.camera();
             let direct_budget = u16::try_from(setup.params.max_depth - 1).unwrap_or(u16::MAX);
             let (positions, normals) = (self.slots.position(), self.slots.geometric_normal());
-            let budgets = &self.photon_bounces;
-            buffers.vm_density.clear();
-            buffers.vm_density.extend((0..n_slots).map(|slot| {
+            let (budgets, radii) = (&self.photon_bounces, self.slots.radius());
+            let spp = setup.params.samples_per_pixel as usize;
+            buffers.merge_weight.clear();
+            buffers.merge_weight.extend((0..n_slots).map(|slot| {
                 let budget = budgets[slot];
                 if budget == NO_VISIBLE_POINT || budget < direct_budget {
-                    f32::INFINITY
-                } else {
-                    camera.film_density(positions[slot], normals[slot])
+                    return 1.0;
                 }
+                let rho = f64::from(camera.film_density(positions[slot], normals[slot]));
+                let n = std::f64::consts::PI * radii[slot] * radii[slot] * rho;
+                let q = light.connection_rate((slot / spp) as u32, rho);
+                (n / (q + n)) as f32
             }));
         }
         let frequency_photons = buffers.traced.iter().map(|c| c.frequency_photons).sum();
@@ -180,7 +187,7 @@ impl PhotonMapper<'_> {
 
         let slots = &self.slots;
         let photon_bounces = &self.photon_bounces;
-        let vm_density = &buffers.vm_density;
+        let merge_weight = &buffers.merge_weight;
         // Fluxes dropped for being NaN or infinite (a BSDF value at a grazing angle, say):
         // rare, so an atomic counter costs nothing on the common path.
         let non_finite_fluxes = AtomicU64::new(0);
@@ -209,18 +216,8 @@ impl PhotonMapper<'_> {
                     kind => Bsdf::from_normal(kind, normal, true).eval(outgoing, photon.incoming),
                 };
                 let mut flux = f * photon.power * slots.weight()[slot];
-                if let Some(light) = light {
-                    // The balance heuristic against the photon's connection to the camera
-                    // (`trace.rs`): N/(q + N), N = πR²ρ; 1 where the camera sees the hitpoint
-                    // only through specular bounces (ρ = ∞).
-                    let rho = f64::from(vm_density[slot]);
-                    if rho.is_finite() {
-                        let r = slots.radius()[slot];
-                        let n = std::f64::consts::PI * r * r * rho;
-                        let spp = setup.params.samples_per_pixel as usize;
-                        let q = light.connection_rate((slot / spp) as u32, rho);
-                        flux *= (n / (q + n)) as f32;
-                    }
+                if let Some(&weight) = merge_weight.get(slot) {
+                    flux *= weight;
                 }
                 if flux.is_finite() {
                     Some(flux)

@@ -2,7 +2,7 @@
 //! on non-specular surfaces (with the frequency steps of `frequency.rs` for frequency photons).
 
 use geometry::{Bsdf, Hit, MaterialKind, Rgb, TransportMode};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use photon::Photon;
 
 use super::Setup;
@@ -254,9 +254,13 @@ impl Setup<'_> {
         out: &mut TracedPhotons,
     ) {
         let camera = self.scene.camera();
-        let mut lens = sampler.clone();
-        lens.skip_to(LENS_DIMENSION + 2 * u64::from(depth));
-        let u_lens = lens.next_2d();
+        let u_lens = if camera.aperture_radius() > 0.0 {
+            let mut lens = sampler.clone();
+            lens.skip_to(LENS_DIMENSION + 2 * u64::from(depth));
+            lens.next_2d()
+        } else {
+            Vec2::ZERO
+        };
         let Some(connection) = camera.connect(hit.position, u_lens) else {
             return;
         };
