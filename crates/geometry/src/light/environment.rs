@@ -171,12 +171,19 @@ impl EnvironmentMap {
             .into_dimensions()
             .map_err(|e| cannot_decode(e.to_string()))?;
         Self::check_size(width, height, square).map_err(bad)?;
+        if format == image::ImageFormat::Hdr {
+            crate::texture::check_hdr_size(&bytes, width, height).map_err(bad)?;
+        }
         let (width, height, rgb) = decode_hdr_image(&bytes, format).map_err(cannot_decode)?;
+        drop(bytes);
         Self::check_size(width, height, square).map_err(bad)?;
+        // The decoded floats become the texels in place (a map may hold 64 M texels: a copy
+        // would double the peak memory).
+        let mut texels: Vec<Vec3> = bytemuck::allocation::try_cast_vec(rgb)
+            .unwrap_or_else(|(_, rgb)| rgb.chunks_exact(3).map(Vec3::from_slice).collect());
         let mut negative = 0;
-        let mut texels = Vec::with_capacity(rgb.len() / 3);
-        for (i, c) in rgb.chunks_exact(3).enumerate() {
-            let t = Vec3::new(c[0], c[1], c[2]);
+        for (i, texel) in texels.iter_mut().enumerate() {
+            let t = *texel;
             if !t.is_finite() {
                 let (x, y) = (i as u32 % width, i as u32 / width);
                 return Err(bad(format!(
@@ -187,7 +194,7 @@ impl EnvironmentMap {
             if t.cmplt(Vec3::ZERO).any() {
                 negative += 1;
             }
-            texels.push(t.max(Vec3::ZERO));
+            *texel = t.max(Vec3::ZERO);
         }
         if texels.iter().all(|&t| luminance(t) <= 0.0) {
             return Err(bad(

@@ -117,6 +117,20 @@ pub(crate) fn check_exr_header(bytes: &[u8], max_texels: u64) -> Result<(), Stri
     Ok(())
 }
 
+/// Checks a Radiance HDR's declared size against its file's: every scanline takes at least 4
+/// bytes (one RGBE texel, then run-length markers), so a file of n bytes holds at most n / 4
+/// scanlines. `image` allocates the whole image before it reads the first scanline, and a
+/// header of a few dozen bytes can declare 64 M texels.
+pub(crate) fn check_hdr_size(bytes: &[u8], width: u32, height: u32) -> Result<(), String> {
+    if u64::from(height) * 4 > bytes.len() as u64 {
+        return Err(format!(
+            "its header declares a {width}x{height} image, more scanlines than a {}-byte file can hold",
+            bytes.len()
+        ));
+    }
+    Ok(())
+}
+
 /// Decodes an image file's bytes (PNG, JPEG, EXR, Radiance HDR, told apart by their contents).
 pub(crate) fn decode(path: &Path, bytes: &[u8]) -> Result<Image, LoadError> {
     let reader = ImageReader::new(std::io::Cursor::new(bytes))
@@ -156,6 +170,9 @@ pub(crate) fn decode(path: &Path, bytes: &[u8]) -> Result<Image, LoadError> {
         check_exr_header(bytes, MAX_TEXELS).map_err(|e| texture_error(path, e))?;
     }
     let (width, height) = reader.into_dimensions().map_err(corrupt)?;
+    if format == ImageFormat::Hdr {
+        check_hdr_size(bytes, width, height).map_err(|e| texture_error(path, e))?;
+    }
     if width == 0 || height == 0 {
         return Err(texture_error(
             path,

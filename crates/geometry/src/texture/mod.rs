@@ -18,7 +18,7 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3, Vec4};
 
-pub(crate) use image_file::{TextureCache, check_exr_header};
+pub(crate) use image_file::{TextureCache, check_exr_header, check_hdr_size};
 
 /// A decoded image, loaded once per file and shared by every material that uses it.
 #[derive(Clone)]

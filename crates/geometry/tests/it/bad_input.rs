@@ -638,7 +638,7 @@ fn bad_texture_files_name_the_image() {
         image::DynamicImage::ImageRgba32F(img).save(&path).unwrap();
         std::fs::read(&path).unwrap()
     };
-    let cases: [(&str, Vec<u8>, &str); 4] = [
+    let cases: [(&str, Vec<u8>, &str); 5] = [
         ("zero_size", png(0, 4, b""), "tex.png"),
         (
             "truncated_png",
@@ -651,6 +651,11 @@ fn bad_texture_files_name_the_image() {
             "corrupt jpg texture",
         ),
         ("nan_texel", nan_exr, "nan texel at (1, 0)"),
+        (
+            "hdr_declares_more_than_it_holds",
+            b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8192 +X 8192\n\x02\x02\x20\x00".to_vec(),
+            "more scanlines than",
+        ),
     ];
     for (test, bytes, needle) in cases {
         let dir = crate::temp_dir(test);
@@ -720,6 +725,20 @@ const ENV_MAPS: &[BadMap] = &[
         "sky.hdr",
         |p| std::fs::write(p, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 0 +X 0\n").unwrap(),
         &["EnvironmentMap {"],
+    ),
+    (
+        // A header of a few dozen bytes declaring 32 M texels: refused before `image`
+        // allocates them (every scanline takes at least 4 bytes of the file).
+        "env_hdr_declares_more_than_it_holds",
+        "sky.hdr",
+        |p| {
+            std::fs::write(
+                p,
+                "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4096 +X 8192\n\x02\x02\x20\x00",
+            )
+            .unwrap()
+        },
+        &["EnvironmentMap {", "8192x4096", "more scanlines than"],
     ),
     (
         "env_nan",
@@ -816,4 +835,24 @@ fn a_good_environment_map_loads_and_lights_a_scene_alone() {
             .any(|w| w.contains("8 negative texels"))
     );
     geometry::Scene::new(description).unwrap();
+}
+
+/// The size bound on Radiance HDR files refuses only what a file cannot hold: a map stored
+/// uncompressed (4 bytes a texel, written here by hand: RGBE (128, 128, 128, 129) is 1.0) loads,
+/// and its integral over the sphere is 4π.
+#[test]
+fn an_uncompressed_hdr_map_loads() {
+    let dir = crate::temp_dir("hdr_uncompressed");
+    let path = dir.join("sky.hdr");
+    let mut bytes = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 8\n".to_vec();
+    for _ in 0..4 * 8 {
+        bytes.extend_from_slice(&[128, 128, 128, 129]);
+    }
+    std::fs::write(&path, &bytes).unwrap();
+    let (env, negative) = geometry::Environment::from_file(&path).unwrap();
+    assert_eq!(negative, 0);
+    let total = env.integrated_radiance();
+    for c in [total.x, total.y, total.z] {
+        assert!((c - 4.0 * std::f32::consts::PI).abs() < 1e-3, "{total:?}");
+    }
 }
