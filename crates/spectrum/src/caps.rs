@@ -121,6 +121,36 @@ impl Caps {
         self.b_max
     }
 
+    /// Keeps the angular slope of a field inside the angular window by narrowing the field in
+    /// space, rather than by clamping b and c.
+    ///
+    /// A field whose angle is correlated with position (after a curved mirror or lens, c ≠ 0)
+    /// spreads in angle for two reasons: the slope θ = (c/a)·x across its width, which
+    /// contributes s = c²/a to b, and the spread at a fixed x, b − s. The clamp of b (then of c
+    /// into `c² ≤ a·b`) lowers the slope when b exceeds `b_max`, which moves the focus of a
+    /// converging field away: a caustic was predicted wide and smooth where it focuses. Here
+    /// such a field is first narrowed by a spatial window (λ added to the inverse entry of a,
+    /// as [`harmonic`] does) until its slope term is s' = max(`b_max` − (b − s), `b_max`/2):
+    /// a and c scale by s'/s, which keeps the slope c/a (the focus distance a/|c|) and the
+    /// spread at fixed x. Where that spread is at most half the window (a lamp focused by a
+    /// mirror), the result has b = `b_max` exactly; where it is wider (a rough lobe) the clamp
+    /// lowers it to the other half, with the slope kept. A field with b ≤ `b_max` is
+    /// unchanged, and the result is continuous in (a, b, c). NaN and infinite inputs are left
+    /// to the clamp.
+    pub(crate) fn window_angles(&self, a: f64, b: f64, c: f64) -> (f64, f64, f64) {
+        if !(b > self.b_max && a > 0.0 && a.is_finite() && b.is_finite() && c.is_finite()) {
+            return (a, b, c);
+        }
+        let slope_part = c * (c / a);
+        let spread = (b - slope_part).max(0.0);
+        let target = (self.b_max - spread).max(0.5 * self.b_max);
+        if slope_part <= target {
+            return (a, b, c);
+        }
+        let keep = target / slope_part;
+        (a * keep, spread + target, c * keep)
+    }
+
     /// Clamps a and b into their ranges and shrinks c into `c² ≤ a·b·(1 − 10⁻¹²)`.
     ///
     /// Infinities land on the caps. A NaN (only reachable through NaN parameters) lands on

@@ -548,10 +548,10 @@ impl Spectrum {
 
     /// Applies the caps (and the Lambertian normal form) to raw coefficients.
     pub(crate) fn finish(a: f64, b: f64, c: f64, lambertian: bool, caps: &Caps) -> Self {
-        let (b, c) = if lambertian {
-            (caps.b_max(), 0.0)
+        let (a, b, c) = if lambertian {
+            (a, caps.b_max(), 0.0)
         } else {
-            (b, c)
+            caps.window_angles(a, b, c)
         };
         let (a, b, c) = caps.clamp(a, b, c);
         debug_assert!(

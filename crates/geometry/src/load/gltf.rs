@@ -188,17 +188,21 @@ struct AccessorRule {
     what: &'static str,
     dimensions: gltf::accessor::Dimensions,
     types: &'static [gltf::accessor::DataType],
+    /// Whether integer components may be normalized (texture coordinates).
+    normalized: bool,
 }
 
 const POSITION_RULE: AccessorRule = AccessorRule {
     what: "POSITION",
     dimensions: gltf::accessor::Dimensions::Vec3,
     types: &[gltf::accessor::DataType::F32],
+    normalized: false,
 };
 const NORMAL_RULE: AccessorRule = AccessorRule {
     what: "NORMAL",
     dimensions: gltf::accessor::Dimensions::Vec3,
     types: &[gltf::accessor::DataType::F32],
+    normalized: false,
 };
 const INDICES_RULE: AccessorRule = AccessorRule {
     what: "indices",
@@ -208,6 +212,18 @@ const INDICES_RULE: AccessorRule = AccessorRule {
         gltf::accessor::DataType::U16,
         gltf::accessor::DataType::U32,
     ],
+    normalized: false,
+};
+
+const TEXCOORD_RULE: AccessorRule = AccessorRule {
+    what: "TEXCOORD",
+    dimensions: gltf::accessor::Dimensions::Vec2,
+    types: &[
+        gltf::accessor::DataType::F32,
+        gltf::accessor::DataType::U8,
+        gltf::accessor::DataType::U16,
+    ],
+    normalized: true,
 };
 
 struct Walker<'a> {
@@ -308,11 +324,16 @@ impl Walker<'_> {
     /// allows. The gltf crate's validation does not, and its readers assume it: a `VEC2`
     /// position or a stride shorter than an item fails a debug assertion (`accessor/util.rs`),
     /// `FLOAT` indices reach an `unreachable!`, a count of 0 underflows.
-    fn check_accessor_types(&self, prim: &gltf::Primitive<'_>) -> Result<(), LoadError> {
+    fn check_accessor_types(
+        &self,
+        prim: &gltf::Primitive<'_>,
+        uv_set: u32,
+    ) -> Result<(), LoadError> {
         let checks = [
             (prim.get(&gltf::Semantic::Positions), POSITION_RULE),
             (prim.get(&gltf::Semantic::Normals), NORMAL_RULE),
             (prim.indices(), INDICES_RULE),
+            (prim.get(&gltf::Semantic::TexCoords(uv_set)), TEXCOORD_RULE),
         ];
         for (accessor, rule) in checks {
             let Some(accessor) = accessor else {
@@ -321,7 +342,7 @@ impl Walker<'_> {
             let (dimensions, data_type) = (accessor.dimensions(), accessor.data_type());
             if dimensions != rule.dimensions
                 || !rule.types.contains(&data_type)
-                || accessor.normalized()
+                || (accessor.normalized() && !rule.normalized)
             {
                 return Err(gltf_error(
                     self.path,
@@ -358,7 +379,15 @@ impl Walker<'_> {
             self.skipped_primitives += 1;
             return Ok(());
         }
-        self.check_accessor_types(prim)?;
+        // The texture-coordinate set the primitive's material reads (the default material's
+        // is 0).
+        let uv_set = prim
+            .material()
+            .index()
+            .and_then(|i| self.uv_sets.get(i))
+            .copied()
+            .unwrap_or(0);
+        self.check_accessor_types(prim, uv_set)?;
         let reader = prim.reader(|b| self.buffers.get(b.index()).map(|d| &d.0[..]));
         let Some(positions) = reader.read_positions() else {
             if let Some(accessor) = prim.get(&gltf::Semantic::Positions) {
@@ -433,7 +462,6 @@ impl Walker<'_> {
                 (self.data.materials.len() - 1) as u32
             }),
         };
-        let uv_set = self.uv_sets.get(material as usize).copied().unwrap_or(0);
         let uvs: Option<Vec<Vec2>> = reader
             .read_tex_coords(uv_set)
             .map(|tc| tc.into_f32().map(Vec2::from).collect())

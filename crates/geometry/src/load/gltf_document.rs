@@ -16,6 +16,8 @@ use crate::error::LoadError;
 /// validation also runs under `catch_unwind`, the only way to contain a panic of the
 /// dependency that this check does not foresee: the user gets one line, not a crash.
 ///
+/// Images are checked for what gltf's `Image::source` unwraps (below).
+///
 /// A GLB header whose total length is shorter than the header itself makes gltf 1.4.1
 /// subtract with overflow (`binary.rs`, `Glb::from_slice`); it is refused first.
 pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<gltf::Gltf, LoadError> {
@@ -53,6 +55,19 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<gltf::Gltf, LoadError> 
                 ));
             }
         }
+    }
+    // gltf 1.4.1's `Image::source` unwraps the mime type of an image in a buffer view, and
+    // the URI of one that has no buffer view; its validation checks neither.
+    for (i, image) in json.images.iter().enumerate() {
+        let problem = match (&image.buffer_view, &image.uri, &image.mime_type) {
+            (Some(_), _, None) => "is stored in a buffer view but has no mimeType",
+            (None, None, _) => "has neither a uri nor a bufferView",
+            _ => continue,
+        };
+        return Err(gltf_error(
+            path,
+            format!("image {i} {problem} (glTF 2.0 requires one)"),
+        ));
     }
     let document = crate::guard::contain(move || gltf::Document::from_json(json))
         .map_err(|()| gltf_error(path, "the gltf crate failed while validating this file"))?

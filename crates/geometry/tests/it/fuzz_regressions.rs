@@ -290,6 +290,62 @@ fn gltf_accessor_layouts_gltf_cannot_read_are_errors() {
     );
 }
 
+/// Found by the `gltf` fuzz target: a `TEXCOORD_0` accessor of `VEC3` (or of `UNSIGNED_INT`)
+/// failed a debug assertion of gltf's reader (`accessor/util.rs:371`, the item's size), and
+/// read texture coordinates across item boundaries without it. Texture coordinates are checked
+/// like positions: `VEC2` of float, or of normalized unsigned byte or short.
+#[test]
+fn gltf_texture_coordinates_of_the_wrong_type_are_errors() {
+    let with_uv = |uv_type: &str, component: u32| {
+        triangle_gltf("accessors")
+            .replace(r#""attributes":{"POSITION":0}"#, r#""attributes":{"POSITION":0,"TEXCOORD_0":1}"#)
+            .replace(
+                r#""max":[1,1,0]}]"#,
+                &format!(
+                    r#""max":[1,1,0]}},{{"bufferView":0,"componentType":{component},"count":3,"type":"{uv_type}"}}]"#
+                ),
+            )
+    };
+    for (uv_type, component, what) in [("VEC3", 5126, "Vec3 of F32"), ("VEC2", 5125, "Vec2 of U32")]
+    {
+        let files = MemoryFiles::new().with("/mem/t.gltf", with_uv(uv_type, component));
+        assert_gltf_error(
+            load_memory("/mem/t.gltf", files),
+            "/mem/t.gltf",
+            &format!("accessor 1 (TEXCOORD) is {what}"),
+        );
+    }
+    // A valid one still loads (VEC2 of float, 24 of the buffer's 36 bytes).
+    let files = MemoryFiles::new().with("/mem/t.gltf", with_uv("VEC2", 5126));
+    let d = load_memory("/mem/t.gltf", files).unwrap();
+    assert_eq!(d.triangles.len(), 1);
+}
+
+/// Found by the `glb` fuzz target: a texture's image in a buffer view without a `mimeType`
+/// panicked in gltf's `Image::source` (`image.rs:128`, an unwrap), as does an image with
+/// neither a URI nor a buffer view.
+#[test]
+fn gltf_images_gltf_cannot_describe_are_errors() {
+    for (image, needle) in [
+        (
+            r#"{"bufferView":0}"#,
+            "image 0 is stored in a buffer view but has no mimeType",
+        ),
+        ("{}", "image 0 has neither a uri nor a bufferView"),
+    ] {
+        let textured = triangle_gltf("accessors")
+            .replace(r#""attributes":{"POSITION":0}"#, r#""attributes":{"POSITION":0},"material":0"#)
+            .replace(
+                r#""bufferViews""#,
+                &format!(
+                    r#""materials":[{{"pbrMetallicRoughness":{{"baseColorTexture":{{"index":0}}}}}}],"textures":[{{"source":0}}],"images":[{image}],"bufferViews""#
+                ),
+            );
+        let files = MemoryFiles::new().with("/mem/t.gltf", textured);
+        assert_gltf_error(load_memory("/mem/t.gltf", files), "/mem/t.gltf", needle);
+    }
+}
+
 /// Found by the `envmap` fuzz target: a 453-byte EXR declaring a data window of
 /// 520 093 700 × 2 texels was decoded (two seconds and 2 GB of memory) before the map was found
 /// not to be 2:1. Its size is now checked from the header, before anything is decoded.

@@ -47,3 +47,31 @@ fn clamp_handles_nan_and_infinities() {
     assert_eq!(clamp_mu(-0.5), 0.5);
     assert_eq!(clamp_eta(f64::NAN), 1.0);
 }
+
+/// The angular window: a field inside it is untouched; a converging field (slope term far
+/// above the window, small spread at fixed x) keeps its slope c/a and its spread, and lands
+/// on b = b_max; a wide spread keeps the slope and half the window; and the window is the
+/// harmonic update (a spatial window) with the weight that gives the new a.
+#[test]
+fn angular_window_keeps_the_slope() {
+    let caps = Caps::new(0.0, 1e6, 0.0, 2.0).unwrap();
+    assert_eq!(caps.window_angles(1.0, 1.9, 1.0), (1.0, 1.9, 1.0));
+    // Slope term c²/a = 36, spread 0.1.
+    let (a, b, c) = (4.0, 36.1, 12.0);
+    let (a2, b2, c2) = caps.window_angles(a, b, c);
+    assert!((c2 / a2 - c / a).abs() < 1e-12);
+    assert!(((b2 - c2 * c2 / a2) - 0.1).abs() < 1e-9);
+    assert!((b2 - 2.0).abs() < 1e-9);
+    let x = a / a2 - 1.0;
+    let (u, v, k) = harmonic(a, b, c, x);
+    assert!((u - a2).abs() < 1e-12 && (v - b2).abs() < 1e-9 && (k - c2).abs() < 1e-12);
+    // Spread 1.5 (more than half the window): slope term 1, spread clamped to the rest.
+    let (a3, b3, c3) = caps.window_angles(4.0, 37.5, 12.0);
+    assert!((c3 / a3 - 3.0).abs() < 1e-12);
+    assert!((c3 * c3 / a3 - 1.0).abs() < 1e-9);
+    let (_, b3, c3) = caps.clamp(a3, b3, c3);
+    assert!((b3 - 2.0).abs() < 1e-12 && (c3 - 12.0 / 36.0).abs() < 1e-12);
+    // Continuous across the edge of the window.
+    let edge = caps.window_angles(4.0, 2.0 + 1e-12, 2.0);
+    assert!((edge.0 - 4.0).abs() < 1e-9 && (edge.2 - 2.0).abs() < 1e-9);
+}

@@ -113,6 +113,30 @@ fn lens_focuses_a_point_light_on_its_image() {
     );
 }
 
+/// A small Lambertian lamp imaged by a concave mirror under the scene caps a renderer uses
+/// (±1 rad angular window): the reflected field converges at the mirror equation's image
+/// distance v = 1/(1/f − 1/u), and there it is as narrow as the lamp's image, m²·a_lamp with
+/// m = v/u. The lamp's rays fill the whole window, so right after the curvature kick the
+/// field's angles exceed it; clamping b (and c with it) flattened the slope and moved the
+/// focus past 3 m (the ring caustic of `scenes/peers/ring-caustic.toml` was predicted smooth
+/// at its cusp).
+#[test]
+fn concave_mirror_images_a_lambertian_lamp_under_scene_caps() {
+    let caps = Caps::for_scene_size(6.0);
+    for (size, u, radius) in [(0.08, 2.2, 0.5), (0.02, 1.0, 1.0), (0.1, 4.0, 2.0)] {
+        let f = radius / 2.0;
+        let lamp = Spectrum::area_light(size, 1.0, &caps);
+        let reflected = lamp
+            .travel(u, &caps)
+            .reflect(1.0, 1.0, 1.0 / radius, Lobe::Mirror, &caps);
+        let v = 1.0 / (1.0 / f - 1.0 / u);
+        let focus = argmin(|d| reflected.travel(d, &caps).a(), 0.0, 3.0 * v);
+        assert_close!(focus, v, 1e-3);
+        let m = v / u;
+        assert_close!(reflected.travel(v, &caps).a(), m * m * lamp.a(), 1e-2);
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(1000))]
 
