@@ -307,14 +307,19 @@ impl Accel {
     /// sanitising of `-0.0` direction components.
     #[inline(always)]
     fn internal_ray(&self, ray: &Ray) -> Option<((PrimRay, Ray8), BoxRay, f32)> {
-        // o·0 + d·0 is ±0 in every lane exactly when every component is finite (∞·0 and NaN give
-        // NaN); one SIMD test instead of six scalar ones.
-        let probe = Vec3A::from(ray.origin) * 0.0 + Vec3A::from(ray.direction) * 0.0;
-        if probe.cmpne(Vec3A::ZERO).any() {
+        // The box tests need a finite origin in internal space (an unused child slot's empty box
+        // is entered by an infinite one) and a tmax that is not NaN (NaN exit distances pass the
+        // integer comparison of `Node::intersect`): the scaled origin is tested, since a huge
+        // finite origin can overflow when scaled. o·0 + d·0 is ±0 in every lane exactly when
+        // every component is finite (∞·0 and NaN give NaN); one SIMD test instead of six scalar
+        // ones.
+        let origin = Vec3A::from(ray.origin) * self.scale;
+        let probe = origin * 0.0 + Vec3A::from(ray.direction) * 0.0;
+        if probe.cmpne(Vec3A::ZERO).any() || ray.t_max.is_nan() {
             return None;
         }
         let prim_ray = PrimRay {
-            origin: Vec3A::from(ray.origin * self.scale),
+            origin,
             direction: Vec3A::from(ray.direction),
             tmin: 0.0,
         };

@@ -256,6 +256,37 @@ fn non_finite_rays_miss() {
     }
 }
 
+/// Found by the `scene_render` fuzz target: in a scene 10⁻²⁰ across, the internal scale is
+/// 2¹⁰⁰, and a camera ray from a finite origin of 10³⁰ overflowed to an infinite origin in
+/// internal space, whose box tests entered the empty box of an unused child slot and followed
+/// its reference (an index out of bounds in `leaf_closest`). A NaN upper bound did the same.
+/// Such rays miss now.
+#[test]
+fn rays_that_overflow_the_internal_scale_miss() {
+    let mut rng = Rng::new(7);
+    let tris: Vec<Triangle> = (0..64)
+        .map(|i| {
+            let c = Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 1e-20;
+            tri(c, c + Vec3::X * 1e-21, c + Vec3::Y * 1e-21, i)
+        })
+        .collect();
+    let accel = Accel::build(&tris, &[], &[]);
+    for origin in [
+        Vec3::splat(1e30),
+        Vec3::new(-3e38, 0.0, 0.0),
+        Vec3::new(0.0, 1e35, -1e35),
+    ] {
+        for d in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Z, Vec3::ONE.normalize()] {
+            let ray = Ray::infinite(origin, d);
+            assert!(accel.intersect(&ray).is_none(), "{ray:?}");
+            assert!(!accel.occluded(&ray), "{ray:?}");
+        }
+    }
+    let mut ray = Ray::infinite(Vec3::splat(0.5e-20), Vec3::Z);
+    ray.t_max = f32::NAN;
+    assert!(accel.intersect(&ray).is_none() && !accel.occluded(&ray));
+}
+
 /// Tens of thousands of primitives, so that the tree is many levels deep.
 #[test]
 fn large_scene() {
