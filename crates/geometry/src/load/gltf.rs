@@ -16,7 +16,11 @@
 //! - triangle strips and fans are converted to triangles; points and lines are skipped with
 //!   a warning; primitives without positions are skipped with a warning;
 //! - missing normals give flat shading; a node transform with negative determinant swaps
-//!   the winding so that front faces stay front faces.
+//!   the winding so that front faces stay front faces;
+//! - `TANGENT` is kept under materials with a normal map (the map's frame, see
+//!   [`crate::Triangle::tangents`]), carried by the node's matrix with w turned around by a
+//!   mirroring one; without it the normal map uses the triangle's own frame;
+//! - images are files beside the glTF file, base64 `data:` URIs or buffer views (GLB).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
