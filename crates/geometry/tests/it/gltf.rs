@@ -346,3 +346,27 @@ fn tangent_accessor_of_the_wrong_type_is_an_error() {
     assert!(err.to_string().contains("(TANGENT) is Vec3"), "{err}");
     crate::assert_names_file(&err, &path);
 }
+
+#[test]
+fn tangents_follow_a_mirroring_toml_transform() {
+    // The glTF of `gltf_with_tangents` as a mesh of a TOML scene, mirrored in x by the
+    // transform: node 0's triangle ends up as node 1's does inside the glTF.
+    let gltf = write("gltf_tangents_in_toml", &gltf_with_tangents());
+    let toml = gltf.with_file_name("scene.toml");
+    std::fs::write(
+        &toml,
+        "format = 1\n[[shapes]]\ntype = \"mesh\"\nfile = \"scene.gltf\"\ntransform = { scale = [-1.0, 1.0, 1.0] }\n",
+    )
+    .unwrap();
+    let scene = load(&toml).unwrap();
+    let inside = load(&gltf).unwrap();
+    assert_eq!(scene.triangles[0].positions, inside.triangles[1].positions);
+    let (got, want) = (
+        scene.triangles[0].tangents.expect("tangents"),
+        inside.triangles[1].tangents.expect("tangents"),
+    );
+    for (g, w) in got.iter().zip(&want) {
+        let d = glam::Vec4::from_array(*g) - glam::Vec4::from_array(*w);
+        assert!(d.length() < 1e-6, "{got:?} != {want:?}");
+    }
+}
