@@ -159,6 +159,7 @@ fn description(input: &Input) -> SceneDescription {
                 normals: n.as_ref().map(|n| [n[0].get(), n[1].get(), n[2].get()]),
                 material: u32::from(*m % 5),
                 uv: None,
+                tangents: None,
             }),
             Shape::Sphere(c, r, m) => d.spheres.push(Sphere {
                 center: c.get(),

@@ -137,6 +137,11 @@ pub struct Triangle {
     /// Per-vertex texture coordinates (image convention: v grows downwards, see
     /// [`crate::texture`]), if the source had them.
     pub uv: Option<[Vec2; 3]>,
+    /// Per-vertex tangents of a normal map's frame (glTF `TANGENT`): xyz a unit tangent along
+    /// the texture's u, w = ±1 the bitangent's side, B = w·(N × T). Loaders keep them only
+    /// under a normal-mapped material; without them the frame is the triangle's own (see
+    /// `docs/scene-format-extensions.md`, "Textures").
+    pub tangents: Option<[[f32; 4]; 3]>,
 }
 
 /// An analytic sphere.

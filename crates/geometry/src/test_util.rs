@@ -102,6 +102,7 @@ pub(crate) fn tri(a: Vec3, b: Vec3, c: Vec3, material: u32) -> Triangle {
         normals: None,
         material,
         uv: None,
+        tangents: None,
     }
 }
 

@@ -390,10 +390,13 @@ pub(crate) fn primitives(d: &SceneDescription) -> Result<(), Invalid> {
         index(format!("triangle {i}"), t.material)?;
         if !t.positions.iter().all(|p| p.is_finite())
             || !t.normals.is_none_or(|n| n.iter().all(|v| v.is_finite()))
+            || !t
+                .tangents
+                .is_none_or(|n| n.iter().flatten().all(|v| v.is_finite()))
         {
             return Err(Invalid::value(
                 format!("triangle {i}"),
-                "has a non-finite vertex or normal",
+                "has a non-finite vertex, normal or tangent",
             ));
         }
     }

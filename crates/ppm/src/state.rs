@@ -618,6 +618,11 @@ pub fn scene_fingerprint(d: &SceneDescription) -> u64 {
             uv.iter()
                 .for_each(|v| v.to_array().iter().for_each(|&c| w.f32(c)));
         }
+        // Only triangles with tangents hash them, so that other fingerprints stay as they were.
+        if let Some(tangents) = t.tangents {
+            w.str("tangents");
+            tangents.iter().flatten().for_each(|&c| w.f32(c));
+        }
     }
     w.u64(d.spheres.len() as u64);
     for s in &d.spheres {

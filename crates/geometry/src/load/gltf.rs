@@ -16,7 +16,11 @@
 //! - triangle strips and fans are converted to triangles; points and lines are skipped with
 //!   a warning; primitives without positions are skipped with a warning;
 //! - missing normals give flat shading; a node transform with negative determinant swaps
-//!   the winding so that front faces stay front faces.
+//!   the winding so that front faces stay front faces;
+//! - `TANGENT` is kept under materials with a normal map (the map's frame, see
+//!   [`crate::Triangle::tangents`]), carried by the node's matrix with w turned around by a
+//!   mirroring one; without it the normal map uses the triangle's own frame;
+//! - images are files beside the glTF file, base64 `data:` URIs or buffer views (GLB).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -204,6 +208,11 @@ const NORMAL_RULE: AccessorRule = AccessorRule {
     types: &[gltf::accessor::DataType::F32],
     normalized: false,
 };
+const TANGENT_RULE: AccessorRule = AccessorRule {
+    what: "TANGENT",
+    dimensions: gltf::accessor::Dimensions::Vec4,
+    types: &[gltf::accessor::DataType::F32],
+};
 const INDICES_RULE: AccessorRule = AccessorRule {
     what: "indices",
     dimensions: gltf::accessor::Dimensions::Scalar,
@@ -332,6 +341,7 @@ impl Walker<'_> {
         let checks = [
             (prim.get(&gltf::Semantic::Positions), POSITION_RULE),
             (prim.get(&gltf::Semantic::Normals), NORMAL_RULE),
+            (prim.get(&gltf::Semantic::Tangents), TANGENT_RULE),
             (prim.indices(), INDICES_RULE),
             (prim.get(&gltf::Semantic::TexCoords(uv_set)), TEXCOORD_RULE),
         ];
@@ -479,6 +489,31 @@ impl Walker<'_> {
                 .map(|&v| (normal_matrix * v).normalize_or_zero())
                 .collect()
         });
+        // Tangents only matter to a normal map: read only under one, so that other
+        // triangles stay as they were. A tangent is a direction in the surface, carried by
+        // the node's matrix; a mirroring matrix turns N × T around, so w changes sign. A
+        // tangent that vanishes or is not finite leaves its triangles the triangle's own frame.
+        let normal_mapped = self
+            .data
+            .materials
+            .get(material as usize)
+            .and_then(|m| m.textures.as_deref())
+            .is_some_and(|t| t.normal.is_some());
+        let world_tangents: Option<Vec<Option<[f32; 4]>>> = reader
+            .read_tangents()
+            .filter(|_| normal_mapped)
+            .map(|tangents| {
+                tangents
+                    .map(|[x, y, z, w]| {
+                        let t = world
+                            .transform_vector3(Vec3::new(x, y, z))
+                            .try_normalize()?;
+                        let w = if w < 0.0 { -1.0 } else { 1.0 };
+                        Some([t.x, t.y, t.z, if flip { -w } else { w }])
+                    })
+                    .collect()
+            })
+            .filter(|t: &Vec<_>| t.len() == positions.len());
         for mut t in triangles {
             if flip {
                 t.swap(1, 2);
@@ -486,7 +521,11 @@ impl Walker<'_> {
             let p = t.map(|i| world_positions[i as usize]);
             let n = world_normals.as_ref().map(|n| t.map(|i| n[i as usize]));
             let uv = uvs.as_ref().map(|uv| t.map(|i| uv[i as usize]));
-            self.data.push_triangle(p, n, uv, material);
+            let tangents = world_tangents.as_ref().and_then(|tangents| {
+                let [a, b, c] = t.map(|i| tangents[i as usize]);
+                Some([a?, b?, c?])
+            });
+            self.data.push_triangle(p, n, uv, tangents, material);
         }
         Ok(())
     }
@@ -516,30 +555,36 @@ struct Textures<'a> {
 }
 
 impl Textures<'_> {
+    /// The name under which an image held inside the file (a buffer view or a `data:` URI) is
+    /// cached and named in errors: `FILE#imageN`.
+    fn embedded_key(&self, index: usize) -> PathBuf {
+        PathBuf::from(format!("{}#image{index}", self.path.display()))
+    }
+
     /// The texture `tex` as a colour (`srgb`) or data texture with its sampler's wrap modes and
-    /// the transform of `KHR_texture_transform`; `None` (with a warning) for an image embedded
-    /// as a data URI, which is not read.
+    /// the transform of `KHR_texture_transform`. The image is a file beside the glTF file, a
+    /// base64 `data:` URI or a buffer view (GLB).
     fn get(
         &mut self,
         tex: &gltf::Texture<'_>,
         srgb: bool,
         transform: Option<gltf::texture::TextureTransform<'_>>,
-    ) -> Result<Option<TextureRef>, LoadError> {
+    ) -> Result<TextureRef, LoadError> {
         let image = tex.source();
         let image = match image.source() {
             gltf::image::Source::Uri { uri, .. } => {
-                if uri.starts_with("data:") {
-                    self.warnings.push(format!(
-                        "image {} is embedded as a data uri, which is not read: its materials use their factors only",
-                        image.index()
-                    ));
-                    return Ok(None);
+                if let Some(rest) = uri.strip_prefix("data:") {
+                    let bytes =
+                        super::gltf_document::image_data_uri(self.path, image.index(), rest)?;
+                    self.cache
+                        .load_bytes(&self.embedded_key(image.index()), &bytes)?
+                } else {
+                    let file = self.dir.unwrap_or(Path::new("")).join(percent_decode(uri));
+                    self.cache.load(&file)?
                 }
-                let file = self.dir.unwrap_or(Path::new("")).join(percent_decode(uri));
-                self.cache.load(&file)?
             }
             gltf::image::Source::View { view, .. } => {
-                let key = PathBuf::from(format!("{}#image{}", self.path.display(), image.index()));
+                let key = self.embedded_key(image.index());
                 let bytes = self
                     .buffers
                     .get(view.buffer().index())
@@ -570,12 +615,12 @@ impl Textures<'_> {
                 texture.transform = m;
             }
         }
-        Ok(Some(texture))
+        Ok(texture)
     }
 
     /// A texture's colour channels' mean (linear data), for the metallic-roughness stand-in.
-    fn mean(&mut self, tex: &gltf::Texture<'_>) -> Result<Option<Vec3>, LoadError> {
-        Ok(self.get(tex, false, None)?.map(|t| t.image.mean(false)))
+    fn mean(&mut self, tex: &gltf::Texture<'_>) -> Result<Vec3, LoadError> {
+        Ok(self.get(tex, false, None)?.image.mean(false))
     }
 }
 
@@ -621,10 +666,9 @@ fn material(
     let mut uv_sets = Vec::new();
     if let Some(info) = pbr.metallic_roughness_texture() {
         uv_sets.push(info.tex_coord());
-        if let Some(mean) = textures.mean(&info.texture())? {
-            metallic *= mean.z;
-            roughness *= mean.y;
-        }
+        let mean = textures.mean(&info.texture())?;
+        metallic *= mean.z;
+        roughness *= mean.y;
     }
     let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
     let kind = if transmission > 0.0 {
@@ -649,22 +693,20 @@ fn material(
     let base_info = pbr.base_color_texture();
     if let Some(info) = &base_info {
         uv_sets.insert(0, info.tex_coord());
-        maps.color = textures.get(&info.texture(), true, info.texture_transform())?;
+        maps.color = Some(textures.get(&info.texture(), true, info.texture_transform())?);
     }
     if let Some(info) = m.emissive_texture()
         && emission != Vec3::ZERO
     {
         uv_sets.push(info.tex_coord());
-        maps.emission = textures.get(&info.texture(), true, info.texture_transform())?;
+        maps.emission = Some(textures.get(&info.texture(), true, info.texture_transform())?);
     }
     if let Some(normal) = m.normal_texture() {
         uv_sets.push(normal.tex_coord());
-        maps.normal = textures
-            .get(&normal.texture(), false, None)?
-            .map(|texture| NormalMap {
-                texture,
-                scale: normal.scale(),
-            });
+        maps.normal = Some(NormalMap {
+            texture: textures.get(&normal.texture(), false, None)?,
+            scale: normal.scale(),
+        });
     }
     let alpha_texture = maps.color.clone().filter(|t| t.image.has_alpha);
     let mode = match m.alpha_mode() {

@@ -144,3 +144,21 @@ fn buffer_uri(path: &Path, index: usize, uri: &str) -> Result<Vec<u8>, LoadError
         )
     })
 }
+
+/// The bytes of an image embedded as a data URI, `rest` being what follows `data:`:
+/// `[<media type>];base64,<data>` (glTF 2.0 allows only base64 for images). The media type is
+/// not checked: the decoder tells the format from the bytes, as for image files.
+pub(super) fn image_data_uri(path: &Path, index: usize, rest: &str) -> Result<Vec<u8>, LoadError> {
+    let Some((_, encoded)) = rest.split_once(";base64,") else {
+        return Err(gltf_error(
+            path,
+            format!("image {index}: data URI is not base64-encoded (no \";base64,\")"),
+        ));
+    };
+    base64::decode(encoded).map_err(|e| {
+        gltf_error(
+            path,
+            format!("image {index}: data URI is not valid base64 ({e})"),
+        )
+    })
+}

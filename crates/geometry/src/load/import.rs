@@ -292,6 +292,7 @@ impl Builder {
             normals,
             material,
             uv,
+            tangents: None,
         });
     }
 

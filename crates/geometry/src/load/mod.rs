@@ -216,6 +216,7 @@ impl MeshData {
         positions: [Vec3; 3],
         normals: Option<[Vec3; 3]>,
         uv: Option<[glam::Vec2; 3]>,
+        tangents: Option<[[f32; 4]; 3]>,
         material: u32,
     ) {
         if is_degenerate(positions) {
@@ -228,6 +229,7 @@ impl MeshData {
             normals: normals.and_then(clean_normals),
             material,
             uv,
+            tangents,
         });
     }
 
@@ -287,6 +289,29 @@ pub(crate) fn is_degenerate(p: [Vec3; 3]) -> bool {
     let cross = e1.cross(e2).length();
     let scale = e1.length_squared().max(e2.length_squared());
     !(cross.is_finite() && cross > 0.0 && cross > 1e-12 * scale)
+}
+
+/// A triangle's tangents (see [`Triangle::tangents`]) carried through the affine map `matrix`:
+/// each xyz by its linear part and renormalised (a tangent is a direction in the surface); a
+/// mirroring map (`flip`, negative determinant) turns N × T around, so w changes sign, and
+/// swaps vertices 1 and 2 as the loaders swap the positions. `None` if a tangent vanishes.
+pub(crate) fn transform_tangents(
+    tangents: [[f32; 4]; 3],
+    matrix: glam::Mat4,
+    flip: bool,
+) -> Option<[[f32; 4]; 3]> {
+    let mut out = [[0.0; 4]; 3];
+    for (o, [x, y, z, w]) in out.iter_mut().zip(tangents) {
+        let t = matrix
+            .transform_vector3(Vec3::new(x, y, z))
+            .try_normalize()?;
+        let w = if flip { -w } else { w };
+        *o = [t.x, t.y, t.z, w];
+    }
+    if flip {
+        out.swap(1, 2);
+    }
+    Some(out)
 }
 
 /// Normalises shading normals; drops them if any is zero or not finite.

@@ -181,7 +181,7 @@ fn add_mesh(data: &mut MeshData, mesh: &tobj::Mesh, material: u32) {
             let uvs = has_uv
                 .then(|| corner.map(uv))
                 .filter(|t| t.iter().all(|v| v.is_finite()));
-            data.push_triangle(corner.map(vertex), normals, uvs, material);
+            data.push_triangle(corner.map(vertex), normals, uvs, None, material);
         }
     }
 }

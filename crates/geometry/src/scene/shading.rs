@@ -77,11 +77,13 @@ impl Scene {
 
     /// Applies the material's normal map, if any, to the shading normal of a triangle hit.
     ///
-    /// The tangent frame is the triangle's: T = ∂p/∂u made perpendicular to the interpolated
-    /// normal, B = −∂p/∂v (texture v grows downwards while a normal map's green axis points up
-    /// the image), on the side of N × T that ∂p/∂v says, so that mirrored texture coordinates
-    /// keep the map's handedness. A perturbed normal that would face away from the geometric
-    /// one is not used.
+    /// The tangent frame is the file's where the triangle has vertex tangents (glTF
+    /// `TANGENT`): T interpolated like the normals and made perpendicular to the interpolated
+    /// normal N, B = w·(N × T) with w the sign of the interpolated handedness (glTF 2.0,
+    /// "Meshes"). Otherwise it is the triangle's: T = ∂p/∂u made perpendicular to N, B = −∂p/∂v
+    /// (texture v grows downwards while a normal map's green axis points up the image), on
+    /// the side of N × T that ∂p/∂v says, so that mirrored texture coordinates keep the map's
+    /// handedness. A perturbed normal that would face away from the geometric one is not used.
     pub(super) fn apply_normal_map(&self, hit: &mut Hit) {
         let Primitive::Triangle(i) = hit.primitive else {
             return;
@@ -94,29 +96,19 @@ impl Scene {
         else {
             return;
         };
-        let Some([uv0, uv1, uv2]) = tri.uv else {
-            return;
-        };
-        let [p0, p1, p2] = tri.positions;
-        let (duv02, duv12) = (uv0 - uv2, uv1 - uv2);
-        let (dp02, dp12) = (p0 - p2, p1 - p2);
-        let det = duv02.x * duv12.y - duv02.y * duv12.x;
-        if det == 0.0 || !det.is_finite() {
+        if tri.uv.is_none() {
             return;
         }
-        let dpdu = (duv12.y * dp02 - duv02.y * dp12) / det;
-        let dpdv = (duv02.x * dp12 - duv12.x * dp02) / det;
         // The interpolated normal on the front side: the map is in the surface's own frame.
         let n = if hit.front_face {
             hit.shading_normal
         } else {
             -hit.shading_normal
         };
-        let Some(t) = (dpdu - n * n.dot(dpdu)).try_normalize() else {
+        let Some((t, b)) = vertex_tangent_frame(tri, hit.uv, n).or_else(|| triangle_frame(tri, n))
+        else {
             return;
         };
-        let b = n.cross(t);
-        let b = if b.dot(-dpdv) < 0.0 { -b } else { b };
         let texel = map.texture.lookup(self.texture_uv(hit)).truncate() * 2.0 - Vec3::ONE;
         let local = Vec3::new(texel.x * map.scale, texel.y * map.scale, texel.z);
         let Some(mapped) = (local.x * t + local.y * b + local.z * n).try_normalize() else {
@@ -141,6 +133,38 @@ impl Scene {
         };
         textures.opaque(triangle_uv(tri, b1, b2), ray_hash(ray, index))
     }
+}
+
+/// The frame (T, B) of a triangle's vertex tangents at barycentrics `b` = (b1, b2) about the unit
+/// normal `n`: T = Σ bᵢ·Tᵢ made perpendicular to `n`, B = w·(n × T) with w the sign of
+/// Σ bᵢ·wᵢ. `None` without vertex tangents or where T is parallel to `n`.
+fn vertex_tangent_frame(tri: &crate::Triangle, b: Vec2, n: Vec3) -> Option<(Vec3, Vec3)> {
+    let [t0, t1, t2] = tri.tangents?.map(glam::Vec4::from_array);
+    let t = (1.0 - b.x - b.y) * t0 + b.x * t1 + b.y * t2;
+    let sign = if t.w < 0.0 { -1.0 } else { 1.0 };
+    let xyz = t.truncate();
+    let t = (xyz - n * n.dot(xyz)).try_normalize()?;
+    Some((t, sign * n.cross(t)))
+}
+
+/// A triangle's own tangent frame (T, B) from its texture coordinates about the unit normal
+/// `n`: T = ∂p/∂u made perpendicular to `n`, B = ±(n × T) on the side of −∂p/∂v. `None`
+/// without texture coordinates, for a degenerate parametrisation, or where ∂p/∂u is parallel
+/// to `n`.
+fn triangle_frame(tri: &crate::Triangle, n: Vec3) -> Option<(Vec3, Vec3)> {
+    let [uv0, uv1, uv2] = tri.uv?;
+    let [p0, p1, p2] = tri.positions;
+    let (duv02, duv12) = (uv0 - uv2, uv1 - uv2);
+    let (dp02, dp12) = (p0 - p2, p1 - p2);
+    let det = duv02.x * duv12.y - duv02.y * duv12.x;
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let dpdu = (duv12.y * dp02 - duv02.y * dp12) / det;
+    let dpdv = (duv02.x * dp12 - duv12.x * dp02) / det;
+    let t = (dpdu - n * n.dot(dpdu)).try_normalize()?;
+    let b = n.cross(t);
+    Some((t, if b.dot(-dpdv) < 0.0 { -b } else { b }))
 }
 
 /// Whether a material's textures cut its surface out anywhere.

@@ -229,6 +229,7 @@ fn mesh_curvature_from_vertex_normals() {
                     normals: Some([p, q, s]),
                     material: 0,
                     uv: None,
+                    tangents: None,
                 });
             }
         }
@@ -517,6 +518,7 @@ fn mesh_curvature_is_the_focusing_principal_curvature() {
                 normals: Some(normals),
                 material: 0,
                 uv: None,
+                tangents: None,
             });
         }
     }

@@ -1,5 +1,5 @@
 //! Textures at hits: cut-outs for every query, textured emitters sampled without bias, the
-//! colour a hit reports, and normal maps in the triangle's frame.
+//! colour a hit reports, and normal maps in the triangle's frame or the vertex tangents' one.
 
 use std::sync::Arc;
 
@@ -213,4 +213,65 @@ fn normal_maps_turn_the_shading_normal_in_the_texture_frame() {
         "{}",
         back.shading_normal
     );
+}
+
+#[test]
+fn vertex_tangents_give_the_normal_map_frame() {
+    // A texel whose tangent-space normal (x, y, z) has both tangent components, so that the
+    // tangent and the bitangent's side both show in the result.
+    let texel = [191u8, 166, 218, 255];
+    let local = Vec3::new(
+        f32::from(texel[0]),
+        f32::from(texel[1]),
+        f32::from(texel[2]),
+    ) * (2.0 / 255.0)
+        - Vec3::ONE;
+    // The hit (0.3, 0.6) lies in the quad's second triangle (0,0), (1,1), (0,1), at
+    // barycentrics b0 = 0.4, b1 = b2 = 0.3. Its vertex tangents: +x at the first vertex, +y
+    // tilted out of the plane at the others; interpolated and made perpendicular to the normal
+    // +z, T ∝ 0.4·x + 0.6·(up's y)·y.
+    let up = Vec3::new(0.0, 1.0, 0.5).normalize();
+    let t = Vec3::new(0.4, 0.6 * up.y, 0.0).normalize();
+    let n = Vec3::Z;
+    for w in [1.0f32, -1.0] {
+        let mut triangles = quad(2);
+        for tri in &mut triangles {
+            tri.normals = Some([Vec3::Z; 3]);
+        }
+        triangles[1].tangents = Some([
+            [1.0, 0.0, 0.0, w],
+            [up.x, up.y, up.z, w],
+            [up.x, up.y, up.z, w],
+        ]);
+        let mut d = description(
+            triangles,
+            Vec::new(),
+            vec![point_light(Vec3::new(5.0, 5.0, 10.0))],
+        );
+        d.materials.push(with_textures(
+            diffuse(0.5, Vec3::ZERO),
+            MaterialTextures {
+                normal: Some(NormalMap {
+                    texture: TextureRef::new(test_image(1, 1, vec![texel]), false),
+                    scale: 1.0,
+                }),
+                ..Default::default()
+            },
+        ));
+        let scene = Scene::new(d).unwrap();
+        let hit = scene
+            .intersect(&Ray::infinite(Vec3::new(0.3, 0.6, 1.0), -Vec3::Z))
+            .unwrap();
+        // glTF 2.0: B = w·(N × T); z × (a, b, 0) = (−b, a, 0).
+        let b = w * Vec3::new(-t.y, t.x, 0.0);
+        let expected = (local.x * t + local.y * b + local.z * n).normalize();
+        let got = hit.shading_normal;
+        assert!(
+            (got - expected).length() < 1e-5,
+            "w {w}: {got} != {expected}"
+        );
+        // Not the triangle's own frame (T = +x, B = +y on this quad).
+        let own = (local.x * Vec3::X + local.y * Vec3::Y + local.z * n).normalize();
+        assert!((got - own).length() > 0.1, "w {w}: {got}");
+    }
 }

@@ -42,15 +42,26 @@ material = "lamp"
 /// A scene whose emitter's albedo is the texture `tex.png` next to it.
 const TEXTURED: &str = "format = 1\n[materials.m]\ntype = \"diffuse\"\nalbedo = { texture = \"tex.png\" }\nemission = [1, 1, 1]\n[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n";
 
-/// A glTF triangle whose material's base colour is the texture `tex.png` (positions and texture
-/// coordinates in one base64 buffer; the material emits).
-const GLTF_TEXTURED: &str = r#"{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+/// A glTF triangle whose material's base colour is the image at the URI `$uri` (a string
+/// literal); positions in one base64 buffer; the material emits.
+macro_rules! gltf_textured_uri {
+    ($uri:literal) => {
+        concat!(
+            r#"{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
 "meshes":[{"primitives":[{"attributes":{"POSITION":0},"material":0}]}],
 "materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0},"metallicFactor":0},"emissiveFactor":[1,1,1]}],
-"textures":[{"source":0}],"images":[{"uri":"tex.png"}],
+"textures":[{"source":0}],"images":[{"uri":""#,
+            $uri,
+            r#""}],
 "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
 "bufferViews":[{"buffer":0,"byteLength":36}],
-"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]}"#;
+"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]}"#
+        )
+    };
+}
+
+/// A glTF triangle whose material's base colour is the texture `tex.png` beside it.
+const GLTF_TEXTURED: &str = gltf_textured_uri!("tex.png");
 
 /// Loads `BASE` with one textual replacement, as if from `dir/scene.toml`.
 fn load_edited(
@@ -426,6 +437,31 @@ const FILES: &[BadFile] = &[
         files: &[("scene.gltf", GLTF_TEXTURED)],
         expect: &["Texture {", "cannot read texture"],
         named: "tex.png",
+    },
+    BadFile {
+        test: "gltf_image_data_uri_not_base64",
+        files: &[(
+            "scene.gltf",
+            gltf_textured_uri!("data:image/png;base64,iVBOR*w0KGgo"),
+        )],
+        expect: &["Gltf {", "image 0: data URI is not valid base64"],
+        named: "scene.gltf",
+    },
+    BadFile {
+        test: "gltf_image_data_uri_without_base64",
+        files: &[("scene.gltf", gltf_textured_uri!("data:image/png,abc"))],
+        expect: &["Gltf {", "image 0: data URI is not base64-encoded"],
+        named: "scene.gltf",
+    },
+    BadFile {
+        // Valid base64 of "hello, world": not an image.
+        test: "gltf_image_data_uri_not_an_image",
+        files: &[(
+            "scene.gltf",
+            gltf_textured_uri!("data:image/png;base64,aGVsbG8sIHdvcmxk"),
+        )],
+        expect: &["Texture {"],
+        named: "scene.gltf#image0",
     },
     BadFile {
         test: "no_emitter",

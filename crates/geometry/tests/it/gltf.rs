@@ -188,3 +188,185 @@ fn index_out_of_range_is_an_error() {
     crate::assert_names_file(&err, &path);
     assert!(err.to_string().contains("index 7"), "{err}");
 }
+
+/// A 2 × 1 PNG, red on the left and blue on the right, written by the `image` crate's encoder.
+fn red_blue_png() -> Vec<u8> {
+    let image = image::RgbaImage::from_raw(2, 1, vec![255, 0, 0, 255, 0, 0, 255, 255]).unwrap();
+    let mut png = Vec::new();
+    image
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    png
+}
+
+/// One triangle whose material's base colour is image 0, given by `uri`.
+fn gltf_with_image(uri: &str) -> String {
+    GLTF.replace(
+        r#""pbrMetallicRoughness": { "baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0 }"#,
+        r#""pbrMetallicRoughness": { "baseColorTexture": { "index": 0 }, "metallicFactor": 0 }"#,
+    )
+    .replace(
+        r#""meshes": ["#,
+        &format!(
+            r#""textures": [ {{ "source": 0 }} ], "images": [ {{ "uri": "{uri}" }} ], "meshes": ["#
+        ),
+    )
+}
+
+#[test]
+fn image_embedded_as_a_data_uri_is_read() {
+    let uri = format!("data:image/png;base64,{}", base64::encode(red_blue_png()));
+    let gltf = gltf_with_image(&uri);
+    assert!(gltf.contains("baseColorTexture") && gltf.contains(&uri));
+    let path = write("gltf_data_uri_image", &gltf);
+    let scene = load(&path).unwrap();
+    let textures = scene.materials[0].textures.as_deref().expect("textured");
+    let color = textures.color.as_ref().expect("a base colour texture");
+    assert_eq!(color.image.resolution(), (2, 1));
+    // Texel centres (sRGB 255 and 0 decode to 1 and 0 exactly).
+    assert_close(color.color(glam::Vec2::new(0.25, 0.5)), Vec3::X);
+    assert_close(color.color(glam::Vec2::new(0.75, 0.5)), Vec3::Z);
+    // Named after the glTF file, as an image in a buffer view is.
+    assert_eq!(
+        color.image.path(),
+        std::path::Path::new(&format!("{}#image0", path.display()))
+    );
+    assert!(
+        scene.notes.warnings.iter().all(|w| !w.contains("data")),
+        "{:?}",
+        scene.notes.warnings
+    );
+}
+
+#[test]
+fn image_data_uri_read_as_a_file_gives_the_same_texels() {
+    // The same PNG beside the file: the data URI is decoded to the same bytes.
+    let path = write("gltf_data_uri_vs_file", &gltf_with_image("rb.png"));
+    std::fs::write(path.with_file_name("rb.png"), red_blue_png()).unwrap();
+    let from_file = load(&path).unwrap();
+    let uri = format!("data:image/png;base64,{}", base64::encode(red_blue_png()));
+    let from_uri = load(&write("gltf_data_uri_vs_file2", &gltf_with_image(&uri))).unwrap();
+    let texture = |s: &geometry::SceneDescription| {
+        s.materials[0]
+            .textures
+            .as_deref()
+            .unwrap()
+            .color
+            .clone()
+            .unwrap()
+    };
+    let (a, b) = (texture(&from_file), texture(&from_uri));
+    for uv in [(0.1, 0.5), (0.5, 0.5), (0.9, 0.2)] {
+        let uv = glam::Vec2::from(uv);
+        assert_eq!(a.lookup(uv), b.lookup(uv));
+    }
+}
+
+/// One triangle with normals, texture coordinates and `TANGENT`s (given unnormalised, all
+/// with w = −1), drawn by three nodes: as it is, mirrored by a scale of −1 along x, and under a
+/// material without a normal map.
+fn gltf_with_tangents() -> String {
+    let floats: [f32; 3 * 3 + 3 * 3 + 3 * 2 + 3 * 4] = [
+        // POSITION
+        0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, //
+        // NORMAL
+        0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, //
+        // TEXCOORD_0
+        0.0, 1.0, 1.0, 1.0, 0.0, 0.0, //
+        // TANGENT
+        2.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0, -1.0, 1.0, 1.0, 0.0, -1.0,
+    ];
+    let bytes: Vec<u8> = floats.iter().flat_map(|f| f.to_le_bytes()).collect();
+    let png = base64::encode(red_blue_png());
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0,1,2]}}],
+"nodes":[{{"mesh":0}},{{"mesh":0,"scale":[-1,1,1]}},{{"mesh":1}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"NORMAL":1,"TEXCOORD_0":2,"TANGENT":3}},"material":0}}]}},
+          {{"primitives":[{{"attributes":{{"POSITION":0,"NORMAL":1,"TEXCOORD_0":2,"TANGENT":3}},"material":1}}]}}],
+"materials":[{{"normalTexture":{{"index":0}},"emissiveFactor":[1,1,1],"pbrMetallicRoughness":{{"metallicFactor":0}}}},
+             {{"pbrMetallicRoughness":{{"metallicFactor":0}}}}],
+"textures":[{{"source":0}}],"images":[{{"uri":"data:image/png;base64,{png}"}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+             {{"bufferView":0,"byteOffset":36,"componentType":5126,"count":3,"type":"VEC3"}},
+             {{"bufferView":0,"byteOffset":72,"componentType":5126,"count":3,"type":"VEC2"}},
+             {{"bufferView":0,"byteOffset":96,"componentType":5126,"count":3,"type":"VEC4"}}],
+"bufferViews":[{{"buffer":0,"byteLength":{len}}}],
+"buffers":[{{"byteLength":{len},"uri":"data:application/octet-stream;base64,{data}"}}]}}"#,
+        len = bytes.len(),
+        data = base64::encode(&bytes),
+    )
+}
+
+#[test]
+fn tangents_are_read_under_a_normal_map_and_follow_the_node() {
+    let scene = load(&write("gltf_tangents", &gltf_with_tangents())).unwrap();
+    assert_eq!(scene.triangles.len(), 3);
+    let h = std::f32::consts::FRAC_1_SQRT_2;
+    let close = |got: [[f32; 4]; 3], want: [[f32; 4]; 3]| {
+        for (g, w) in got.iter().zip(&want) {
+            let d = glam::Vec4::from_array(*g) - glam::Vec4::from_array(*w);
+            assert!(d.length() < 1e-6, "{got:?} != {want:?}");
+        }
+    };
+    // As given: unit xyz, w kept.
+    close(
+        scene.triangles[0].tangents.expect("tangents"),
+        [
+            [1.0, 0.0, 0.0, -1.0],
+            [0.0, 1.0, 0.0, -1.0],
+            [h, h, 0.0, -1.0],
+        ],
+    );
+    // Mirrored in x: x negated, the winding swapped (vertices 1 and 2), and w turned around
+    // (B = w·(N × T) must stay the mirror image of the unmirrored bitangent).
+    assert_eq!(
+        scene.triangles[1].positions,
+        [Vec3::ZERO, Vec3::Y, Vec3::new(-1.0, 0.0, 0.0)]
+    );
+    close(
+        scene.triangles[1].tangents.expect("tangents"),
+        [
+            [-1.0, 0.0, 0.0, 1.0],
+            [-h, h, 0.0, 1.0],
+            [0.0, 1.0, 0.0, 1.0],
+        ],
+    );
+    // No normal map: the tangents are not kept.
+    assert_eq!(scene.triangles[2].tangents, None);
+}
+
+#[test]
+fn tangent_accessor_of_the_wrong_type_is_an_error() {
+    let gltf = gltf_with_tangents().replace(
+        r#""byteOffset":96,"componentType":5126,"count":3,"type":"VEC4""#,
+        r#""byteOffset":96,"componentType":5126,"count":3,"type":"VEC3""#,
+    );
+    let path = write("gltf_tangent_vec3", &gltf);
+    let err = load(&path).unwrap_err();
+    assert!(err.to_string().contains("(TANGENT) is Vec3"), "{err}");
+    crate::assert_names_file(&err, &path);
+}
+
+#[test]
+fn tangents_follow_a_mirroring_toml_transform() {
+    // The glTF of `gltf_with_tangents` as a mesh of a TOML scene, mirrored in x by the
+    // transform: node 0's triangle ends up as node 1's does inside the glTF.
+    let gltf = write("gltf_tangents_in_toml", &gltf_with_tangents());
+    let toml = gltf.with_file_name("scene.toml");
+    std::fs::write(
+        &toml,
+        "format = 1\n[[shapes]]\ntype = \"mesh\"\nfile = \"scene.gltf\"\ntransform = { scale = [-1.0, 1.0, 1.0] }\n",
+    )
+    .unwrap();
+    let scene = load(&toml).unwrap();
+    let inside = load(&gltf).unwrap();
+    assert_eq!(scene.triangles[0].positions, inside.triangles[1].positions);
+    let (got, want) = (
+        scene.triangles[0].tangents.expect("tangents"),
+        inside.triangles[1].tangents.expect("tangents"),
+    );
+    for (g, w) in got.iter().zip(&want) {
+        let d = glam::Vec4::from_array(*g) - glam::Vec4::from_array(*w);
+        assert!(d.length() < 1e-6, "{got:?} != {want:?}");
+    }
+}

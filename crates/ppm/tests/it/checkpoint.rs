@@ -113,6 +113,22 @@ fn the_fingerprint_covers_textures() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Vertex tangents (a normal map's frame) change the fingerprint; a scene without them keeps
+/// the one it had.
+#[test]
+fn the_fingerprint_covers_tangents() {
+    let mut scene = cornell("CornellBox-Sphere.obj", 4, 4).description().clone();
+    let plain = ppm::scene_fingerprint(&scene);
+    scene.triangles[0].tangents = Some([[1.0, 0.0, 0.0, 1.0]; 3]);
+    let with = ppm::scene_fingerprint(&scene);
+    scene.triangles[0].tangents = Some([[1.0, 0.0, 0.0, -1.0]; 3]);
+    let mirrored = ppm::scene_fingerprint(&scene);
+    assert_ne!(plain, with);
+    assert_ne!(with, mirrored);
+    scene.triangles[0].tangents = None;
+    assert_eq!(plain, ppm::scene_fingerprint(&scene));
+}
+
 const PNG_HEX: &str = "89504e470d0a1a0a0000000d49484452000000010000000108060000001f15c4890000000d4944415478da636460f85f0f0002870180eb47ba920000000049454e44ae426082";
 
 /// A checkpoint with its columns changed by `edit` (decompressed, edited, recompressed, the

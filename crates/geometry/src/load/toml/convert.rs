@@ -192,12 +192,14 @@ impl Converter<'_> {
                         [c, c + e1, c + e1 + e2],
                         None,
                         Some([uv(0.0, 0.0), uv(1.0, 0.0), uv(1.0, 1.0)]),
+                        None,
                         m,
                     );
                     acc.push(
                         [c, c + e1 + e2, c + e2],
                         None,
                         Some([uv(0.0, 0.0), uv(1.0, 1.0), uv(0.0, 1.0)]),
+                        None,
                         m,
                     );
                 }
@@ -255,7 +257,10 @@ impl Converter<'_> {
                             }
                         }
                         let n = n.filter(|n| n.iter().all(|v| *v != Vec3::ZERO));
-                        acc.push(p, n, uv, material_of(t.material));
+                        let tangents = t
+                            .tangents
+                            .and_then(|t| crate::load::transform_tangents(t, matrix, flip));
+                        acc.push(p, n, uv, tangents, material_of(t.material));
                     }
                 }
             }
@@ -636,6 +641,7 @@ impl Accumulator {
         positions: [Vec3; 3],
         normals: Option<[Vec3; 3]>,
         uv: Option<[glam::Vec2; 3]>,
+        tangents: Option<[[f32; 4]; 3]>,
         material: u32,
     ) {
         if crate::load::is_degenerate(positions) {
@@ -647,6 +653,7 @@ impl Accumulator {
                 normals,
                 material,
                 uv,
+                tangents,
             });
         }
     }
