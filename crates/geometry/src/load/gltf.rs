@@ -212,6 +212,7 @@ const TANGENT_RULE: AccessorRule = AccessorRule {
     what: "TANGENT",
     dimensions: gltf::accessor::Dimensions::Vec4,
     types: &[gltf::accessor::DataType::F32],
+    normalized: false,
 };
 const INDICES_RULE: AccessorRule = AccessorRule {
     what: "indices",
@@ -223,7 +224,6 @@ const INDICES_RULE: AccessorRule = AccessorRule {
     ],
     normalized: false,
 };
-
 const TEXCOORD_RULE: AccessorRule = AccessorRule {
     what: "TEXCOORD",
     dimensions: gltf::accessor::Dimensions::Vec2,
