@@ -39,6 +39,20 @@ fn with_textures(mut m: crate::Material, t: MaterialTextures) -> crate::Material
     m
 }
 
+/// A grey diffuse material whose normals come from `image` (a tangent-space map).
+fn normal_mapped(image: Arc<crate::texture::Image>) -> crate::Material {
+    with_textures(
+        diffuse(0.5, Vec3::ZERO),
+        MaterialTextures {
+            normal: Some(NormalMap {
+                texture: TextureRef::new(image, false),
+                scale: 1.0,
+            }),
+            ..Default::default()
+        },
+    )
+}
+
 #[test]
 fn cutouts_let_every_query_through_their_holes() {
     // A masked quad (alpha 0 on the left, 1 on the right, cutoff ½: the hole is x < ½) in front
@@ -188,16 +202,7 @@ fn normal_maps_turn_the_shading_normal_in_the_texture_frame() {
         Vec::new(),
         vec![point_light(Vec3::new(5.0, 5.0, 10.0))],
     );
-    d.materials.push(with_textures(
-        diffuse(0.5, Vec3::ZERO),
-        MaterialTextures {
-            normal: Some(NormalMap {
-                texture: TextureRef::new(image, false),
-                scale: 1.0,
-            }),
-            ..Default::default()
-        },
-    ));
+    d.materials.push(normal_mapped(image));
     let scene = Scene::new(d).unwrap();
     let hit = scene
         .intersect(&Ray::infinite(Vec3::new(0.3, 0.6, 1.0), -Vec3::Z))
@@ -248,16 +253,8 @@ fn vertex_tangents_give_the_normal_map_frame() {
             Vec::new(),
             vec![point_light(Vec3::new(5.0, 5.0, 10.0))],
         );
-        d.materials.push(with_textures(
-            diffuse(0.5, Vec3::ZERO),
-            MaterialTextures {
-                normal: Some(NormalMap {
-                    texture: TextureRef::new(test_image(1, 1, vec![texel]), false),
-                    scale: 1.0,
-                }),
-                ..Default::default()
-            },
-        ));
+        d.materials
+            .push(normal_mapped(test_image(1, 1, vec![texel])));
         let scene = Scene::new(d).unwrap();
         let hit = scene
             .intersect(&Ray::infinite(Vec3::new(0.3, 0.6, 1.0), -Vec3::Z))
