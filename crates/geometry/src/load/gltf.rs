@@ -505,11 +505,8 @@ impl Walker<'_> {
             .map(|tangents| {
                 tangents
                     .map(|[x, y, z, w]| {
-                        let t = world
-                            .transform_vector3(Vec3::new(x, y, z))
-                            .try_normalize()?;
                         let w = if w < 0.0 { -1.0 } else { 1.0 };
-                        Some([t.x, t.y, t.z, if flip { -w } else { w }])
+                        super::transform_tangent([x, y, z, w], world, flip)
                     })
                     .collect()
             })

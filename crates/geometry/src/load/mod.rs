@@ -291,27 +291,31 @@ pub(crate) fn is_degenerate(p: [Vec3; 3]) -> bool {
     !(cross.is_finite() && cross > 0.0 && cross > 1e-12 * scale)
 }
 
-/// A triangle's tangents (see [`Triangle::tangents`]) carried through the affine map `matrix`:
-/// each xyz by its linear part and renormalised (a tangent is a direction in the surface); a
-/// mirroring map (`flip`, negative determinant) turns N × T around, so w changes sign, and
-/// swaps vertices 1 and 2 as the loaders swap the positions. `None` if a tangent vanishes.
+/// A vertex tangent `[x, y, z, w]` (see [`Triangle::tangents`]) carried through the affine map
+/// `matrix`: xyz by its linear part and renormalised (a tangent is a direction in the surface);
+/// a mirroring map (`flip`, negative determinant) turns N × T around, so w changes sign. `None`
+/// if the tangent vanishes.
+pub(crate) fn transform_tangent(
+    [x, y, z, w]: [f32; 4],
+    matrix: glam::Mat4,
+    flip: bool,
+) -> Option<[f32; 4]> {
+    let t = matrix
+        .transform_vector3(Vec3::new(x, y, z))
+        .try_normalize()?;
+    Some([t.x, t.y, t.z, if flip { -w } else { w }])
+}
+
+/// A triangle's tangents carried through `matrix` ([`transform_tangent`]); a mirroring map also
+/// swaps vertices 1 and 2, as the loaders swap the positions. `None` if a tangent vanishes.
 pub(crate) fn transform_tangents(
     tangents: [[f32; 4]; 3],
     matrix: glam::Mat4,
     flip: bool,
 ) -> Option<[[f32; 4]; 3]> {
-    let mut out = [[0.0; 4]; 3];
-    for (o, [x, y, z, w]) in out.iter_mut().zip(tangents) {
-        let t = matrix
-            .transform_vector3(Vec3::new(x, y, z))
-            .try_normalize()?;
-        let w = if flip { -w } else { w };
-        *o = [t.x, t.y, t.z, w];
-    }
-    if flip {
-        out.swap(1, 2);
-    }
-    Some(out)
+    let [a, b, c] = tangents.map(|t| transform_tangent(t, matrix, flip));
+    let (a, b, c) = (a?, b?, c?);
+    Some(if flip { [a, c, b] } else { [a, b, c] })
 }
 
 /// Normalises shading normals; drops them if any is zero or not finite.
