@@ -591,6 +591,10 @@ pub fn scene_fingerprint(d: &SceneDescription) -> u64 {
             texture("emission", t.emission.as_ref());
             texture("normal", t.normal.as_ref().map(|n| &n.texture));
             texture("alpha", t.alpha.as_ref().and_then(|a| a.texture.as_ref()));
+            texture(
+                "metallic_roughness",
+                t.metallic_roughness.as_ref().map(|m| &m.texture),
+            );
             if let Some(n) = &t.normal {
                 w.f32(n.scale);
             }
@@ -600,6 +604,13 @@ pub fn scene_fingerprint(d: &SceneDescription) -> u64 {
                     geometry::texture::AlphaMode::Mask { cutoff } => w.f32(cutoff),
                     geometry::texture::AlphaMode::Blend => w.str("blend"),
                 }
+            }
+            // Only materials with a metallic-roughness texture hash it, so that other
+            // fingerprints stay as they were.
+            if let Some(mr) = &t.metallic_roughness {
+                mr.base.to_array().iter().for_each(|&c| w.f32(c));
+                w.f32(mr.metallic);
+                w.f32(mr.roughness);
             }
         }
     }

@@ -5,7 +5,8 @@
 //! - materials: transmission > 0 → dielectric (ior from `KHR_materials_ior`, default 1.5);
 //!   metallic ≥ 0.5 ([`METALLIC_THRESHOLD`]) with roughness < 0.01 → mirror with the base
 //!   colour; metallic ≥ 0.5 otherwise → glossy with α = roughness² and no diffuse base;
-//!   else diffuse with the base colour; textures as [`material`] says.
+//!   else diffuse with the base colour ([`gltf_kind`]), per texel under a metallic-roughness
+//!   texture; textures as [`material`] says.
 //!   Emission = emissive factor × emissive strength. A primitive without a material gets
 //!   the glTF default material (white, metallic 1, roughness 1, so glossy with α = 1);
 //! - the camera is the perspective camera with the lowest index that a node of the scene
@@ -33,14 +34,34 @@ use super::{MeshData, read_bytes};
 use crate::description::{Camera, Light, Material, MaterialKind};
 use crate::error::LoadError;
 use crate::texture::{
-    Alpha, AlphaMode, MaterialTextures, NormalMap, TextureCache, TextureRef, Wrap,
+    Alpha, AlphaMode, MaterialTextures, MetallicRoughness, NormalMap, TextureCache, TextureRef,
+    Wrap,
 };
 
 /// Metallic factor from which a glTF material counts as a conductor.
 pub const METALLIC_THRESHOLD: f32 = 0.5;
 
 /// Roughness below which a conductor is a perfect mirror.
-const MIRROR_ROUGHNESS: f32 = 0.01;
+pub(crate) const MIRROR_ROUGHNESS: f32 = 0.01;
+
+/// The scattering model of an opaque glTF material with base colour `base`: a conductor
+/// (mirror below [`MIRROR_ROUGHNESS`], else glossy with α = roughness² and no diffuse base)
+/// from metallic [`METALLIC_THRESHOLD`] on, else diffuse with the base colour.
+pub(crate) fn gltf_kind(base: Vec3, metallic: f32, roughness: f32) -> MaterialKind {
+    if metallic >= METALLIC_THRESHOLD {
+        if roughness < MIRROR_ROUGHNESS {
+            MaterialKind::Mirror { reflectance: base }
+        } else {
+            MaterialKind::Glossy {
+                reflectance: base,
+                roughness: roughness * roughness,
+                diffuse: Vec3::ZERO,
+            }
+        }
+    } else {
+        MaterialKind::Diffuse { albedo: base }
+    }
+}
 
 /// Deepest node hierarchy accepted (guards against cyclic node graphs).
 const MAX_DEPTH: usize = 1024;
@@ -484,48 +505,122 @@ impl Walker<'_> {
             .iter()
             .map(|&p| world.transform_point3(p))
             .collect();
-        let world_normals: Option<Vec<Vec3>> = normals.map(|n| {
-            n.iter()
-                .map(|&v| (normal_matrix * v).normalize_or_zero())
-                .collect()
-        });
-        // Tangents only matter to a normal map: read only under one, so that other
-        // triangles stay as they were. A tangent is a direction in the surface, carried by
-        // the node's matrix; a mirroring matrix turns N × T around, so w changes sign. A
-        // tangent that vanishes or is not finite leaves its triangles the triangle's own frame.
+        // Tangents only matter to a normal map: read (or generated) only under one, so that
+        // other triangles stay as they were. Per triangle corner, in the file's frame: the
+        // file's TANGENT, else MikkTSpace's from the positions, normals and texture
+        // coordinates (what glTF 2.0 asks for when a file has none, and what the tools that
+        // bake normal maps use); without normals or texture coordinates the normal map falls
+        // back on the triangle's own frame.
         let normal_mapped = self
             .data
             .materials
             .get(material as usize)
             .and_then(|m| m.textures.as_deref())
             .is_some_and(|t| t.normal.is_some());
-        let world_tangents: Option<Vec<Option<[f32; 4]>>> = reader
-            .read_tangents()
-            .filter(|_| normal_mapped)
-            .map(|tangents| {
-                tangents
-                    .map(|[x, y, z, w]| {
-                        let w = if w < 0.0 { -1.0 } else { 1.0 };
-                        super::transform_tangent([x, y, z, w], world, flip)
-                    })
+        let corner_tangents: Option<Vec<[[f32; 4]; 3]>> = if !normal_mapped {
+            None
+        } else if let Some(tangents) = reader.read_tangents() {
+            let tangents: Vec<[f32; 4]> = tangents.collect();
+            (tangents.len() == positions.len()).then(|| {
+                triangles
+                    .iter()
+                    .map(|t| t.map(|i| tangents[i as usize]))
                     .collect()
             })
-            .filter(|t: &Vec<_>| t.len() == positions.len());
-        for mut t in triangles {
+        } else {
+            match (&normals, &uvs) {
+                (Some(normals), Some(uvs)) => {
+                    Some(mikktspace_tangents(&triangles, &positions, normals, uvs))
+                }
+                _ => None,
+            }
+        };
+        let world_normals: Option<Vec<Vec3>> = normals.map(|n| {
+            n.iter()
+                .map(|&v| (normal_matrix * v).normalize_or_zero())
+                .collect()
+        });
+        for (k, mut t) in triangles.into_iter().enumerate() {
+            // A tangent is a direction in the surface, carried by the node's matrix; a
+            // mirroring matrix turns N × T around, so w changes sign (and the corners swap
+            // with the positions). A tangent that vanishes or is not finite leaves its
+            // triangle the triangle's own frame.
+            let tangents = corner_tangents.as_ref().and_then(|corners| {
+                let signed =
+                    corners[k].map(|[x, y, z, w]| [x, y, z, if w < 0.0 { -1.0 } else { 1.0 }]);
+                super::transform_tangents(signed, world, flip)
+            });
             if flip {
                 t.swap(1, 2);
             }
             let p = t.map(|i| world_positions[i as usize]);
             let n = world_normals.as_ref().map(|n| t.map(|i| n[i as usize]));
             let uv = uvs.as_ref().map(|uv| t.map(|i| uv[i as usize]));
-            let tangents = world_tangents.as_ref().and_then(|tangents| {
-                let [a, b, c] = t.map(|i| tangents[i as usize]);
-                Some([a?, b?, c?])
-            });
             self.data.push_triangle(p, n, uv, tangents, material);
         }
         Ok(())
     }
+}
+
+/// MikkTSpace tangents (x, y, z, w) per triangle corner of the mesh `triangles` with per-vertex
+/// `positions`, `normals` and texture coordinates `uvs` (glTF's, v downwards).
+///
+/// MikkTSpace gets v upwards (1 − v, as Blender gives it and as normal maps are baked): its
+/// tangent follows ∂p/∂u and its sign makes w·(N × T) follow ∂p/∂v upwards, the frame that
+/// glTF's TANGENT and the renderer's normal maps use (green up the image). A corner
+/// MikkTSpace gives nothing (a degenerate triangle without neighbours) gets a zero tangent,
+/// which leaves its triangle the triangle's own frame.
+fn mikktspace_tangents(
+    triangles: &[[u32; 3]],
+    positions: &[Vec3],
+    normals: &[Vec3],
+    uvs: &[Vec2],
+) -> Vec<[[f32; 4]; 3]> {
+    struct Mesh<'a> {
+        triangles: &'a [[u32; 3]],
+        positions: &'a [Vec3],
+        normals: &'a [Vec3],
+        uvs: &'a [Vec2],
+        out: Vec<[[f32; 4]; 3]>,
+    }
+    impl bevy_mikktspace::Geometry for Mesh<'_> {
+        fn num_faces(&self) -> usize {
+            self.triangles.len()
+        }
+        fn num_vertices_of_face(&self, _face: usize) -> usize {
+            3
+        }
+        fn position(&self, face: usize, vert: usize) -> [f32; 3] {
+            self.positions[self.triangles[face][vert] as usize].to_array()
+        }
+        fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
+            self.normals[self.triangles[face][vert] as usize].to_array()
+        }
+        fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
+            let uv = self.uvs[self.triangles[face][vert] as usize];
+            [uv.x, 1.0 - uv.y]
+        }
+        fn set_tangent(
+            &mut self,
+            tangent_space: Option<bevy_mikktspace::TangentSpace>,
+            face: usize,
+            vert: usize,
+        ) {
+            self.out[face][vert] = tangent_space.map_or([0.0; 4], |t| t.tangent_encoded());
+        }
+    }
+    let mut mesh = Mesh {
+        triangles,
+        positions,
+        normals,
+        uvs,
+        out: vec![[[0.0; 4]; 3]; triangles.len()],
+    };
+    // The error type has no values: generation cannot fail.
+    if bevy_mikktspace::generate_tangents(&mut mesh).is_err() {
+        return vec![[[0.0; 4]; 3]; triangles.len()];
+    }
+    mesh.out
 }
 
 /// The glTF default material: base colour 1, metallic 1, roughness 1.
@@ -614,11 +709,6 @@ impl Textures<'_> {
         }
         Ok(texture)
     }
-
-    /// A texture's colour channels' mean (linear data), for the metallic-roughness stand-in.
-    fn mean(&mut self, tex: &gltf::Texture<'_>) -> Result<Vec3, LoadError> {
-        Ok(self.get(tex, false, None)?.image.mean(false))
-    }
 }
 
 /// A URI's `%XX` escapes decoded (glTF URIs are percent-encoded: `a%20b.png`).
@@ -647,9 +737,10 @@ fn percent_decode(uri: &str) -> String {
 ///
 /// Textures: the base colour texture multiplies the base colour (and its alpha the alpha);
 /// the emissive texture the emission; the normal texture perturbs the shading normal; the
-/// metallic-roughness texture stands in as its mean (metallic × mean blue, roughness × mean
-/// green), which decides the kind and the roughness for the whole material. `MASK` cuts the
-/// surface out below `alphaCutoff`, `BLEND` keeps it with probability alpha.
+/// metallic-roughness texture decides the kind and the roughness per texel (metallic × blue,
+/// roughness × green, see [`MetallicRoughness`]), its mean the material's own kind (what
+/// reports show). `MASK` cuts the surface out below `alphaCutoff`, `BLEND` keeps it with
+/// probability alpha.
 fn material(
     m: &gltf::Material<'_>,
     index: usize,
@@ -658,35 +749,36 @@ fn material(
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, alpha_factor] = pbr.base_color_factor();
     let base = Vec3::new(r, g, b);
-    let mut metallic = pbr.metallic_factor();
-    let mut roughness = pbr.roughness_factor();
+    let (metallic_factor, roughness_factor) = (pbr.metallic_factor(), pbr.roughness_factor());
+    let (mut metallic, mut roughness) = (metallic_factor, roughness_factor);
     let mut uv_sets = Vec::new();
+    let mut maps = MaterialTextures::default();
+    let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
     if let Some(info) = pbr.metallic_roughness_texture() {
         uv_sets.push(info.tex_coord());
-        let mean = textures.mean(&info.texture())?;
+        let texture = textures.get(&info.texture(), false, info.texture_transform())?;
+        // The material's own kind (what reports show) follows the texture's mean; hits take
+        // their texel's (transmission wins over both).
+        let mean = texture.image.mean(false);
         metallic *= mean.z;
         roughness *= mean.y;
+        if transmission <= 0.0 {
+            maps.metallic_roughness = Some(MetallicRoughness {
+                texture,
+                base,
+                metallic: metallic_factor,
+                roughness: roughness_factor,
+            });
+        }
     }
-    let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
     let kind = if transmission > 0.0 {
         MaterialKind::Dielectric {
             ior: m.ior().unwrap_or(1.5),
         }
-    } else if metallic >= METALLIC_THRESHOLD {
-        if roughness < MIRROR_ROUGHNESS {
-            MaterialKind::Mirror { reflectance: base }
-        } else {
-            MaterialKind::Glossy {
-                reflectance: base,
-                roughness: roughness * roughness,
-                diffuse: Vec3::ZERO,
-            }
-        }
     } else {
-        MaterialKind::Diffuse { albedo: base }
+        gltf_kind(base, metallic, roughness)
     };
     let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
-    let mut maps = MaterialTextures::default();
     let base_info = pbr.base_color_texture();
     if let Some(info) = &base_info {
         uv_sets.insert(0, info.tex_coord());

@@ -46,6 +46,7 @@ pub use files::{FileSource, MemoryFiles};
 pub use frame::FRAMED_FOV_Y_DEGREES;
 pub(crate) use frame::{bounds, frame_camera};
 pub use gltf::METALLIC_THRESHOLD;
+pub(crate) use gltf::{MIRROR_ROUGHNESS, gltf_kind};
 pub use obj::DEFAULT_ALBEDO;
 
 /// Film width used when the scene file gives none.

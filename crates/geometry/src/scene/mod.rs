@@ -94,8 +94,15 @@ pub struct Scene {
     bounds: Aabb,
     /// Whether some triangle's material has a cut-out (alpha test).
     cutouts: bool,
-    /// Whether some hit needs texture work before it is returned (a cut-out or a normal map).
+    /// Whether some hit needs texture work before it is returned (a cut-out, a normal map or
+    /// a metallic-roughness texture).
     textured_hits: bool,
+    /// Per material, the index its first variant has (see [`crate::texture::MetallicRoughness`]:
+    /// the materials a hit on a metallic-roughness texture becomes, numbered after the
+    /// description's); empty if no material has one.
+    variant_first: Vec<Option<u32>>,
+    /// The variants, in index order.
+    variants: Vec<Material>,
 }
 
 impl Scene {
@@ -187,6 +194,7 @@ impl Scene {
             .materials
             .iter()
             .any(|m| m.textures.as_ref().is_some_and(|t| t.normal.is_some()));
+        let (variant_first, variants) = shading::material_variants(&description.materials);
         Ok(Self {
             description,
             accel,
@@ -195,7 +203,9 @@ impl Scene {
             lights,
             bounds,
             cutouts,
-            textured_hits: cutouts || normal_mapped,
+            textured_hits: cutouts || normal_mapped || !variants.is_empty(),
+            variant_first,
+            variants,
         })
     }
 
@@ -210,8 +220,15 @@ impl Scene {
     }
 
     /// The material with index `idx` (as in [`Hit::material`]); `None` if out of range.
+    /// Indices past the description's materials are the variants that hits on a
+    /// metallic-roughness texture take (see [`crate::texture::MetallicRoughness`]).
+    #[inline]
     pub fn material(&self, idx: u32) -> Option<&Material> {
-        self.description.materials.get(idx as usize)
+        let materials = &self.description.materials;
+        materials.get(idx as usize).or_else(|| {
+            self.variants
+                .get((idx as usize).checked_sub(materials.len())?)
+        })
     }
 
     /// Bounding box of all geometry (of the light positions if there is no geometry).
@@ -261,6 +278,7 @@ impl Scene {
         };
         let mut hit = self.hit(ray, raw);
         self.apply_normal_map(&mut hit);
+        self.apply_metallic_roughness(&mut hit);
         Some(hit)
     }
 

@@ -120,6 +120,22 @@ impl Scene {
         }
     }
 
+    /// Turns the material of a hit on a metallic-roughness texture into the variant its texel
+    /// chooses.
+    pub(super) fn apply_metallic_roughness(&self, hit: &mut Hit) {
+        let Some(&Some(first)) = self.variant_first.get(hit.material as usize) else {
+            return;
+        };
+        let Some(mr) = self
+            .material(hit.material)
+            .and_then(|m| m.textures.as_deref())
+            .and_then(|t| t.metallic_roughness.as_ref())
+        else {
+            return;
+        };
+        hit.material = first + mr.variant(self.texture_uv(hit));
+    }
+
     /// Whether triangle `index` is present at barycentrics (b1, b2) for `ray` (its material's
     /// cut-out test; a blend cut-out decides by a hash of the ray, so that a ray meets the same
     /// surface every time it is traced).
@@ -165,6 +181,39 @@ fn triangle_frame(tri: &crate::Triangle, n: Vec3) -> Option<(Vec3, Vec3)> {
     let t = (dpdu - n * n.dot(dpdu)).try_normalize()?;
     let b = n.cross(t);
     Some((t, if b.dot(-dpdv) < 0.0 { -b } else { b }))
+}
+
+/// The variants of the materials with a metallic-roughness texture: per material the index
+/// of its first variant (empty if there are none) and the variants, numbered after
+/// `materials`. A variant is the material with another kind: the same name (with the
+/// variant's number), emission and textures.
+pub(super) fn material_variants(materials: &[Material]) -> (Vec<Option<u32>>, Vec<Material>) {
+    let mut first = vec![None; materials.len()];
+    let mut variants = Vec::new();
+    for (i, m) in materials.iter().enumerate() {
+        let Some(mr) = m
+            .textures
+            .as_deref()
+            .and_then(|t| t.metallic_roughness.as_ref())
+        else {
+            continue;
+        };
+        first[i] = Some((materials.len() + variants.len()) as u32);
+        variants.extend(
+            mr.variant_kinds()
+                .into_iter()
+                .enumerate()
+                .map(|(k, kind)| Material {
+                    name: format!("{} (texel variant {k})", m.name),
+                    kind,
+                    ..m.clone()
+                }),
+        );
+    }
+    if variants.is_empty() {
+        first.clear();
+    }
+    (first, variants)
 }
 
 /// Whether a material's textures cut its surface out anywhere.

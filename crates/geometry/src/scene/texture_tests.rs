@@ -272,3 +272,115 @@ fn vertex_tangents_give_the_normal_map_frame() {
         assert!((got - own).length() > 0.1, "w {w}: {got}");
     }
 }
+
+/// A quad whose metallic-roughness texture is, from left to right: a dielectric texel
+/// (metallic 0), a smooth metal (metallic 1, roughness 0), a metal of roughness 0.5 and a
+/// fully rough one, under a base colour of (0.9, 0.6, 0.3).
+fn metallic_roughness_quad() -> Scene {
+    use crate::MaterialKind;
+    let image = test_image(
+        4,
+        1,
+        vec![
+            [0, 255, 0, 255],
+            [0, 0, 255, 255],
+            [0, 128, 255, 255],
+            [0, 255, 255, 255],
+        ],
+    );
+    let mut texture = TextureRef::new(image, false);
+    texture.wrap = [Wrap::Clamp; 2];
+    let base = Vec3::new(0.9, 0.6, 0.3);
+    let mut d = description(
+        quad(2),
+        Vec::new(),
+        vec![point_light(Vec3::new(5.0, 5.0, 10.0))],
+    );
+    d.materials.push(with_textures(
+        crate::Material {
+            name: "metal".into(),
+            kind: MaterialKind::Diffuse { albedo: base },
+            emission: Vec3::ZERO,
+            textures: None,
+        },
+        MaterialTextures {
+            metallic_roughness: Some(crate::texture::MetallicRoughness {
+                texture,
+                base,
+                metallic: 1.0,
+                roughness: 1.0,
+            }),
+            ..Default::default()
+        },
+    ));
+    Scene::new(d).unwrap()
+}
+
+#[test]
+fn metallic_roughness_textures_choose_the_model_per_texel() {
+    use crate::MaterialKind;
+    let scene = metallic_roughness_quad();
+    let base = Vec3::new(0.9, 0.6, 0.3);
+    // Texel centres at x = 1/8, 3/8, 5/8, 7/8; the expected kinds are glTF's mapping of
+    // each texel's (metallic, roughness), written out here rather than taken from the loader.
+    let expected = [
+        MaterialKind::Diffuse { albedo: base },
+        MaterialKind::Mirror { reflectance: base },
+        MaterialKind::Glossy {
+            reflectance: base,
+            // Roughness 128/255 rounds to level 32 of 64: 0.5, α = 0.25.
+            roughness: 0.25,
+            diffuse: Vec3::ZERO,
+        },
+        MaterialKind::Glossy {
+            reflectance: base,
+            roughness: 1.0,
+            diffuse: Vec3::ZERO,
+        },
+    ];
+    let materials = scene.materials().len() as u32;
+    for (i, want) in expected.iter().enumerate() {
+        let x = (2 * i + 1) as f32 / 8.0;
+        let ray = Ray::infinite(Vec3::new(x, 0.5, 1.0), -Vec3::Z);
+        let hit = scene.intersect(&ray).unwrap();
+        assert!(hit.material >= materials, "x = {x}: not a variant");
+        let m = scene.material(hit.material).unwrap();
+        assert_eq!(m.kind, *want, "x = {x}");
+        assert_eq!(
+            scene.intersect_inlined(&ray).map(|h| h.material),
+            Some(hit.material)
+        );
+        // The BSDF the hit gets is the texel's: a mirror is specular, the others are not.
+        let bsdf = scene.bsdf(&hit).unwrap();
+        assert_eq!(bsdf.is_specular(), i == 1, "x = {x}");
+    }
+    // Past the variants there is no material.
+    let variants = 2 + crate::texture::MetallicRoughness::LEVELS;
+    assert!(scene.material(materials + variants - 1).is_some());
+    assert!(scene.material(materials + variants).is_none());
+}
+
+#[test]
+fn metallic_roughness_levels_round_to_the_nearest() {
+    // Roughness r = (k ± 0.4)/64 lands on level k, α = (k/64)²; below 0.01 a mirror.
+    let image = test_image(1, 1, vec![[0, 255, 255, 255]]);
+    for k in [1u32, 7, 32, 63, 64] {
+        for offset in [-0.4f32, 0.0, 0.4] {
+            let r = ((k as f32 + offset) / 64.0).min(1.0);
+            let mr = crate::texture::MetallicRoughness {
+                texture: TextureRef::new(image.clone(), false),
+                base: Vec3::ONE,
+                metallic: 1.0,
+                roughness: r,
+            };
+            let variant = mr.variant(Vec2::splat(0.5));
+            let expected = if r < 0.01 { 1 } else { 1 + k };
+            assert_eq!(variant, expected, "r = {r}");
+            if let crate::MaterialKind::Glossy { roughness, .. } =
+                mr.variant_kinds()[variant as usize]
+            {
+                assert!((roughness.sqrt() - r).abs() <= 0.5 / 64.0 + 1e-6, "r = {r}");
+            }
+        }
+    }
+}

@@ -283,6 +283,58 @@ pub struct NormalMap {
     pub scale: f32,
 }
 
+/// glTF's metallic-roughness texture, read per texel: metallic = `metallic` × blue, roughness
+/// = `roughness` × green (linear data). Each hit becomes the material glTF's mapping gives for
+/// its texel's values (diffuse, mirror or glossy, as glTF materials are mapped), with the
+/// roughness rounded to one of [`MetallicRoughness::LEVELS`] levels: the scene keeps one
+/// material per level, so that a hitpoint stores what it hit as an index like any other.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MetallicRoughness {
+    /// The texture (data, not colour).
+    pub texture: TextureRef,
+    /// The base colour: the diffuse albedo or the conductor's reflectance.
+    pub base: Vec3,
+    /// glTF `metallicFactor`.
+    pub metallic: f32,
+    /// glTF `roughnessFactor`.
+    pub roughness: f32,
+}
+
+impl MetallicRoughness {
+    /// Roughness levels of a conductor: roughness k/`LEVELS` for k = 1..=`LEVELS` (a
+    /// roughness within 1/128 of the texel's; below 0.01 a mirror).
+    pub const LEVELS: u32 = 64;
+
+    /// The material kinds a hit can take, in variant order: the diffuse base, the mirror, then
+    /// the conductor at each roughness level.
+    pub fn variant_kinds(&self) -> Vec<crate::MaterialKind> {
+        let mut kinds = vec![
+            crate::load::gltf_kind(self.base, 0.0, 1.0),
+            crate::load::gltf_kind(self.base, 1.0, 0.0),
+        ];
+        kinds.extend(
+            (1..=Self::LEVELS)
+                .map(|k| crate::load::gltf_kind(self.base, 1.0, k as f32 / Self::LEVELS as f32)),
+        );
+        kinds
+    }
+
+    /// The variant (an index into [`MetallicRoughness::variant_kinds`]) at `uv`.
+    #[inline]
+    pub fn variant(&self, uv: Vec2) -> u32 {
+        let texel = self.texture.lookup(uv);
+        let (metallic, roughness) = (self.metallic * texel.z, self.roughness * texel.y);
+        if metallic < crate::load::METALLIC_THRESHOLD {
+            0
+        } else if roughness < crate::load::MIRROR_ROUGHNESS {
+            1
+        } else {
+            let level = (roughness.min(1.0) * Self::LEVELS as f32).round() as u32;
+            1 + level.clamp(1, Self::LEVELS)
+        }
+    }
+}
+
 /// The textures of one material. Every colour texture multiplies what the material would do
 /// without it (see `docs/scene-format-extensions.md`, "Textures").
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -296,6 +348,8 @@ pub struct MaterialTextures {
     pub normal: Option<NormalMap>,
     /// Cuts the surface out where it is transparent.
     pub alpha: Option<Alpha>,
+    /// Chooses the scattering model per texel (glTF `metallicRoughnessTexture`).
+    pub metallic_roughness: Option<MetallicRoughness>,
 }
 
 impl MaterialTextures {
@@ -305,6 +359,7 @@ impl MaterialTextures {
             && self.emission.is_none()
             && self.normal.is_none()
             && self.alpha.is_none()
+            && self.metallic_roughness.is_none()
     }
 
     /// What the textures modulate, for reports: `color`, `emission`, `normal`, `alpha` (an
@@ -315,6 +370,7 @@ impl MaterialTextures {
             (self.emission.is_some(), "emission"),
             (self.normal.is_some(), "normal"),
             (self.alpha.is_some(), "alpha"),
+            (self.metallic_roughness.is_some(), "metallic-roughness"),
         ]
         .into_iter()
         .filter_map(|(used, name)| used.then_some(name))
@@ -328,6 +384,7 @@ impl MaterialTextures {
             .chain(&self.emission)
             .chain(self.normal.iter().map(|n| &n.texture))
             .chain(self.alpha.iter().filter_map(|a| a.texture.as_ref()))
+            .chain(self.metallic_roughness.iter().map(|m| &m.texture))
     }
 
     /// Whether the surface is present at `uv` for a ray whose hash (uniform in [0, 1)) is `u`.
@@ -357,7 +414,7 @@ pub struct TextureSummary {
     pub resolution: [u32; 2],
     /// Bytes of the decoded texels.
     pub bytes: usize,
-    /// How materials use it: `color`, `emission`, `normal`, `alpha`.
+    /// How materials use it: `color`, `emission`, `normal`, `alpha`, `metallic-roughness`.
     pub uses: Vec<&'static str>,
 }
 
@@ -370,6 +427,10 @@ pub(crate) fn summarize(materials: &[crate::Material]) -> Vec<TextureSummary> {
             (t.emission.as_ref(), "emission"),
             (t.normal.as_ref().map(|n| &n.texture), "normal"),
             (t.alpha.as_ref().and_then(|a| a.texture.as_ref()), "alpha"),
+            (
+                t.metallic_roughness.as_ref().map(|m| &m.texture),
+                "metallic-roughness",
+            ),
         ];
         for (texture, what) in uses {
             let Some(texture) = texture else { continue };

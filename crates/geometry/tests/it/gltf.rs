@@ -370,3 +370,63 @@ fn tangents_follow_a_mirroring_toml_transform() {
         assert!(d.length() < 1e-6, "{got:?} != {want:?}");
     }
 }
+
+/// NormalTangentMirrorTest's own `TANGENT`s (exported by Blender, which computes MikkTSpace)
+/// against the tangents generated when the attribute is removed: the same frames, w included.
+#[test]
+fn generated_tangents_match_the_files_own() {
+    let dir = crate::shared_scenes()
+        .join("gltf/NormalTangentMirrorTest/glTF")
+        .canonicalize()
+        .unwrap();
+    let original = dir.join("NormalTangentMirrorTest.gltf");
+    let mut json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&original).unwrap()).unwrap();
+    for mesh in json["meshes"].as_array_mut().unwrap() {
+        for prim in mesh["primitives"].as_array_mut().unwrap() {
+            prim["attributes"]
+                .as_object_mut()
+                .unwrap()
+                .remove("TANGENT");
+        }
+    }
+    // The copy reads the shared buffer and images where they are.
+    for list in ["buffers", "images"] {
+        for item in json[list].as_array_mut().unwrap() {
+            let uri = item["uri"].as_str().unwrap();
+            item["uri"] = dir.join(uri).to_string_lossy().into_owned().into();
+        }
+    }
+    let copy = crate::temp_dir("gltf_generated_tangents").join("no-tangents.gltf");
+    std::fs::write(&copy, serde_json::to_string(&json).unwrap()).unwrap();
+
+    let options = geometry::LoadOptions::allow_no_emitter();
+    let with = geometry::load_with(&original, &options).unwrap();
+    let without = geometry::load_with(&copy, &options).unwrap();
+    assert_eq!(with.triangles.len(), without.triangles.len());
+    let (mut corners, mut close, mut same_sign) = (0usize, 0usize, 0usize);
+    for (a, b) in with.triangles.iter().zip(&without.triangles) {
+        let (Some(ta), Some(tb)) = (a.tangents, b.tangents) else {
+            panic!("a triangle without tangents");
+        };
+        for (ta, tb) in ta.iter().zip(&tb) {
+            corners += 1;
+            let (va, vb) = (Vec3::from_slice(ta), Vec3::from_slice(tb));
+            if va.normalize().dot(vb.normalize()) > 0.996 {
+                close += 1; // within 5°
+            }
+            if ta[3] == tb[3] {
+                same_sign += 1;
+            }
+        }
+    }
+    println!("{corners} corners: {close} within 5°, {same_sign} with the same w");
+    assert!(
+        close as f64 >= 0.99 * corners as f64,
+        "{close} of {corners} within 5°"
+    );
+    assert!(
+        same_sign as f64 >= 0.99 * corners as f64,
+        "{same_sign} of {corners} with the same w"
+    );
+}
