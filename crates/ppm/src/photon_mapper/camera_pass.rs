@@ -199,6 +199,17 @@ impl Setup<'_> {
         }
     }
 
+    /// The position and geometric normal of the visible point that the camera path of `slot`
+    /// in `pass` makes (as [`Setup::trace_camera_path`] would), or `None` where it makes none:
+    /// for the clear-disc probes shared across passes, which recompute an earlier pass's
+    /// visible points rather than remember them.
+    pub(super) fn visible_surface(&self, slot: u32, pass: u32) -> Option<(Vec3, Vec3)> {
+        let end = self.camera_chain(slot, pass).end?;
+        end.throughput
+            .is_finite()
+            .then_some((end.hit.position, end.hit.geometric_normal))
+    }
+
     fn camera_chain(&self, slot: u32, pass: u32) -> CameraChain {
         let spp = self.params.samples_per_pixel;
         let pixel = slot / spp;

@@ -653,41 +653,51 @@ pub(super) fn scatter_spectrum(
 /// Whether the disc of radius `r_top` around `slot`'s visible point lies inside the clear disc
 /// of radius `clear` around `leader`'s: the same plane (normals within about 0.8°, the offset
 /// along the normal within the probes' own lift), and centres at most `clear − r_top` apart.
-fn shares_disc(
-    slots: &HitPoints<SlotFrequency>,
-    leader: usize,
-    slot: usize,
+/// Passes that share one clear disc per 2 × 2 block of pixels ([`BlockDisc`]).
+pub(super) const BLOCK_DISC_PASSES: u32 = 16;
+
+/// The clear disc that the slots of a 2 × 2 block of pixels share for [`BLOCK_DISC_PASSES`]
+/// passes: probed (out to eight times the largest kernel R_max) around the visible point of
+/// the block's first slot that has one in the first pass of the epoch.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BlockDisc {
+    /// The first pass of the epoch.
+    epoch: u32,
+    centre: Vec3,
+    normal: Vec3,
+    /// The clear radius around `centre`; 0 if none (or no slot had a visible point).
     clear: f64,
-    r_top: f64,
-) -> bool {
-    let (a, b) = (slots.position()[leader], slots.position()[slot]);
-    let (na, nb) = (
-        slots.geometric_normal()[leader],
-        slots.geometric_normal()[slot],
-    );
-    let offset = b - a;
-    let lift = 1e-3 * r_top as f32 + 1e-5 * a.abs().max_element();
-    na.dot(nb) >= 0.9999
-        && na.dot(offset).abs() <= lift
-        && f64::from(offset.length()) + r_top <= clear
+}
+
+impl BlockDisc {
+    /// Whether the gather disc of radius `r_top` around `position` (unit geometric normal
+    /// `normal`) lies inside this one: the same plane, and δ + r_top within the clear radius.
+    fn covers(&self, position: Vec3, normal: Vec3, r_top: f64) -> bool {
+        let offset = position - self.centre;
+        let lift = 1e-3 * r_top as f32 + 1e-5 * self.centre.abs().max_element();
+        self.normal.dot(normal) >= 0.9999
+            && self.normal.dot(offset).abs() <= lift
+            && f64::from(offset.length()) + r_top <= self.clear
+    }
 }
 
 impl PhotonMapper<'_> {
     /// Probes the clear radius ([`crate::disc::clear_level`]) of every valid slot that has
     /// become a candidate for holding (R ≤ r_freq; with `all`, every slot with a frequency
     /// radius) and has not been probed at its visible point, in parallel. Deterministic: the
-    /// probes use no random numbers, and which slots share a probe depends only on the pass's
-    /// visible points.
+    /// probes use no random numbers, and which slots share a probe depends only on the pass
+    /// and its visible points.
     ///
     /// With `freq_probe_share` (and not `all`) the slots of each 2 × 2 block of pixels share
-    /// one probe: the block's first slot that needs one probes out to eight times the largest
-    /// kernel R_max, and a slot of the block whose visible point lies in the same plane, at a
-    /// distance δ with δ + R_max within that clear radius, is clear at R_max without probes of
-    /// its own (its disc lies inside the probed one). The others, and the first slot where its
-    /// wide disc is not clear out to R_max, probe as before.
+    /// one probe for [`BLOCK_DISC_PASSES`] passes ([`BlockDisc`]): around the block's first
+    /// visible point of the epoch's first pass, out to eight times the largest kernel R_max,
+    /// and a slot of the block whose visible point lies in the same plane, at a distance δ
+    /// with δ + R_max within that clear radius, is clear at R_max without probes of its own
+    /// (its disc lies inside the probed one). The others probe their own disc as before.
     pub(super) fn probe_clear_radii(&mut self, all: bool) {
         let k = self.setup.params.kernel_k;
         let r_top = self.setup.kernel_max();
+        let mut discs = std::mem::take(&mut self.block_discs);
         let slots = &self.slots;
         let scene = self.setup.scene;
         let needs_probe = |slot: usize| {
@@ -716,8 +726,9 @@ impl PhotonMapper<'_> {
                 .map(|slot| (slot, probe(slot, r_top)))
                 .collect()
         } else {
-            let (width, height) = (self.setup.width as usize, self.setup.height as usize);
-            let spp = self.setup.params.samples_per_pixel as usize;
+            let setup = &self.setup;
+            let (width, height) = (setup.width as usize, setup.height as usize);
+            let spp = setup.params.samples_per_pixel as usize;
             let blocks_x = width.div_ceil(2);
             let block_slots = move |block: usize| {
                 let (bx, by) = (2 * (block % blocks_x), 2 * (block / blocks_x));
@@ -725,29 +736,43 @@ impl PhotonMapper<'_> {
                     .flat_map(move |y| (bx..(bx + 2).min(width)).map(move |x| y * width + x))
                     .flat_map(move |pixel| pixel * spp..(pixel + 1) * spp)
             };
-            let n_blocks = blocks_x * height.div_ceil(2);
-            (0..n_blocks)
-                .into_par_iter()
+            let epoch = self.pass / BLOCK_DISC_PASSES * BLOCK_DISC_PASSES;
+            let wide = 8.0 * r_top;
+            // The block's disc in this epoch: around the first visible point of the epoch's
+            // first pass, recomputed from the camera paths (not from the slots, which hold
+            // this pass's points), so that it is the same whenever it is computed.
+            let block_disc = |block: usize| {
+                let visible =
+                    block_slots(block).find_map(|slot| setup.visible_surface(slot as u32, epoch));
+                let (centre, normal, clear) = match visible {
+                    Some((centre, normal)) => {
+                        let level = crate::disc::clear_level(scene, centre, normal, wide as f32);
+                        (centre, normal, crate::disc::level_radius(level, wide))
+                    }
+                    None => (Vec3::ZERO, Vec3::ZERO, 0.0),
+                };
+                BlockDisc {
+                    epoch,
+                    centre,
+                    normal,
+                    clear,
+                }
+            };
+            discs.resize(blocks_x * height.div_ceil(2), None);
+            discs
+                .par_iter_mut()
+                .enumerate()
                 .with_min_len(SLOT_CHUNK / 4)
-                .flat_map_iter(|block| {
+                .flat_map_iter(|(block, disc)| {
                     let mut out = Vec::new();
-                    let mut leader: Option<(usize, f64)> = None;
                     for slot in block_slots(block).filter(|&s| needs_probe(s)) {
-                        let Some((first, clear)) = leader else {
-                            let wide = probe(slot, 8.0 * r_top);
-                            let clear = crate::disc::level_radius(wide, 8.0 * r_top);
-                            leader = Some((slot, clear));
-                            // Near an edge the wide ladder stops short of the smallest levels:
-                            // the leader probes its own as every slot does.
-                            let own = if clear >= r_top {
-                                0
-                            } else {
-                                probe(slot, r_top)
-                            };
-                            out.push((slot, own));
-                            continue;
+                        let shared = match disc {
+                            Some(d) if d.epoch == epoch => *d,
+                            _ => *disc.insert(block_disc(block)),
                         };
-                        let level = if shares_disc(slots, first, slot, clear, r_top) {
+                        let (position, normal) =
+                            (slots.position()[slot], slots.geometric_normal()[slot]);
+                        let level = if shared.covers(position, normal, r_top) {
                             0
                         } else {
                             probe(slot, r_top)
@@ -758,6 +783,7 @@ impl PhotonMapper<'_> {
                 })
                 .collect()
         };
+        self.block_discs = discs;
         let columns = self.slots.columns_mut();
         for (slot, level) in probed {
             columns.freq[slot].clear_level = level;

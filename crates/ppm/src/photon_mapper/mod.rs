@@ -80,6 +80,10 @@ pub(crate) struct PhotonMapper<'s> {
     /// The pass-independent estimator's kernels and sums (`appm` only; set before its first
     /// pass).
     independent: Option<independent::Independent>,
+    /// Per 2 × 2 block of pixels, the clear disc its slots share ([`frequency::BlockDisc`]): a
+    /// function of the scene, the parameters and the pass, recomputed where missing (after a
+    /// restore), so that it is not part of a checkpoint.
+    block_discs: Vec<Option<frequency::BlockDisc>>,
 }
 
 /// `photon_bounces` of a slot without a visible point (budgets are below `max_depth` ≤ 1024).
@@ -169,6 +173,7 @@ impl<'s> PhotonMapper<'s> {
             photons: PhotonPass::default(),
             frequency: FrequencyDeposits::default(),
             independent: None,
+            block_discs: Vec::new(),
         })
     }
 
