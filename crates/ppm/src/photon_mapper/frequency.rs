@@ -659,7 +659,7 @@ pub(super) const BLOCK_DISC_PASSES: u32 = 16;
 /// The clear disc that the slots of a 2 × 2 block of pixels share for [`BLOCK_DISC_PASSES`]
 /// passes: probed (out to eight times the largest kernel R_max) around the visible point of
 /// the block's first slot that has one in the first pass of the epoch.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct BlockDisc {
     /// The first pass of the epoch.
     epoch: u32,
