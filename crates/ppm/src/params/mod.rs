@@ -160,9 +160,10 @@ pub struct RenderParams {
     /// edges the kernel then shrinks at once to the distance where the disc leaves the
     /// surface, which removes most of photon mapping's corner bias.
     pub freq_clear_cap: bool,
-    /// Whether the candidates of a 2 × 2 block of pixels share one clear-disc probe where
-    /// their visible points lie in one plane well inside the probed disc
-    /// (`PhotonMapper::probe_clear_radii`); otherwise every candidate probes its own.
+    /// Whether the candidates of a 2 × 2 block of pixels (every slot of it under
+    /// `freq_clear_cap`) share one clear-disc probe for 16 passes where their visible points
+    /// lie in one plane well inside the probed disc (`PhotonMapper::probe_clear_radii`);
+    /// otherwise every candidate probes its own.
     pub freq_probe_share: bool,
     /// Whether the photon mappers also connect every stored photon to the camera (light
     /// tracing) and combine the two estimates of what the camera sees directly on a

@@ -307,7 +307,7 @@ pub const PARAMS: &[Param] = &[
     Param {
         name: "freq_probe_share",
         flag: "no-freq-probe-share",
-        help: "Let every candidate of a frequency method probe its own clear disc (by default the candidates of a 2x2 block of pixels share one probe where their points lie in one plane inside it)",
+        help: "Let every candidate of a frequency method probe its own clear disc (by default the candidates of a 2x2 block of pixels share one probe for 16 passes where their points lie in one plane inside it)",
         kind: ParamKind::Switch { sets: false },
         get: |p| on_off(p.freq_probe_share),
         set: |p, v| {

@@ -688,13 +688,13 @@ impl PhotonMapper<'_> {
     /// probes use no random numbers, and which slots share a probe depends only on the pass
     /// and its visible points.
     ///
-    /// With `freq_probe_share` (and not `all`) the slots of each 2 × 2 block of pixels share
+    /// With `share` (`freq_probe_share`) the slots of each 2 × 2 block of pixels share
     /// one probe for [`BLOCK_DISC_PASSES`] passes ([`BlockDisc`]): around the block's first
     /// visible point of the epoch's first pass, out to eight times the largest kernel R_max,
     /// and a slot of the block whose visible point lies in the same plane, at a distance δ
     /// with δ + R_max within that clear radius, is clear at R_max without probes of its own
     /// (its disc lies inside the probed one). The others probe their own disc as before.
-    pub(super) fn probe_clear_radii(&mut self, all: bool) {
+    pub(super) fn probe_clear_radii(&mut self, all: bool, share: bool) {
         let k = self.setup.params.kernel_k;
         let r_top = self.setup.kernel_max();
         let mut discs = std::mem::take(&mut self.block_discs);
@@ -718,7 +718,7 @@ impl PhotonMapper<'_> {
                 r0 as f32,
             )
         };
-        let probed: Vec<(usize, u8)> = if all || !self.setup.params.freq_probe_share {
+        let probed: Vec<(usize, u8)> = if !share {
             (0..slots.len())
                 .into_par_iter()
                 .with_min_len(SLOT_CHUNK)
@@ -799,7 +799,8 @@ impl PhotonMapper<'_> {
     ///
     /// [`RenderParams::growth_pass`]: crate::RenderParams::growth_pass
     pub(super) fn grow_kernels(&mut self) {
-        self.probe_clear_radii(true);
+        // The pilot sizes kernels from each slot's own ladder.
+        self.probe_clear_radii(true, false);
         let k = self.setup.params.kernel_k;
         let r_top = self.setup.kernel_max();
         let valid: Vec<bool> = (0..self.slots.len()).map(|s| self.is_valid(s)).collect();

@@ -19,7 +19,7 @@ impl PhotonMapper<'_> {
         let uses_frequency = params.method.uses_frequency();
         let probe_clock = Instant::now();
         if uses_frequency && params.freq_geometry {
-            self.probe_clear_radii(params.freq_clear_cap);
+            self.probe_clear_radii(params.freq_clear_cap, params.freq_probe_share);
         }
         let probe_seconds = probe_clock.elapsed().as_secs_f64();
         let r_top = self.setup.kernel_max();
