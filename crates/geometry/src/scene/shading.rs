@@ -30,6 +30,12 @@ impl Scene {
         }
     }
 
+    /// The textures of material `idx`, if it has any.
+    #[inline]
+    fn textures(&self, idx: u32) -> Option<&MaterialTextures> {
+        self.material(idx).and_then(|m| m.textures.as_deref())
+    }
+
     /// The BSDF of `material` at `hit` (whose material it is), with its colour texture.
     /// Inlined into the photon loop for untextured materials (as `Bsdf::new` was; outlined, the
     /// call cost about 1 % of a photon path's instructions), the textured case out of line.
@@ -52,11 +58,7 @@ impl Scene {
     /// evaluates the untextured material, gets the textured one.
     #[inline]
     pub fn scattering_tint(&self, hit: &Hit) -> Rgb {
-        match self
-            .material(hit.material)
-            .and_then(|m| m.textures.as_deref())
-            .and_then(|t| t.color.as_ref())
-        {
+        match self.textures(hit.material).and_then(|t| t.color.as_ref()) {
             None => Rgb::ONE,
             Some(color) => color.color(self.texture_uv(hit)),
         }
@@ -89,11 +91,7 @@ impl Scene {
             return;
         };
         let tri = &self.description.triangles[i as usize];
-        let Some(map) = self
-            .material(hit.material)
-            .and_then(|m| m.textures.as_deref())
-            .and_then(|t| t.normal.as_ref())
-        else {
+        let Some(map) = self.textures(hit.material).and_then(|t| t.normal.as_ref()) else {
             return;
         };
         if tri.uv.is_none() {
@@ -127,8 +125,7 @@ impl Scene {
             return;
         };
         let Some(mr) = self
-            .material(hit.material)
-            .and_then(|m| m.textures.as_deref())
+            .textures(hit.material)
             .and_then(|t| t.metallic_roughness.as_ref())
         else {
             return;
@@ -141,10 +138,7 @@ impl Scene {
     /// surface every time it is traced).
     pub(super) fn covered(&self, ray: &Ray, index: u32, b1: f32, b2: f32) -> bool {
         let tri = &self.description.triangles[index as usize];
-        let Some(textures) = self
-            .material(tri.material)
-            .and_then(|m| m.textures.as_deref())
-        else {
+        let Some(textures) = self.textures(tri.material) else {
             return true;
         };
         textures.opaque(triangle_uv(tri, b1, b2), ray_hash(ray, index))

@@ -24,8 +24,8 @@ fn tags_pack_chunk_and_record_indices_when_they_fit() {
     assert!(last < UNTAGGED);
 }
 
-#[test]
-fn global_tags_deposit_exactly_what_packed_tags_do() {
+/// The shared CornellBox-Sphere at 24 × 24.
+fn cornell_sphere_24() -> Scene {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/scenes/cornell_box/CornellBox-Sphere.obj");
     let mut description = geometry::load(&path).unwrap();
@@ -33,7 +33,12 @@ fn global_tags_deposit_exactly_what_packed_tags_do() {
         width: 24,
         height: 24,
     };
-    let scene = Scene::new(description).unwrap();
+    Scene::new(description).unwrap()
+}
+
+#[test]
+fn global_tags_deposit_exactly_what_packed_tags_do() {
+    let scene = cornell_sphere_24();
     let mut params = RenderParams::preview();
     params.method = Method::FreqPpm;
     params.photons_per_pass = 5_000;
@@ -65,14 +70,7 @@ fn global_tags_deposit_exactly_what_packed_tags_do() {
 /// image, as one that kept them.
 #[test]
 fn block_discs_recomputed_mid_epoch_are_those_of_the_epoch_start() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/scenes/cornell_box/CornellBox-Sphere.obj");
-    let mut description = geometry::load(&path).unwrap();
-    description.film = geometry::Film {
-        width: 24,
-        height: 24,
-    };
-    let scene = Scene::new(description).unwrap();
+    let scene = cornell_sphere_24();
     let mut params = RenderParams::preview();
     params.method = Method::FreqSppm;
     params.photons_per_pass = 5_000;
