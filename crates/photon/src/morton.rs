@@ -201,8 +201,11 @@ fn morton_keys<T, C>(
 /// were slower).
 const DIGIT_BITS: u32 = 11;
 const RADIX: usize = 1 << DIGIT_BITS;
-/// Blocks of a radix pass (the same for any thread count, so the result is too).
+/// Blocks of a radix pass at most (the same for any thread count, so the result is too).
 const BLOCKS: usize = 32;
+/// Keys per block at least: a block's histogram, cursors and runs cost a few steps per digit
+/// (`RADIX` of them), which smaller blocks do not earn back.
+const MIN_BLOCK_LEN: usize = 1 << 16;
 
 /// Sorts `packed = key << 32 | item` values, given in increasing item order, by key with ties
 /// in item order (so in increasing order of `packed`): three stable least-significant-digit
@@ -211,8 +214,7 @@ fn sort_keys(keys: &mut Vec<u64>, spare: &mut Vec<u64>) {
     let n = keys.len();
     spare.clear();
     spare.resize(n, 0);
-    // Small inputs in one block: the histograms would cost more than they save.
-    let blocks = if n < 1 << 16 { 1 } else { BLOCKS };
+    let blocks = (n / MIN_BLOCK_LEN).clamp(1, BLOCKS);
     let block_len = n.div_ceil(blocks).max(1);
     for pass in 0..3 {
         if radix_pass(keys, spare, 32 + pass * DIGIT_BITS, block_len) {
@@ -315,7 +317,9 @@ mod tests {
 
     #[test]
     fn radix_sort_equals_a_plain_sort() {
-        for n in [0, 1, 5, 1000, 70_000, 300_001] {
+        // One block up to 131 071 values, four for 300 001 (the last one short), 32 (the most)
+        // for 2 500 003.
+        for n in [0, 1, 5, 1000, 70_000, 300_001, 2_500_003] {
             let mut keys = packed(n);
             let mut expected = keys.clone();
             expected.sort_unstable();
