@@ -75,7 +75,10 @@ pub struct BsdfSample {
 /// A material's scattering at one surface point, in the hit's shading frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bsdf {
-    frame: Frame,
+    /// The unit shading normal. The shading frame is built from it where a method needs one
+    /// (`Frame::from_normal` is a pure function of it): a photon killed by the roulette, or a
+    /// Lambertian evaluated against a normal, never needs the tangents.
+    normal: Vec3,
     kind: MaterialKind,
     /// For dielectrics: η on the far side of the shading normal over η on its side.
     eta: f32,
@@ -126,7 +129,7 @@ impl Bsdf {
             _ => 1.0,
         };
         Self {
-            frame: Frame::from_normal(normal),
+            normal,
             kind,
             eta,
             tint: Rgb::ONE,
@@ -155,8 +158,9 @@ impl Bsdf {
     }
 
     /// The shading frame (its `n` is the shading normal).
-    pub fn frame(&self) -> &Frame {
-        &self.frame
+    #[inline]
+    pub fn frame(&self) -> Frame {
+        Frame::from_normal(self.normal)
     }
 
     /// Whether the BSDF is purely specular (mirror, smooth dielectric): [`Bsdf::eval`] is then always zero.
@@ -171,7 +175,16 @@ impl Bsdf {
 
     /// The BSDF value f(outgoing, incoming), without the cosine; zero for delta lobes.
     pub fn eval(&self, outgoing: Vec3, incoming: Vec3) -> Rgb {
-        let (wo, wi) = (self.frame.to_local(outgoing), self.frame.to_local(incoming));
+        if let MaterialKind::Diffuse { albedo } = self.kind {
+            // The local z of both directions, without the tangents.
+            return if outgoing.dot(self.normal) * incoming.dot(self.normal) <= 0.0 {
+                Rgb::ZERO
+            } else {
+                albedo * FRAC_1_PI
+            };
+        }
+        let frame = self.frame();
+        let (wo, wi) = (frame.to_local(outgoing), frame.to_local(incoming));
         if wo.z * wi.z <= 0.0 {
             return Rgb::ZERO;
         }
@@ -194,7 +207,8 @@ impl Bsdf {
 
     /// Solid-angle density with which [`Bsdf::sample`] draws `incoming`; zero for delta lobes.
     pub fn pdf(&self, outgoing: Vec3, incoming: Vec3) -> f32 {
-        let (wo, wi) = (self.frame.to_local(outgoing), self.frame.to_local(incoming));
+        let frame = self.frame();
+        let (wo, wi) = (frame.to_local(outgoing), frame.to_local(incoming));
         if wo.z * wi.z <= 0.0 {
             return 0.0;
         }
@@ -223,7 +237,8 @@ impl Bsdf {
         u: Vec2,
         mode: TransportMode,
     ) -> Option<BsdfSample> {
-        let wo = self.frame.to_local(outgoing);
+        let frame = self.frame();
+        let wo = frame.to_local(outgoing);
         if wo.z == 0.0 || !wo.is_finite() {
             return None;
         }
@@ -238,7 +253,7 @@ impl Bsdf {
                 }
                 let pdf = wi.z.abs() * FRAC_1_PI;
                 (pdf > 0.0).then(|| BsdfSample {
-                    incoming: self.frame.to_world(wi),
+                    incoming: frame.to_world(wi),
                     weight: albedo,
                     pdf,
                     is_specular: false,
@@ -250,14 +265,14 @@ impl Bsdf {
                     return None;
                 }
                 Some(BsdfSample {
-                    incoming: self.frame.to_world(Vec3::new(-wo.x, -wo.y, wo.z)),
+                    incoming: frame.to_world(Vec3::new(-wo.x, -wo.y, wo.z)),
                     weight: reflectance,
                     pdf: 1.0,
                     is_specular: true,
                     is_transmission: false,
                 })
             }
-            MaterialKind::Dielectric { .. } => self.sample_dielectric(wo, u_lobe, mode),
+            MaterialKind::Dielectric { .. } => self.sample_dielectric(&frame, wo, u_lobe, mode),
             MaterialKind::Glossy {
                 reflectance,
                 roughness,
@@ -287,7 +302,7 @@ impl Bsdf {
                 }
                 let wi = if flip { -wi_up } else { wi_up };
                 Some(BsdfSample {
-                    incoming: self.frame.to_world(wi),
+                    incoming: frame.to_world(wi),
                     weight: f * (wi_up.z / pdf) * self.tint,
                     pdf,
                     is_specular: false,
@@ -297,13 +312,19 @@ impl Bsdf {
         }
     }
 
-    fn sample_dielectric(&self, wo: Vec3, u_lobe: f32, mode: TransportMode) -> Option<BsdfSample> {
+    fn sample_dielectric(
+        &self,
+        frame: &Frame,
+        wo: Vec3,
+        u_lobe: f32,
+        mode: TransportMode,
+    ) -> Option<BsdfSample> {
         // Relative η across the boundary, seen from the side of `wo`.
         let eta = if wo.z > 0.0 { self.eta } else { 1.0 / self.eta };
         let r = fresnel_dielectric(wo.z.abs(), eta);
         if u_lobe < r {
             return Some(BsdfSample {
-                incoming: self.frame.to_world(Vec3::new(-wo.x, -wo.y, wo.z)),
+                incoming: frame.to_world(Vec3::new(-wo.x, -wo.y, wo.z)),
                 weight: Rgb::ONE,
                 pdf: r,
                 is_specular: true,
@@ -316,7 +337,7 @@ impl Bsdf {
             TransportMode::Importance => 1.0,
         };
         Some(BsdfSample {
-            incoming: self.frame.to_world(wi),
+            incoming: frame.to_world(wi),
             weight: Rgb::splat(scale),
             pdf: 1.0 - r,
             is_specular: true,
