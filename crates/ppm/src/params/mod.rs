@@ -247,7 +247,7 @@ impl RenderParams {
             .then_some(self.freq_pilot)
     }
 
-    /// A quick preview: classical PPM, 100 000 photons per pass, α = 0.7, one hitpoint per
+    /// The defaults: freq-sppm, 100 000 photons per pass, α = 0.7, one hitpoint per
     /// pixel; for the frequency methods 10 % frequency photons, K = K_STRICT, min-radius merge
     /// and occlusion probes (the defaults of `docs/convergence.md` and `docs/integrators.md`).
     #[must_use]
@@ -271,7 +271,7 @@ impl RenderParams {
             freq_grow: 1.0,
             freq_hold_alpha: 0.9,
             freq_pilot: 4,
-            freq_clear_cap: false,
+            freq_clear_cap: true,
             freq_probe_share: true,
             light_tracing: true,
         }

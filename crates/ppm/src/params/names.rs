@@ -295,9 +295,9 @@ pub const PARAMS: &[Param] = &[
     },
     Param {
         name: "freq_clear_cap",
-        flag: "freq-clear-cap",
-        help: "Cap every slot's radius of a frequency method at the clear radius of its gather disc (probed at every visible point), not only the held ones",
-        kind: ParamKind::Switch { sets: true },
+        flag: "no-freq-clear-cap",
+        help: "Cap only the held slots of a frequency method at the clear radius of their gather disc (by default every slot's radius is capped there, which removes most of the bias at corners and edges)",
+        kind: ParamKind::Switch { sets: false },
         get: |p| on_off(p.freq_clear_cap),
         set: |p, v| {
             p.freq_clear_cap = parse_switch(v)?;
@@ -531,7 +531,7 @@ mod tests {
         params.freq_grow = 2.5;
         params.freq_hold_alpha = 1.0;
         params.freq_pilot = 0;
-        params.freq_clear_cap = true;
+        params.freq_clear_cap = false;
         params.light_tracing = false;
         params.freq_probe_share = false;
         for base in [RenderParams::preview(), params] {
