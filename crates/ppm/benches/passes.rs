@@ -18,7 +18,8 @@
 //! `FPPM_BENCH_METHODS=ppm,freq` restricts the methods, `FPPM_BENCH_THREADS=1,2` the thread
 //! counts (the summary lines need both 1 and 2 threads of ppm and freq); `FPPM_BENCH_PHOTONS`
 //! and `FPPM_BENCH_PASSES` change the photons per pass and the timed passes (for profiling
-//! under callgrind). A second table gives the median seconds of each phase of a pass. "pass
+//! under callgrind); `FPPM_BENCH_LIGHT_TRACING=0` turns off the photons' connections to the
+//! camera (the work of a pass before light tracing, for comparisons with older builds). A second table gives the median seconds of each phase of a pass. "pass
 //! CPU s" is the process CPU time of a pass (all threads): with 1 thread it is the work
 //! itself, whatever else runs on the machine.
 //!
@@ -105,6 +106,7 @@ fn run<'s>(
             let mut params = RenderParams::preview();
             params.method = method;
             params.photons_per_pass = photons_per_pass;
+            params.light_tracing = env_or("FPPM_BENCH_LIGHT_TRACING", 1u8) != 0;
             let mut renderer = Renderer::new(scene, params).unwrap();
             // The first pass traces the hitpoints and builds the grid: not the steady state.
             pool.install(|| renderer.iterate());

@@ -123,9 +123,14 @@ impl Setup<'_> {
         if spectrum.is_some() {
             out.frequency_photons += 1;
         }
+        // Read once: the stores into `out` in the loop would otherwise make the compiler
+        // reload them through `self.params` at every bounce.
+        let max_depth = self.params.max_depth;
+        let rr_depth = self.params.rr_depth;
+        let direct_lighting = self.params.direct_lighting;
         // `depth`: the photon's bounces before this hit. A hitpoint adds one more, so hits at
         // depth max_depth − 1 are the last that can count.
-        for depth in 0..self.params.max_depth {
+        for depth in 0..max_depth {
             let Some(hit) = self.scene.intersect_inlined(&ray) else {
                 break;
             };
@@ -141,7 +146,7 @@ impl Setup<'_> {
             let bsdf = self.scene.material_bsdf(material, &hit);
             // With direct lighting by light sampling, photons straight from an emitter are
             // already accounted for at the hitpoints.
-            let counted_by_light_sampling = self.params.direct_lighting && depth == 0;
+            let counted_by_light_sampling = direct_lighting && depth == 0;
             if !bsdf.is_specular() && !counted_by_light_sampling {
                 let tag = self.record_frequency_photon(
                     here,
@@ -166,7 +171,7 @@ impl Setup<'_> {
                 }
             }
             // Scatter, unless no later hit could count.
-            if depth + 1 == self.params.max_depth {
+            if depth + 1 == max_depth {
                 break;
             }
             let u_lobe = sampler.next_f32();
@@ -179,7 +184,7 @@ impl Setup<'_> {
             // leaves out there), so the roulette runs before the direction is drawn and a killed
             // photon costs no BSDF sample; elsewhere it needs the sampled weight. Either way q
             // is fixed before `u_roulette` is compared with it: unbiased.
-            let roulette = depth + 1 >= self.params.rr_depth;
+            let roulette = depth + 1 >= rr_depth;
             let kill_probability = |scattered: Rgb| {
                 let ratio = luminance(scattered) / luminance(power).max(f32::MIN_POSITIVE);
                 (1.0 - ratio).max(0.0)
