@@ -258,28 +258,12 @@ impl Scene {
     /// ([`Scene::intersect_inlined`] compiles it in too).
     #[inline(always)]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        if self.textured_hits {
-            return self.intersect_textured(ray);
-        }
-        let raw = self.accel.intersect(ray)?;
-        Some(self.hit(ray, raw))
-    }
-
-    /// [`Scene::intersect`] in a scene with cut-outs or normal maps: the closest hit that the
-    /// alpha tests let through, with its normal mapped. Kept out of line so that the queries
-    /// of untextured scenes compile as before.
-    #[inline(never)]
-    fn intersect_textured(&self, ray: &Ray) -> Option<Hit> {
-        let raw = if self.cutouts {
-            self.accel
-                .intersect_cutout(ray, &|i, b1, b2| self.covered(ray, i, b1, b2))?
+        let raw = if self.textured_hits {
+            self.intersect_raw_textured(ray)?
         } else {
             self.accel.intersect(ray)?
         };
-        let mut hit = self.hit(ray, raw);
-        self.apply_normal_map(&mut hit);
-        self.apply_metallic_roughness(&mut hit);
-        Some(hit)
+        Some(self.finish_hit(ray, raw))
     }
 
     /// [`Scene::intersect`], with the BVH traversal compiled into the caller instead of called:
@@ -290,11 +274,52 @@ impl Scene {
     #[doc(hidden)]
     #[inline(always)]
     pub fn intersect_inlined(&self, ray: &Ray) -> Option<Hit> {
-        if self.textured_hits {
-            return self.intersect_textured(ray);
+        let raw = if self.textured_hits {
+            self.intersect_raw_textured(ray)?
+        } else {
+            self.accel.intersect_inlined(ray)?
+        };
+        Some(self.finish_hit(ray, raw))
+    }
+
+    /// The closest hit in a scene with cut-outs or normal maps: the closest one the alpha
+    /// tests let through. Out of line, returning the small `RawHit`, so that the queries of
+    /// untextured scenes compile as before.
+    #[inline(never)]
+    fn intersect_raw_textured(&self, ray: &Ray) -> Option<RawHit> {
+        if self.cutouts {
+            self.accel
+                .intersect_cutout(ray, &|i, b1, b2| self.covered(ray, i, b1, b2))
+        } else {
+            self.accel.intersect(ray)
         }
-        let raw = self.accel.intersect_inlined(ray)?;
-        Some(self.hit(ray, raw))
+    }
+
+    /// The hit of `raw`, with its normal mapped and its metallic-roughness variant chosen in
+    /// a scene that has either.
+    ///
+    /// The textured case is a call that takes the hit by value and returns only what it
+    /// changes: had it written a whole `Hit` through memory (as returning `Option<Hit>` from
+    /// an out-of-line query did), the untextured case inlined beside it would have had to
+    /// build its hit in that memory too, about 28 instructions more per photon bounce.
+    #[inline(always)]
+    fn finish_hit(&self, ray: &Ray, raw: RawHit) -> Hit {
+        let mut hit = self.hit(ray, raw);
+        if self.textured_hits {
+            let (shading_normal, material) = self.textured_surface(hit);
+            hit.shading_normal = shading_normal;
+            hit.material = material;
+        }
+        hit
+    }
+
+    /// The shading normal and material of `hit` after its material's normal map and
+    /// metallic-roughness texture.
+    #[inline(never)]
+    fn textured_surface(&self, mut hit: Hit) -> (Vec3, u32) {
+        self.apply_normal_map(&mut hit);
+        self.apply_metallic_roughness(&mut hit);
+        (hit.shading_normal, hit.material)
     }
 
     #[inline(always)]
