@@ -86,6 +86,7 @@ impl GatherStats {
     /// every slot shrinks as a PPM slot with an α in [α, α_hold]: for a steady M per pass,
     /// R² ∝ N^−(1−α)/α → 0 while N·R² → ∞ (Hachisuka et al. 2008; Knaus and Zwicker 2011), so
     /// bias and variance both vanish and the estimate converges.
+    #[inline]
     pub fn update_with_hold(
         &mut self,
         n_new: u32,
