@@ -19,9 +19,10 @@
 //! counts (the summary lines need both 1 and 2 threads of ppm and freq); `FPPM_BENCH_PHOTONS`
 //! and `FPPM_BENCH_PASSES` change the photons per pass and the timed passes (for profiling
 //! under callgrind); `FPPM_BENCH_LIGHT_TRACING=0` turns off the photons' connections to the
-//! camera (the work of a pass before light tracing, for comparisons with older builds). A second table gives the median seconds of each phase of a pass. "pass
-//! CPU s" is the process CPU time of a pass (all threads): with 1 thread it is the work
-//! itself, whatever else runs on the machine.
+//! camera (the work of a pass before light tracing, for comparisons with older builds). A
+//! second table gives the median seconds of each phase of a pass. "pass CPU s" is the process
+//! CPU time of a pass (all threads): with 1 thread it is the work itself, whatever else runs
+//! on the machine.
 //!
 //! The summary lines are medians over pass rounds of ratios or differences within a round (the
 //! passes compared ran seconds apart). Even so, the tracing phase's extra time of freq over
