@@ -266,20 +266,38 @@ impl Scene {
         Some(self.finish_hit(ray, raw))
     }
 
+    /// Whether some hit needs texture work before it is returned: a cut-out, a normal map or a
+    /// metallic-roughness texture somewhere in the scene. What the `TEXTURED_HITS` of
+    /// [`Scene::intersect_inlined`] must be.
+    #[doc(hidden)]
+    #[inline]
+    pub fn textured_hits(&self) -> bool {
+        self.textured_hits
+    }
+
     /// [`Scene::intersect`], with the BVH traversal compiled into the caller instead of called:
     /// the same answer, for the photon tracer's loop, which does little else, so that the call
     /// and the vector registers saved around it do not weigh on its short rays. A code
     /// generation choice of that one loop rather than a query of its own, hence hidden from
     /// the documentation; every caller gets its own copy of the traversal.
+    ///
+    /// `TEXTURED_HITS` must be [`Scene::textured_hits`] (debug builds assert it): the caller
+    /// compiles its loop once per value and picks the copy once, so that the loop of an
+    /// untextured scene holds no trace of the textured case (in one loop, the test and the
+    /// join of the two cases cost a photon path about 130 instructions; docs/performance.md).
+    /// With `false` in a scene that has textured hits, their cut-outs, normal maps and
+    /// metallic-roughness textures would be ignored.
     #[doc(hidden)]
     #[inline(always)]
-    pub fn intersect_inlined(&self, ray: &Ray) -> Option<Hit> {
-        let raw = if self.textured_hits {
-            self.intersect_raw_textured(ray)?
+    pub fn intersect_inlined<const TEXTURED_HITS: bool>(&self, ray: &Ray) -> Option<Hit> {
+        debug_assert_eq!(TEXTURED_HITS, self.textured_hits);
+        if TEXTURED_HITS {
+            let raw = self.intersect_raw_textured(ray)?;
+            Some(self.finish_hit(ray, raw))
         } else {
-            self.accel.intersect_inlined(ray)?
-        };
-        Some(self.finish_hit(ray, raw))
+            let raw = self.accel.intersect_inlined(ray)?;
+            Some(self.hit(ray, raw))
+        }
     }
 
     /// The closest hit in a scene with cut-outs or normal maps: the closest one the alpha
@@ -434,6 +452,11 @@ impl Scene {
         }
     }
 
+    /// Inlined, as [`Scene::cylinder_hit`] is, so that the hit of every kind of primitive is
+    /// built in registers: with these two called, the inlined triangle hit was written to the
+    /// memory their results arrive in, and reloaded from it with wide loads that the stores
+    /// just made could not forward, about 4 % of the photon loop's time (docs/performance.md).
+    #[inline(always)]
     fn sphere_hit(&self, ray: &Ray, index: u32, t: f32) -> Hit {
         let s = &self.description.spheres[index as usize];
         let outward = (ray.at(t) - s.center).normalize_or(Vec3::Z);
@@ -461,6 +484,7 @@ impl Scene {
         }
     }
 
+    #[inline(always)]
     fn cylinder_hit(&self, ray: &Ray, index: u32, t: f32) -> Hit {
         let c = &self.description.cylinders[index as usize];
         let rel = ray.at(t) - c.center;
@@ -535,5 +559,15 @@ fn triangle_extra(tri: &crate::Triangle) -> TriangleExtra {
         centroid: ((p0 + p1 + p2) / 3.0).into(),
         lower: p0.min(p1).min(p2).into(),
         upper: p0.max(p1).max(p2).into(),
+    }
+}
+
+/// [`Scene::intersect_inlined`] with the scene's own `TEXTURED_HITS`, as the photon tracer calls it.
+#[cfg(test)]
+fn intersect_inlined(scene: &Scene, ray: &Ray) -> Option<Hit> {
+    if scene.textured_hits() {
+        scene.intersect_inlined::<true>(ray)
+    } else {
+        scene.intersect_inlined::<false>(ray)
     }
 }

@@ -5,6 +5,7 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
+use super::intersect_inlined;
 use crate::test_util::{description, diffuse, point_light, tri};
 use crate::texture::{Alpha, AlphaMode, MaterialTextures, NormalMap, TextureRef, Wrap, test_image};
 use crate::{Ray, Scene};
@@ -85,7 +86,7 @@ fn cutouts_let_every_query_through_their_holes() {
         let hit = scene.intersect(&ray).unwrap();
         let expected_t = if through { 2.0 } else { 1.0 };
         assert!((hit.t - expected_t).abs() < 1e-5, "x = {x}: t = {}", hit.t);
-        assert_eq!(scene.intersect_inlined(&ray).map(|h| h.t), Some(hit.t));
+        assert_eq!(intersect_inlined(&scene, &ray).map(|h| h.t), Some(hit.t));
         // A shadow ray from in front of the mask to just before the back quad.
         let shadow = Ray::new(Vec3::new(x, 0.5, 1.0), -Vec3::Z, 1.5);
         assert_eq!(scene.occluded(&shadow), !through, "x = {x}");
@@ -347,7 +348,7 @@ fn metallic_roughness_textures_choose_the_model_per_texel() {
         let m = scene.material(hit.material).unwrap();
         assert_eq!(m.kind, *want, "x = {x}");
         assert_eq!(
-            scene.intersect_inlined(&ray).map(|h| h.material),
+            intersect_inlined(&scene, &ray).map(|h| h.material),
             Some(hit.material)
         );
         // The BSDF the hit gets is the texel's: a mirror is specular, the others are not.

@@ -92,13 +92,31 @@ impl AsRef<[Photon]> for TracedPhotons {
 
 impl Setup<'_> {
     /// Traces photon path `index` of pass `pass` and stores its non-specular hits in `out`.
+    #[inline]
+    pub(super) fn trace_photon(
+        &self,
+        pass: u32,
+        index: u64,
+        tag_base: u32,
+        light: Option<LightTracing<'_>>,
+        out: &mut TracedPhotons,
+    ) {
+        if self.scene.textured_hits() {
+            self.trace_photon_in::<true>(pass, index, tag_base, light, out);
+        } else {
+            self.trace_photon_in::<false>(pass, index, tag_base, light, out);
+        }
+    }
+
+    /// [`Setup::trace_photon`] in a scene whose `Scene::textured_hits` is `TEXTURED_HITS`.
     ///
     /// The hot loop of a pass: `Scene::intersect_inlined` compiles the BVH traversal and the
-    /// hit into it, so that the `Hit` is not returned through memory. Not inlined itself (one
+    /// hit into it, so that the `Hit` is not returned through memory, and one copy per kind of
+    /// scene keeps the texture work of hits out of the untextured one. Not inlined itself (one
     /// call per path), so that it stays visible in profiles; docs/performance.md says where
     /// its time goes.
     #[inline(never)]
-    pub(super) fn trace_photon(
+    fn trace_photon_in<const TEXTURED_HITS: bool>(
         &self,
         pass: u32,
         index: u64,
@@ -131,7 +149,7 @@ impl Setup<'_> {
         // `depth`: the photon's bounces before this hit. A hitpoint adds one more, so hits at
         // depth max_depth − 1 are the last that can count.
         for depth in 0..max_depth {
-            let Some(hit) = self.scene.intersect_inlined(&ray) else {
+            let Some(hit) = self.scene.intersect_inlined::<TEXTURED_HITS>(&ray) else {
                 break;
             };
             let Some(material) = self.scene.material(hit.material) else {
