@@ -99,6 +99,7 @@ impl PhotonMapper<'_> {
         let n_chunks = usize::try_from(n.div_ceil(PHOTON_CHUNK)).unwrap_or(usize::MAX);
         buffers.traced.resize_with(n_chunks, TracedPhotons::default);
         let layout = self.frequency.layout(n_chunks, setup.params.max_depth);
+        let textured_hits = setup.scene.textured_hits();
         let light = setup.params.light_tracing.then(|| LightTracing {
             radii: self.slots.radius(),
             samples_per_pixel: setup.params.samples_per_pixel,
@@ -113,7 +114,12 @@ impl PhotonMapper<'_> {
                 let end = (start + PHOTON_CHUNK).min(n);
                 let tag_base = layout.chunk_base(chunk);
                 for idx in start..end {
-                    setup.trace_photon(pass, first_index + idx, tag_base, light, out);
+                    let index = first_index + idx;
+                    if textured_hits {
+                        setup.trace_photon::<true>(pass, index, tag_base, light, out);
+                    } else {
+                        setup.trace_photon::<false>(pass, index, tag_base, light, out);
+                    }
                 }
             });
         self.n_emitted += n;

@@ -92,23 +92,7 @@ impl AsRef<[Photon]> for TracedPhotons {
 
 impl Setup<'_> {
     /// Traces photon path `index` of pass `pass` and stores its non-specular hits in `out`.
-    #[inline]
-    pub(super) fn trace_photon(
-        &self,
-        pass: u32,
-        index: u64,
-        tag_base: u32,
-        light: Option<LightTracing<'_>>,
-        out: &mut TracedPhotons,
-    ) {
-        if self.scene.textured_hits() {
-            self.trace_photon_in::<true>(pass, index, tag_base, light, out);
-        } else {
-            self.trace_photon_in::<false>(pass, index, tag_base, light, out);
-        }
-    }
-
-    /// [`Setup::trace_photon`] in a scene whose `Scene::textured_hits` is `TEXTURED_HITS`.
+    /// `TEXTURED_HITS` must be the scene's `Scene::textured_hits`.
     ///
     /// The hot loop of a pass: `Scene::intersect_inlined` compiles the BVH traversal and the
     /// hit into it, so that the `Hit` is not returned through memory, and one copy per kind of
@@ -116,7 +100,7 @@ impl Setup<'_> {
     /// call per path), so that it stays visible in profiles; docs/performance.md says where
     /// its time goes.
     #[inline(never)]
-    fn trace_photon_in<const TEXTURED_HITS: bool>(
+    pub(super) fn trace_photon<const TEXTURED_HITS: bool>(
         &self,
         pass: u32,
         index: u64,
