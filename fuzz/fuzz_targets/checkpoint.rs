@@ -7,7 +7,7 @@
 use std::sync::LazyLock;
 
 use fppm_fuzz::{checkpoint_bytes, checkpoint_scene};
-use geometry::Scene;
+use scene::Scene;
 use libfuzzer_sys::fuzz_target;
 
 static SCENE: LazyLock<Scene> = LazyLock::new(checkpoint_scene);

@@ -9,7 +9,7 @@
 use std::sync::LazyLock;
 
 use fppm_fuzz::{checkpoint_scene, column_checkpoints};
-use geometry::Scene;
+use scene::Scene;
 use libfuzzer_sys::fuzz_target;
 
 static SCENE: LazyLock<Scene> = LazyLock::new(checkpoint_scene);

@@ -18,9 +18,8 @@
 use std::sync::{Arc, LazyLock};
 
 use fppm_fuzz::{envmap_files, envmap_pbrt_files, fuzzed};
-use geometry::{
-    Environment, EnvironmentMap, EnvironmentRadiance, LoadOptions, Scene, SceneDescription,
-};
+use scene::{Environment, EnvironmentMap, EnvironmentRadiance, Scene, SceneDescription};
+use import::LoadOptions;
 use glam::{Vec2, Vec3};
 use libfuzzer_sys::fuzz_target;
 
@@ -28,7 +27,7 @@ use libfuzzer_sys::fuzz_target;
 static BASE: LazyLock<SceneDescription> = LazyLock::new(|| {
     let text =
         fppm_fuzz::ENVMAP_SCENE.replace("file   = \"sky.exr\"", "radiance = [1.0, 1.0, 1.0]");
-    geometry::load_toml_str(&text, &fuzzed("envmap_scene.toml")).expect("the base scene loads")
+    import::load_toml_str(&text, &fuzzed("envmap_scene.toml")).expect("the base scene loads")
 });
 
 /// Sample values: the ends of [0, 1) and a few inside.
@@ -86,14 +85,14 @@ fuzz_target!(|data: &[u8]| {
     let description = match mode % 4 {
         3 => {
             let (path, files) = envmap_pbrt_files(rest.to_vec());
-            match geometry::load_from(&path, files, &LoadOptions::allow_no_emitter()) {
+            match import::load_from(&path, files, &LoadOptions::allow_no_emitter()) {
                 Ok(d) => d,
                 Err(_) => return,
             }
         }
         m @ (0 | 1) => {
             let (path, files) = envmap_files(rest.to_vec(), m == 1);
-            match geometry::load_from(&path, files, &LoadOptions::allow_no_emitter()) {
+            match import::load_from(&path, files, &LoadOptions::allow_no_emitter()) {
                 Ok(d) => d,
                 Err(_) => return,
             }

@@ -5,10 +5,7 @@
 #![no_main]
 
 use arbitrary::{Arbitrary, Unstructured};
-use geometry::{
-    Camera, Cylinder, Film, Light, LoadNotes, Material, MaterialKind, RenderDefaults,
-    SceneDescription, Sphere, Triangle,
-};
+use scene::{Camera, Cylinder, Film, Light, LoadNotes, Material, MaterialKind, RenderDefaults, SceneDescription, Sphere, Triangle};
 use glam::Vec3;
 use libfuzzer_sys::fuzz_target;
 use ppm::{FrequencyFloor, MergePolicy, Method, RenderParams, Renderer};
@@ -102,16 +99,16 @@ struct Input {
 
 fn material(m: &Mat, i: usize) -> Material {
     let kind = match &m.kind {
-        Kind::Diffuse(a) => MaterialKind::Diffuse { albedo: a.get() },
-        Kind::Mirror(r) => MaterialKind::Mirror {
+        Kind::Diffuse(a) => MaterialKind::Diffuse(scene::Diffuse { albedo: a.get() }),
+        Kind::Mirror(r) => MaterialKind::Mirror(scene::Mirror {
             reflectance: r.get(),
-        },
-        Kind::Dielectric(ior) => MaterialKind::Dielectric { ior: ior.0 },
-        Kind::Glossy(r, roughness, d) => MaterialKind::Glossy {
+        }),
+        Kind::Dielectric(ior) => MaterialKind::Dielectric(scene::Dielectric { ior: ior.0 }),
+        Kind::Glossy(r, roughness, d) => MaterialKind::Glossy(scene::Glossy {
             reflectance: r.get(),
             roughness: roughness.0,
             diffuse: d.get(),
-        },
+        }),
     };
     Material {
         name: format!("m{i}"),

@@ -7,8 +7,9 @@
 #![no_main]
 
 use fppm_fuzz::texture_files;
-use geometry::texture::{TextureRef, Wrap};
-use geometry::{LoadOptions, Ray, Scene};
+use scene::texture::{TextureRef, Wrap};
+use scene::{Ray, Scene};
+use import::LoadOptions;
 use glam::{Vec2, Vec3};
 use libfuzzer_sys::fuzz_target;
 
@@ -28,7 +29,7 @@ const UVS: [(f32, f32); 10] = [
 
 fuzz_target!(|data: &[u8]| {
     let (path, files) = texture_files(data.to_vec());
-    let Ok(description) = geometry::load_from(&path, files, &LoadOptions::allow_no_emitter())
+    let Ok(description) = import::load_from(&path, files, &LoadOptions::allow_no_emitter())
     else {
         return;
     };

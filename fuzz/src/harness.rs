@@ -68,10 +68,10 @@ pub fn split_nul(data: &[u8]) -> (&[u8], &[u8]) {
 ///
 /// If [`CHECKPOINT_SCENE`] does not load (a bug of the harness, caught by xtask's tests).
 #[must_use]
-pub fn checkpoint_scene() -> geometry::Scene {
-    let description = geometry::load_toml_str(CHECKPOINT_SCENE, &fuzzed("checkpoint_scene.toml"))
+pub fn checkpoint_scene() -> scene::Scene {
+    let description = import::load_toml_str(CHECKPOINT_SCENE, &fuzzed("checkpoint_scene.toml"))
         .expect("the checkpoint scene loads");
-    geometry::Scene::new(description).expect("the checkpoint scene builds")
+    scene::Scene::new(description).expect("the checkpoint scene builds")
 }
 
 /// Bytes of a checkpoint before the fuzzed body: magic, format version, scene fingerprint.
@@ -81,11 +81,11 @@ pub const CHECKPOINT_HEADER: usize = 8 + 4 + 8;
 /// `body`: the header and the FNV-1a checksum are made right so that the fuzzer's mutations
 /// reach the parser of the body instead of failing the checksum.
 #[must_use]
-pub fn checkpoint_bytes(scene: &geometry::Scene, body: &[u8]) -> Vec<u8> {
+pub fn checkpoint_bytes(scene: &scene::Scene, body: &[u8]) -> Vec<u8> {
     let mut out = Vec::with_capacity(CHECKPOINT_HEADER + body.len() + 8);
     out.extend_from_slice(b"FPPMSTAT");
     out.extend_from_slice(&ppm::STATE_VERSION.to_le_bytes());
-    out.extend_from_slice(&ppm::scene_fingerprint(scene.description()).to_le_bytes());
+    out.extend_from_slice(&scene.description().fingerprint().to_le_bytes());
     out.extend_from_slice(body);
     let hash = fnv1a(&out);
     out.extend_from_slice(&hash.to_le_bytes());
@@ -283,7 +283,7 @@ pub fn checkpoint_params(method: ppm::Method) -> ppm::RenderParams {
 ///
 /// If a checkpoint just saved does not split (a bug of the harness or of the library).
 #[must_use]
-pub fn column_checkpoints(scene: &geometry::Scene) -> Vec<(String, Vec<u8>, Vec<u8>)> {
+pub fn column_checkpoints(scene: &scene::Scene) -> Vec<(String, Vec<u8>, Vec<u8>)> {
     let mut out = Vec::new();
     for method in ppm::Method::ALL {
         let Ok(mut renderer) = ppm::Renderer::new(scene, checkpoint_params(method)) else {

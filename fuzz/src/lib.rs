@@ -2,20 +2,21 @@
 //! used by `xtask`), and the checks run on whatever loads.
 //!
 //! Every target reads its input in memory (no temporary files): scenes through
-//! [`geometry::load_from`] with a resolver closure, checkpoints and EXRs from byte slices.
+//! [`import::load_from`] with a resolver closure, checkpoints and EXRs from byte slices.
 
 mod harness;
 
 use std::path::Path;
 
-use geometry::{LoadOptions, Scene, SceneDescription};
+use scene::{Scene, SceneDescription};
+use import::LoadOptions;
 
 pub use harness::*;
 
 /// Loads `path` from `files` and, if it loads, builds the [`Scene`] (validation, lights, BVH)
 /// and summarises it: what every loader target runs.
-pub fn load_and_build(path: &Path, files: impl geometry::FileSource + 'static) {
-    let Ok(description) = geometry::load_from(path, files, &LoadOptions::allow_no_emitter()) else {
+pub fn load_and_build(path: &Path, files: impl import::FileSource + 'static) {
+    let Ok(description) = import::load_from(path, files, &LoadOptions::allow_no_emitter()) else {
         return;
     };
     build(description);

@@ -8,23 +8,31 @@ use std::process::Command;
 /// edge, or a missing one, is a change of ARCHITECTURE.md's map first.
 const EDGES: &[(&str, &[&str])] = &[
     ("spectrum", &[]),
-    ("geometry", &[]),
+    ("scene", &[]),
+    ("import", &["scene"]),
     ("photon", &[]),
-    ("ppm", &["spectrum", "geometry", "photon"]),
+    ("ppm", &["spectrum", "scene", "photon"]),
     ("film", &[]),
-    ("cli", &["geometry", "ppm", "film"]),
-    ("xtask", &["geometry", "ppm", "film"]),
+    ("cli", &["scene", "import", "ppm", "film"]),
+    ("xtask", &["scene", "import", "ppm", "film"]),
 ];
 
 /// The direction of ARCHITECTURE.md: the crates each crate may depend on.
 const ALLOWED: &[(&str, &[&str])] = &[
     ("spectrum", &[]),
-    ("geometry", &["spectrum"]),
-    ("photon", &["spectrum", "geometry"]),
-    ("ppm", &["spectrum", "geometry", "photon"]),
+    ("scene", &["spectrum"]),
+    ("import", &["spectrum", "scene"]),
+    ("photon", &["spectrum", "scene"]),
+    ("ppm", &["spectrum", "scene", "photon"]),
     ("film", &[]),
-    ("cli", &["spectrum", "geometry", "photon", "ppm", "film"]),
-    ("xtask", &["spectrum", "geometry", "photon", "ppm", "film"]),
+    (
+        "cli",
+        &["spectrum", "scene", "import", "photon", "ppm", "film"],
+    ),
+    (
+        "xtask",
+        &["spectrum", "scene", "import", "photon", "ppm", "film"],
+    ),
 ];
 
 /// Normal (non-dev, non-build) dependencies of every workspace package.
@@ -119,14 +127,87 @@ fn spectrum_depends_on_nothing_but_std() {
     assert_eq!(deps["spectrum"], Vec::<String>::new());
 }
 
+/// The third-party libraries only one workspace crate may name: the BVH builder belongs to the
+/// scene runtime, the file-format parsers and image decoders to the importers.
+const OWNED_LIBRARIES: &[(&str, &[&str])] = &[
+    ("scene", &["obvhs"]),
+    (
+        "import",
+        &[
+            "tobj",
+            "gltf",
+            "spade",
+            "roxmltree",
+            "ply-rs-bw",
+            "bevy_mikktspace",
+            "flate2",
+        ],
+    ),
+];
+
 #[test]
-fn only_geometry_knows_the_scene_and_bvh_libraries() {
+fn only_their_owner_knows_the_bvh_and_format_libraries() {
     let deps = dependencies();
     for (name, actual) in &deps {
-        for library in ["obvhs", "tobj", "gltf", "spade", "roxmltree", "ply-rs-bw"] {
-            if actual.iter().any(|d| d == library) {
-                assert_eq!(name, "geometry", "{name} depends on {library}");
+        for (owner, libraries) in OWNED_LIBRARIES {
+            for library in *libraries {
+                if actual.iter().any(|d| d == library) {
+                    assert_eq!(name, owner, "{name} depends on {library}");
+                }
             }
         }
+    }
+}
+
+/// Every package `root` compiles in a normal build (its normal dependencies, transitively, on
+/// this platform), as `cargo tree` lists them.
+fn normal_closure(root: &str) -> Vec<String> {
+    let output = Command::new(env!("CARGO"))
+        .args([
+            "tree",
+            "-p",
+            root,
+            "-e",
+            "normal",
+            "--prefix",
+            "none",
+            "-f",
+            "{p}",
+            "--offline",
+        ])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8(output.stdout)
+        .unwrap()
+        .lines()
+        .filter_map(|line| line.split_whitespace().next())
+        .map(str::to_owned)
+        .collect()
+}
+
+#[test]
+fn the_integrators_compile_no_importer() {
+    let closure = normal_closure("ppm");
+    assert!(closure.iter().any(|n| n == "scene"), "{closure:?}");
+    for importer in [
+        "import",
+        "gltf",
+        "tobj",
+        "spade",
+        "roxmltree",
+        "ply-rs-bw",
+        "image",
+        "toml",
+    ] {
+        assert!(
+            !closure.iter().any(|n| n == importer),
+            "ppm compiles {importer}: {closure:?}"
+        );
     }
 }

@@ -15,13 +15,13 @@ mod shared_scenes;
 /// `passes` path-traced passes (max depth 5, `seed`) of `scene` on a `width × height` film:
 /// the renders the importer tests compare.
 fn path_image(
-    mut scene: geometry::SceneDescription,
+    mut scene: scene::SceneDescription,
     (width, height): (u32, u32),
     seed: u64,
     passes: u32,
 ) -> Vec<[f32; 3]> {
-    scene.film = geometry::Film { width, height };
-    let scene = geometry::Scene::new(scene).unwrap();
+    scene.film = scene::Film { width, height };
+    let scene = scene::Scene::new(scene).unwrap();
     let mut params = ppm::RenderParams::preview();
     params.method = ppm::Method::Path;
     params.max_depth = 5;

@@ -1,6 +1,6 @@
 //! Round trip through Mitsuba 3 XML: a scene written as Mitsuba XML by the helper below (an
 //! exporter that knows nothing of the importer's code, only Mitsuba's documented plugins) and
-//! read back by `geometry::load` describes the same scene and renders the same image.
+//! read back by `import::load` describes the same scene and renders the same image.
 //!
 //! What Mitsuba cannot say is lost on purpose and checked as such: an arc of a cylinder comes
 //! back whole (Mitsuba's `cylinder` has no arc), and the render settings other than the
@@ -9,8 +9,8 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use geometry::{Light, MaterialKind, SceneDescription};
 use glam::Vec3;
+use scene::{Light, MaterialKind, SceneDescription};
 
 /// The Fresnel reflectance at normal incidence of ior 1.5 (the coat of Mitsuba's plastic as
 /// written here), ((1.5 − 1) / (1.5 + 1))².
@@ -83,34 +83,34 @@ fn write_mitsuba(scene: &SceneDescription, dir: &Path) -> PathBuf {
     x.push_str("  </sensor>\n");
     for (i, m) in scene.materials.iter().enumerate() {
         let body = match m.kind {
-            MaterialKind::Diffuse { albedo } => {
+            MaterialKind::Diffuse(scene::Diffuse { albedo }) => {
                 format!(
                     "<bsdf type=\"diffuse\" id=\"m{i}\"><rgb name=\"reflectance\" value=\"{}\"/></bsdf>",
                     c3(albedo)
                 )
             }
-            MaterialKind::Mirror { reflectance } => format!(
+            MaterialKind::Mirror(scene::Mirror { reflectance }) => format!(
                 "<bsdf type=\"conductor\" id=\"m{i}\"><string name=\"material\" value=\"none\"/><rgb name=\"specular_reflectance\" value=\"{}\"/></bsdf>",
                 c3(reflectance)
             ),
-            MaterialKind::Dielectric { ior } => format!(
+            MaterialKind::Dielectric(scene::Dielectric { ior }) => format!(
                 "<bsdf type=\"dielectric\" id=\"m{i}\"><float name=\"int_ior\" value=\"{ior}\"/><float name=\"ext_ior\" value=\"1\"/></bsdf>"
             ),
-            MaterialKind::Glossy {
+            MaterialKind::Glossy(scene::Glossy {
                 reflectance,
                 roughness,
                 diffuse,
-            } if diffuse == Vec3::ZERO => format!(
+            }) if diffuse == Vec3::ZERO => format!(
                 "<bsdf type=\"roughconductor\" id=\"m{i}\"><string name=\"material\" value=\"none\"/><float name=\"alpha\" value=\"{roughness}\"/><rgb name=\"specular_reflectance\" value=\"{}\"/></bsdf>",
                 c3(reflectance)
             ),
             // A coat over a diffuse base: Mitsuba's roughplastic, whose import scales the
             // specular part by the coat's Fresnel F0 and the diffuse part by 1 − F0.
-            MaterialKind::Glossy {
+            MaterialKind::Glossy(scene::Glossy {
                 reflectance,
                 roughness,
                 diffuse,
-            } => format!(
+            }) => format!(
                 "<bsdf type=\"roughplastic\" id=\"m{i}\"><float name=\"int_ior\" value=\"1.5\"/><float name=\"ext_ior\" value=\"1\"/><float name=\"alpha\" value=\"{roughness}\"/><rgb name=\"specular_reflectance\" value=\"{}\"/><rgb name=\"diffuse_reflectance\" value=\"{}\"/></bsdf>",
                 c3(reflectance / F0),
                 c3(diffuse / (1.0 - F0))
@@ -130,7 +130,7 @@ fn write_mitsuba(scene: &SceneDescription, dir: &Path) -> PathBuf {
         }
     };
     // One OBJ per run of consecutive triangles of one material, so the order is kept.
-    let mut runs: Vec<(u32, Vec<&geometry::Triangle>)> = Vec::new();
+    let mut runs: Vec<(u32, Vec<&scene::Triangle>)> = Vec::new();
     for t in &scene.triangles {
         match runs.last_mut() {
             Some((m, tris)) if *m == t.material => tris.push(t),
@@ -252,26 +252,29 @@ fn close_f(a: f32, b: f32, what: &str) {
 
 fn close_kind(a: MaterialKind, b: MaterialKind, what: &str) {
     match (a, b) {
-        (MaterialKind::Diffuse { albedo: x }, MaterialKind::Diffuse { albedo: y }) => {
-            close(x, y, what)
-        }
-        (MaterialKind::Mirror { reflectance: x }, MaterialKind::Mirror { reflectance: y }) => {
-            close(x, y, what)
-        }
-        (MaterialKind::Dielectric { ior: x }, MaterialKind::Dielectric { ior: y }) => {
-            close_f(x, y, what)
-        }
         (
-            MaterialKind::Glossy {
+            MaterialKind::Diffuse(scene::Diffuse { albedo: x }),
+            MaterialKind::Diffuse(scene::Diffuse { albedo: y }),
+        ) => close(x, y, what),
+        (
+            MaterialKind::Mirror(scene::Mirror { reflectance: x }),
+            MaterialKind::Mirror(scene::Mirror { reflectance: y }),
+        ) => close(x, y, what),
+        (
+            MaterialKind::Dielectric(scene::Dielectric { ior: x }),
+            MaterialKind::Dielectric(scene::Dielectric { ior: y }),
+        ) => close_f(x, y, what),
+        (
+            MaterialKind::Glossy(scene::Glossy {
                 reflectance: r1,
                 roughness: a1,
                 diffuse: d1,
-            },
-            MaterialKind::Glossy {
+            }),
+            MaterialKind::Glossy(scene::Glossy {
                 reflectance: r2,
                 roughness: a2,
                 diffuse: d2,
-            },
+            }),
         ) => {
             close(r1, r2, what);
             close_f(a1, a2, what);
@@ -443,9 +446,9 @@ fn shared_cornell_boxes_round_trip_through_mitsuba_xml() {
         "CornellBox-Water",
         "CornellBox-Empty-RG",
     ] {
-        let original = geometry::load(&root.join(format!("{name}.obj"))).unwrap();
+        let original = import::load(&root.join(format!("{name}.obj"))).unwrap();
         let xml = write_mitsuba(&original, &temp_dir(name));
-        let back = geometry::load(&xml).unwrap();
+        let back = import::load(&xml).unwrap();
         assert_same(&original, &back, name);
         assert_same_image(&render(original), &render(back), name);
     }
@@ -454,9 +457,9 @@ fn shared_cornell_boxes_round_trip_through_mitsuba_xml() {
 #[test]
 fn default_scene_round_trips_through_mitsuba_xml() {
     let text = include_str!("../../crates/cli/src/default_scene.toml");
-    let original = geometry::load_toml_str(text, Path::new("default_scene.toml")).unwrap();
+    let original = import::load_toml_str(text, Path::new("default_scene.toml")).unwrap();
     let xml = write_mitsuba(&original, &temp_dir("default"));
-    let back = geometry::load(&xml).unwrap();
+    let back = import::load(&xml).unwrap();
     // The render settings other than max_depth (method, passes, photons, seed) are not
     // Mitsuba's to carry; the default scene sets none of max_depth.
     assert_same(&original, &back, "default scene");

@@ -18,8 +18,8 @@
 
 use std::path::Path;
 
-use geometry::{MaterialKind, SceneDescription};
 use glam::Vec3;
+use scene::{MaterialKind, SceneDescription};
 
 /// floor.ply and plate1..4.ply, x negated and every face reversed.
 const OBJS: &[(&str, &str)] = &[
@@ -187,7 +187,7 @@ fn veach_mis_matches_its_hand_conversion() {
         std::fs::write(dir.join(name), text).unwrap();
     }
     std::fs::write(dir.join("veach.toml"), TOML).unwrap();
-    let mut by_hand = geometry::load(&dir.join("veach.toml")).unwrap();
+    let mut by_hand = import::load(&dir.join("veach.toml")).unwrap();
     for m in &mut by_hand.materials {
         let roughness = match m.name.as_str() {
             "plate1" => 0.005,
@@ -196,15 +196,15 @@ fn veach_mis_matches_its_hand_conversion() {
             "plate4" => 0.1,
             _ => continue,
         };
-        m.kind = MaterialKind::Glossy {
+        m.kind = MaterialKind::Glossy(scene::Glossy {
             reflectance: Vec3::splat(0.04),
             roughness,
             diffuse: 0.96 * Vec3::new(0.07, 0.09, 0.13),
-        };
+        });
     }
     let pbrt = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../shared/scenes/pbrt-v4/veach-mis/veach-mis.pbrt");
-    let imported = geometry::load(&pbrt).unwrap();
+    let imported = import::load(&pbrt).unwrap();
     assert_eq!(imported.film, by_hand.film);
     assert_eq!(
         imported.render.get("max_depth"),

@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use geometry::{Film, Scene};
 use ppm::{Method, RenderParams, Renderer};
+use scene::{Film, Scene};
 
 fn shared(relative: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -36,7 +36,7 @@ const LIT_SCENES: &[&str] = &[
 #[test]
 fn every_lit_shared_scene_renders_with_every_method() {
     for relative in LIT_SCENES {
-        let mut description = geometry::load(&shared(relative)).unwrap();
+        let mut description = import::load(&shared(relative)).unwrap();
         description.film = Film {
             width: 12,
             height: 12,

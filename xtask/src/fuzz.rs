@@ -588,7 +588,7 @@ mod seeds {
 
     /// Small images of every kind the texture loader reads: 8- and 16-bit PNG (grey, RGB,
     /// RGBA with a mask), JPEG, OpenEXR (half and float) and Radiance HDR. The JPEG, EXR and HDR
-    /// encoders are the `image` features `geometry` enables (Cargo unifies them).
+    /// encoders are the `image` features `import` enables (Cargo unifies them).
     pub(super) fn images() -> Result<Vec<(String, Vec<u8>)>> {
         use image::{DynamicImage, ImageBuffer, ImageFormat, Luma, Rgb, Rgb32FImage, Rgba};
         let encode = |img: DynamicImage, format: ImageFormat| -> Result<Vec<u8>> {
@@ -735,7 +735,7 @@ mod seeds {
 
 #[cfg(test)]
 mod tests {
-    use geometry::{LoadOptions, load_from};
+    use import::{LoadOptions, load_from};
 
     use super::{harness, parse_stats, seeds};
 
@@ -800,7 +800,7 @@ mod tests {
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
             let textured = d.materials.iter().filter(|m| m.textures.is_some()).count();
             assert_eq!(textured, 2, "{name}: the floor and the sign are textured");
-            geometry::Scene::new(d).unwrap_or_else(|e| panic!("{name}: {e}"));
+            scene::Scene::new(d).unwrap_or_else(|e| panic!("{name}: {e}"));
         }
     }
 
@@ -825,7 +825,7 @@ mod tests {
                 load_from(&path, files, &LoadOptions::default())
             }
             .unwrap_or_else(|e| panic!("{name}: {e}"));
-            let scene = geometry::Scene::new(d).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let scene = scene::Scene::new(d).unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(scene.lights().has_environment(), "{name}");
         }
         assert_eq!(files, 4);

@@ -134,7 +134,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
     let mut noise_lines = Vec::new();
     for name in &flags.scenes {
         let scene_path = root.join("scenes/peers").join(format!("{name}.toml"));
-        let mut description = geometry::load(&scene_path)
+        let mut description = import::load(&scene_path)
             .with_context(|| format!("loading {}", scene_path.display()))?;
         if let Some((w, h)) = flags.film {
             description.film.width = w;
@@ -143,7 +143,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         let (width, height) = (description.film.width, description.film.height);
         let dir = out.join(name);
         let xml = write_mitsuba(&description, &dir.join("mitsuba"))?;
-        let scene = geometry::Scene::new(description)?;
+        let scene = scene::Scene::new(description)?;
         let diffuse = diffuse_first_hit_mask(&scene, width as usize, height as usize);
 
         // The reference: two independent halves.
@@ -302,7 +302,7 @@ fn score(
 }
 
 /// Pixels whose camera ray through the pixel centre first hits a diffuse, non-emitting surface.
-fn diffuse_first_hit_mask(scene: &geometry::Scene, width: usize, height: usize) -> Vec<bool> {
+fn diffuse_first_hit_mask(scene: &scene::Scene, width: usize, height: usize) -> Vec<bool> {
     let mut mask = vec![false; width * height];
     for y in 0..height {
         for x in 0..width {
@@ -314,7 +314,7 @@ fn diffuse_first_hit_mask(scene: &geometry::Scene, width: usize, height: usize) 
                 .and_then(|hit| scene.material(hit.material))
                 .is_some_and(|m| {
                     m.emission.max_element() == 0.0
-                        && matches!(m.kind, geometry::MaterialKind::Diffuse { .. })
+                        && matches!(m.kind, scene::MaterialKind::Diffuse(_))
                 });
             mask[y * width + x] = diffuse;
         }
@@ -422,10 +422,7 @@ fn run_mitsuba(
 /// `constant` or `envmap` ([`environment_emitter`]). Glossy materials and lights other than
 /// emissive surfaces, point lights and the environment are refused: the peer scenes do not use
 /// them.
-pub(crate) fn write_mitsuba(
-    description: &geometry::SceneDescription,
-    dir: &Path,
-) -> Result<PathBuf> {
+pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -> Result<PathBuf> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut xml = String::new();
     writeln!(xml, "<scene version=\"3.0.0\">")?;
@@ -477,7 +474,7 @@ pub(crate) fn write_mitsuba(
             );
         }
         let bsdf = match m.kind {
-            geometry::MaterialKind::Diffuse { albedo } if color.is_some() => {
+            scene::MaterialKind::Diffuse(scene::Diffuse { albedo }) if color.is_some() => {
                 let texture = color.context("checked")?;
                 if albedo != Vec3::ONE {
                     bail!(
@@ -493,15 +490,15 @@ pub(crate) fn write_mitsuba(
             _ if color.is_some() => {
                 bail!("material {}: only diffuse textures are exported", m.name)
             }
-            geometry::MaterialKind::Diffuse { albedo } => format!(
+            scene::MaterialKind::Diffuse(scene::Diffuse { albedo }) => format!(
                 "<bsdf type=\"twosided\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"{}\"/></bsdf></bsdf>",
                 rgb(albedo.to_array())
             ),
-            geometry::MaterialKind::Mirror { reflectance } => format!(
+            scene::MaterialKind::Mirror(scene::Mirror { reflectance }) => format!(
                 "<bsdf type=\"twosided\"><bsdf type=\"conductor\"><string name=\"material\" value=\"none\"/><rgb name=\"specular_reflectance\" value=\"{}\"/></bsdf></bsdf>",
                 rgb(reflectance.to_array())
             ),
-            geometry::MaterialKind::Dielectric { ior } => format!(
+            scene::MaterialKind::Dielectric(scene::Dielectric { ior }) => format!(
                 "<bsdf type=\"dielectric\"><float name=\"int_ior\" value=\"{ior}\"/><float name=\"ext_ior\" value=\"1.0\"/></bsdf>"
             ),
             other => bail!("material {} ({other:?}) is not exported", m.name),
@@ -612,7 +609,7 @@ pub(crate) fn write_mitsuba(
     }
     for light in &description.lights {
         match *light {
-            geometry::Light::Point {
+            scene::Light::Point {
                 position,
                 intensity,
             } => writeln!(
@@ -635,17 +632,17 @@ pub(crate) fn write_mitsuba(
 
 /// The environment as a Mitsuba emitter: `constant` (scale folded into the radiance) or
 /// `envmap` of the same file (absolute path), `scale`, and the rotation as its `to_world`
-/// matrix. Both read the map in Mitsuba's orientation (`geometry::Environment`).
-fn environment_emitter(env: &geometry::Environment) -> String {
+/// matrix. Both read the map in Mitsuba's orientation (`scene::Environment`).
+fn environment_emitter(env: &scene::Environment) -> String {
     match &env.radiance {
-        geometry::EnvironmentRadiance::Constant(c) => {
+        scene::EnvironmentRadiance::Constant(c) => {
             let c = *c * env.scale;
             format!(
                 "<emitter type=\"constant\"><rgb name=\"radiance\" value=\"{}, {}, {}\"/></emitter>",
                 c.x, c.y, c.z
             )
         }
-        geometry::EnvironmentRadiance::Map(map) => {
+        scene::EnvironmentRadiance::Map(map) => {
             let path = std::path::absolute(&map.path).unwrap_or_else(|_| map.path.clone());
             // Mitsuba's `matrix` is row-major.
             let m = env.to_world.transpose().to_cols_array();
@@ -669,7 +666,7 @@ fn environment_emitter(env: &geometry::Environment) -> String {
 
 /// An open cylinder's kept arc as an ASCII PLY of `segments` quads with exact outward normals,
 /// counter-clockwise seen from outside (the front, as fppm's analytic cylinder).
-fn cylinder_ply(c: &geometry::Cylinder, segments: usize) -> String {
+fn cylinder_ply(c: &scene::Cylinder, segments: usize) -> String {
     let side = c.axis.cross(c.facing);
     let mut ply = String::new();
     let n_vertices = 2 * (segments + 1);
@@ -697,14 +694,14 @@ fn cylinder_ply(c: &geometry::Cylinder, segments: usize) -> String {
 
 /// A Mitsuba `bitmap` texture parameter reading `texture`'s image file: colour textures as
 /// Mitsuba decodes them by default (sRGB for 8-bit files), data (alpha) `raw`.
-fn bitmap(name: &str, texture: &geometry::texture::TextureRef) -> Result<String> {
-    if texture.transform != geometry::texture::TextureRef::IDENTITY {
+fn bitmap(name: &str, texture: &scene::texture::TextureRef) -> Result<String> {
+    if texture.transform != scene::texture::TextureRef::IDENTITY {
         bail!("texture transforms are not exported");
     }
-    let wrap = |w: geometry::texture::Wrap| match w {
-        geometry::texture::Wrap::Repeat => "repeat",
-        geometry::texture::Wrap::Mirror => "mirror",
-        geometry::texture::Wrap::Clamp => "clamp",
+    let wrap = |w: scene::texture::Wrap| match w {
+        scene::texture::Wrap::Repeat => "repeat",
+        scene::texture::Wrap::Mirror => "mirror",
+        scene::texture::Wrap::Clamp => "clamp",
     };
     if texture.wrap[0] != texture.wrap[1] {
         bail!("different wrap modes along u and v are not exported");

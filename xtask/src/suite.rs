@@ -81,7 +81,7 @@ pub(crate) fn load_suite(root: &Path) -> Result<Suite> {
 }
 
 /// Loads the scene file with the suite's film size.
-pub(crate) fn load_scene(root: &Path, entry: &SuiteScene) -> Result<geometry::Scene> {
+pub(crate) fn load_scene(root: &Path, entry: &SuiteScene) -> Result<scene::Scene> {
     load_scene_sized(root, &entry.path, entry.width, entry.height)
 }
 
@@ -91,20 +91,20 @@ pub(crate) fn load_scene_sized(
     path: &Path,
     width: u32,
     height: u32,
-) -> Result<geometry::Scene> {
+) -> Result<scene::Scene> {
     let path = root.join(path);
     let mut description =
-        geometry::load(&path).with_context(|| format!("loading {}", path.display()))?;
+        import::load(&path).with_context(|| format!("loading {}", path.display()))?;
     description.film.width = width;
     description.film.height = height;
-    geometry::Scene::new(description).with_context(|| format!("building {}", path.display()))
+    scene::Scene::new(description).with_context(|| format!("building {}", path.display()))
 }
 
 /// The parameters of `method` on `entry` at the check budget: the scene's `[render]` table,
 /// then the suite's.
 pub(crate) fn params(
     entry: &SuiteScene,
-    scene: &geometry::Scene,
+    scene: &scene::Scene,
     method: ppm::Method,
     seed: u64,
 ) -> Result<ppm::RenderParams> {
@@ -131,7 +131,7 @@ pub(crate) struct Rendered {
 
 /// Renders `passes` passes of `params` and returns the image.
 pub(crate) fn render(
-    scene: &geometry::Scene,
+    scene: &scene::Scene,
     params: ppm::RenderParams,
     passes: u32,
 ) -> Result<Rendered> {
@@ -167,7 +167,7 @@ pub(crate) fn passes(entry: &SuiteScene, method: ppm::Method) -> u32 {
 /// lamp is hundreds of times brighter than the walls, so the few pixels on its outline, where
 /// PPM's single fixed hitpoint per pixel lands either on or off the lamp, would otherwise
 /// dominate both the mean and the relative MSE; they say nothing about light transport.
-pub(crate) fn transport_mask(scene: &geometry::Scene) -> Vec<bool> {
+pub(crate) fn transport_mask(scene: &scene::Scene) -> Vec<bool> {
     let film = scene.description().film;
     let (w, h) = (film.width as usize, film.height as usize);
     let mut emitter = vec![false; w * h];

@@ -70,7 +70,7 @@ fn main() -> ExitCode {
     // panic message is not printed first. Any other panic is reported as Rust does.
     let default_hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
-        if !geometry::containing_a_panic() {
+        if !import::containing_a_panic() {
             default_hook(info);
         }
     }));
@@ -112,15 +112,13 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
 
 /// `fppm info [SCENE]`: what was loaded, without rendering.
 fn info(scene: Option<&Path>, env: Option<std::path::PathBuf>) -> anyhow::Result<Outcome> {
-    let options = geometry::LoadOptions {
+    let options = import::LoadOptions {
         environment: env,
-        ..geometry::LoadOptions::allow_no_emitter()
+        ..import::LoadOptions::allow_no_emitter()
     };
     let description = match scene {
-        Some(path) => geometry::load_with(path, &options)?,
-        None => {
-            geometry::load_toml_str_with(DEFAULT_SCENE, Path::new(DEFAULT_SCENE_NAME), &options)?
-        }
+        Some(path) => import::load_with(path, &options)?,
+        None => import::load_toml_str_with(DEFAULT_SCENE, Path::new(DEFAULT_SCENE_NAME), &options)?,
     };
     let summary = description.summary();
     let mut text = summary.to_string();
@@ -141,7 +139,7 @@ pub(crate) fn print_stdout(text: &str) -> anyhow::Result<()> {
 }
 
 /// The error and its causes joined by `: `, skipping a cause whose text the message already
-/// holds (library errors such as `geometry::LoadError` quote their source).
+/// holds (library errors such as `import::LoadError` quote their source).
 fn error_chain(err: &anyhow::Error) -> String {
     let mut message = String::new();
     for cause in err.chain() {

@@ -22,7 +22,7 @@ static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 pub(crate) fn render(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Result<Outcome> {
     let job = settings::render_job(scene, args)?;
     check_memory(&job)?;
-    let scene = geometry::Scene::new(job.description.clone())?;
+    let scene = scene::Scene::new(job.description.clone())?;
     in_pool(job.run.threads, || {
         let renderer = Renderer::new(&scene, job.params)
             .map_err(|e| anyhow::anyhow!("{}: {e}", job.description.source.display()))?;
@@ -69,7 +69,7 @@ pub(crate) fn resume(args: &ResumeArgs) -> anyhow::Result<Outcome> {
         earlier_seconds: note.render_seconds,
     };
     check_memory(&job)?;
-    let scene = geometry::Scene::new(job.description.clone())?;
+    let scene = scene::Scene::new(job.description.clone())?;
     in_pool(job.run.threads, || {
         let renderer = Renderer::restore(&scene, &bytes)
             .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;

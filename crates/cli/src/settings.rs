@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::Context;
-use geometry::SceneDescription;
 use ppm::{Method, ParamError, RenderParams};
+use scene::SceneDescription;
 
 use crate::args::{AovArg, OutputArgs, ParamArgs, RenderArgs, RunArgs, TonemapArg};
 use crate::output::{self, Tonemap};
@@ -148,15 +148,13 @@ pub(crate) fn load_scene(
     scene: Option<&Path>,
     env: Option<&Path>,
 ) -> anyhow::Result<SceneDescription> {
-    let options = geometry::LoadOptions {
+    let options = import::LoadOptions {
         environment: env.map(Path::to_path_buf),
-        ..geometry::LoadOptions::default()
+        ..import::LoadOptions::default()
     };
     Ok(match scene {
-        Some(path) => geometry::load_with(path, &options)?,
-        None => {
-            geometry::load_toml_str_with(DEFAULT_SCENE, Path::new(DEFAULT_SCENE_NAME), &options)?
-        }
+        Some(path) => import::load_with(path, &options)?,
+        None => import::load_toml_str_with(DEFAULT_SCENE, Path::new(DEFAULT_SCENE_NAME), &options)?,
     })
 }
 
@@ -167,9 +165,9 @@ pub(crate) type FilmOverride = (Option<u32>, Option<u32>);
 fn film_flags(width: Option<u32>, height: Option<u32>) -> anyhow::Result<FilmOverride> {
     for (flag, value) in [("--width", width), ("--height", height)] {
         if let Some(v) = value
-            && !(1..=geometry::MAX_FILM_SIDE).contains(&v)
+            && !(1..=scene::MAX_FILM_SIDE).contains(&v)
         {
-            usage!("{flag} {v} is outside [1, {}]", geometry::MAX_FILM_SIDE);
+            usage!("{flag} {v} is outside [1, {}]", scene::MAX_FILM_SIDE);
         }
     }
     Ok((width, height))
@@ -183,12 +181,11 @@ pub(crate) fn apply_film(description: &mut SceneDescription, (width, height): Fi
         (Some(w), Some(h)) => (film.width, film.height) = (w, h),
         (Some(w), None) => {
             film.width = w;
-            film.height =
-                ((f64::from(w) / aspect).round() as u32).clamp(1, geometry::MAX_FILM_SIDE);
+            film.height = ((f64::from(w) / aspect).round() as u32).clamp(1, scene::MAX_FILM_SIDE);
         }
         (None, Some(h)) => {
             film.height = h;
-            film.width = ((f64::from(h) * aspect).round() as u32).clamp(1, geometry::MAX_FILM_SIDE);
+            film.width = ((f64::from(h) * aspect).round() as u32).clamp(1, scene::MAX_FILM_SIDE);
         }
         (None, None) => {}
     }

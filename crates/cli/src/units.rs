@@ -91,7 +91,7 @@ pub(crate) fn plan(args: PlanArgs) -> anyhow::Result<Outcome> {
         .check(film.width, film.height, &job.params, true)?;
     std::fs::create_dir_all(&args.job)
         .with_context(|| format!("{}: cannot create the job folder", args.job.display()))?;
-    let scene = geometry::Scene::new(job.description.clone())?;
+    let scene = scene::Scene::new(job.description.clone())?;
     let clock = Instant::now();
     let bytes = in_pool(job.run.threads, || {
         let kernels = Renderer::pass_independent_kernels(&scene, job.params)
@@ -182,14 +182,14 @@ fn read_plan(job: &Path) -> anyhow::Result<(Vec<u8>, StateHeader, PlanNote)> {
 }
 
 /// The scene of a plan, with the plan's film.
-fn plan_scene(note: &PlanNote) -> anyhow::Result<geometry::Scene> {
+fn plan_scene(note: &PlanNote) -> anyhow::Result<scene::Scene> {
     let mut description =
         settings::load_scene(note.render.scene.as_deref(), note.render.env.as_deref())?;
     settings::apply_film(
         &mut description,
         (Some(note.render.width), Some(note.render.height)),
     );
-    Ok(geometry::Scene::new(description)?)
+    Ok(scene::Scene::new(description)?)
 }
 
 /// The unit index: `--index`, else Slurm's `SLURM_ARRAY_TASK_ID`, else Kubernetes'

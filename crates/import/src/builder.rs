@@ -10,11 +10,11 @@ use std::path::Path;
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
 use super::{LoadOptions, SceneParts, finish, is_degenerate};
-use crate::description::{
+use crate::error::LoadError;
+use scene::{
     Camera, Cylinder, Film, Light, LoadNotes, Material, RenderDefaults, Rgb, SceneDescription,
     Sphere, Triangle,
 };
-use crate::error::LoadError;
 
 /// Grey that stands in for a texture that cannot be read (or is procedural).
 pub(crate) const TEXTURE_STANDIN_GREY: f32 = 0.5;
@@ -33,7 +33,7 @@ pub(crate) struct IndexedMesh {
     pub(crate) positions: Vec<Vec3>,
     pub(crate) normals: Option<Vec<Vec3>>,
     /// Per-vertex texture coordinates in fppm's convention (v = 0 at the image's top row, see
-    /// [`crate::texture`]): Mitsuba's own uv as read (its bitmaps put v = 0 at the top), pbrt's
+    /// [`scene::texture`]): Mitsuba's own uv as read (its bitmaps put v = 0 at the top), pbrt's
     /// with v flipped by [`IndexedMesh::flip_v`].
     pub(crate) uvs: Option<Vec<Vec2>>,
     pub(crate) indices: Vec<[u32; 3]>,
@@ -189,7 +189,7 @@ pub(crate) struct Builder {
     /// Emitters that were skipped (environment lights), for the no-emitter error.
     pub(crate) skipped_emitters: Vec<String>,
     /// The environment light (the first the file defines).
-    pub(crate) environment: Option<crate::Environment>,
+    pub(crate) environment: Option<scene::Environment>,
 }
 
 impl Builder {
@@ -407,7 +407,7 @@ fn srgb_to_linear(v: f64) -> f64 {
 
 /// Sets the scene's environment light; a second one is dropped with a warning (fppm renders
 /// one environment).
-pub(crate) fn set_environment(builder: &mut Builder, element: &str, env: crate::Environment) {
+pub(crate) fn set_environment(builder: &mut Builder, element: &str, env: scene::Environment) {
     if builder.environment.is_some() {
         builder.warn(format!(
             "{element}: a second environment light is ignored (fppm renders one)"

@@ -2,37 +2,13 @@
 
 use glam::Vec3;
 
-use crate::description::{Camera, Cylinder, Sphere, Triangle};
+use scene::{Camera, Cylinder, Sphere, Triangle};
 
 /// Vertical field of view of a framed camera, in degrees.
 pub const FRAMED_FOV_Y_DEGREES: f32 = 40.0;
 
 /// Extra room around the framed bounding box (5 %).
 const MARGIN: f32 = 1.05;
-
-/// World-space bounding box of triangles, spheres and cylinders, or `None` if there are none.
-pub(crate) fn bounds(
-    triangles: &[Triangle],
-    spheres: &[Sphere],
-    cylinders: &[Cylinder],
-) -> Option<(Vec3, Vec3)> {
-    let mut lo = Vec3::splat(f32::INFINITY);
-    let mut hi = Vec3::splat(f32::NEG_INFINITY);
-    for p in triangles.iter().flat_map(|t| t.positions) {
-        lo = lo.min(p);
-        hi = hi.max(p);
-    }
-    for s in spheres {
-        lo = lo.min(s.center - Vec3::splat(s.radius));
-        hi = hi.max(s.center + Vec3::splat(s.radius));
-    }
-    for c in cylinders {
-        let b = c.bounds();
-        lo = lo.min(b.min);
-        hi = hi.max(b.max);
-    }
-    (lo.cmple(hi).all()).then_some((lo, hi))
-}
 
 /// A pinhole camera on the +Z side of the bounding box, looking down −Z at its centre, with
 /// up = +Y and a 40° vertical field of view. It stands back far enough that the box's front
@@ -45,8 +21,8 @@ pub(crate) fn frame_camera(
     cylinders: &[Cylinder],
     aspect: f32,
 ) -> Camera {
-    let (lo, hi) =
-        bounds(triangles, spheres, cylinders).unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)));
+    let (lo, hi) = scene::primitive_bounds(triangles, spheres, cylinders)
+        .unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)));
     let center = 0.5 * (lo + hi);
     let half = 0.5 * (hi - lo);
     let aspect = if aspect.is_finite() && aspect > 0.0 {

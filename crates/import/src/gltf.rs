@@ -3,9 +3,9 @@
 //! The default scene (or else scene 0) is walked from its root nodes, composing world matrices.
 //! Mapping (scene-format.md, "glTF 2.0 mapping"), with these decisions:
 //! - materials: transmission > 0 → dielectric (ior from `KHR_materials_ior`, default 1.5);
-//!   metallic ≥ 0.5 ([`METALLIC_THRESHOLD`]) with roughness < 0.01 → mirror with the base
+//!   metallic ≥ 0.5 ([`scene::texture::METALLIC_THRESHOLD`]) with roughness < 0.01 → mirror with the base
 //!   colour; metallic ≥ 0.5 otherwise → glossy with α = roughness² and no diffuse base;
-//!   else diffuse with the base colour ([`gltf_kind`]), per texel under a metallic-roughness
+//!   else diffuse with the base colour ([`MetallicRoughness::kind`]), per texel under a metallic-roughness
 //!   texture; textures as [`material`] says.
 //!   Emission = emissive factor × emissive strength. A primitive without a material gets
 //!   the glTF default material (white, metallic 1, roughness 1, so glossy with α = 1);
@@ -19,7 +19,7 @@
 //! - missing normals give flat shading; a node transform with negative determinant swaps
 //!   the winding so that front faces stay front faces;
 //! - `TANGENT` is kept under materials with a normal map (the map's frame, see
-//!   [`crate::Triangle::tangents`]), carried by the node's matrix with w turned around by a
+//!   [`scene::Triangle::tangents`]), carried by the node's matrix with w turned around by a
 //!   mirroring one; without it the normal map uses the triangle's own frame;
 //! - images are files beside the glTF file, base64 `data:` URIs or buffer views (GLB).
 
@@ -31,37 +31,12 @@ use gltf::khr_lights_punctual::Kind;
 use gltf::mesh::Mode;
 
 use super::{MeshData, read_bytes};
-use crate::description::{Camera, Light, Material, MaterialKind};
 use crate::error::LoadError;
-use crate::texture::{
-    Alpha, AlphaMode, MaterialTextures, MetallicRoughness, NormalMap, TextureCache, TextureRef,
-    Wrap,
+use crate::image_file::TextureCache;
+use scene::texture::{
+    Alpha, AlphaMode, MaterialTextures, MetallicRoughness, NormalMap, TextureRef, Wrap,
 };
-
-/// Metallic factor from which a glTF material counts as a conductor.
-pub const METALLIC_THRESHOLD: f32 = 0.5;
-
-/// Roughness below which a conductor is a perfect mirror.
-pub(crate) const MIRROR_ROUGHNESS: f32 = 0.01;
-
-/// The scattering model of an opaque glTF material with base colour `base`: a conductor
-/// (mirror below [`MIRROR_ROUGHNESS`], else glossy with α = roughness² and no diffuse base)
-/// from metallic [`METALLIC_THRESHOLD`] on, else diffuse with the base colour.
-pub(crate) fn gltf_kind(base: Vec3, metallic: f32, roughness: f32) -> MaterialKind {
-    if metallic >= METALLIC_THRESHOLD {
-        if roughness < MIRROR_ROUGHNESS {
-            MaterialKind::Mirror { reflectance: base }
-        } else {
-            MaterialKind::Glossy {
-                reflectance: base,
-                roughness: roughness * roughness,
-                diffuse: Vec3::ZERO,
-            }
-        }
-    } else {
-        MaterialKind::Diffuse { albedo: base }
-    }
-}
+use scene::{Camera, Light, Material, MaterialKind};
 
 /// Deepest node hierarchy accepted (guards against cyclic node graphs).
 const MAX_DEPTH: usize = 1024;
@@ -136,7 +111,7 @@ pub(crate) fn load_gltf(path: &Path) -> Result<MeshData, LoadError> {
     }
     data.camera = walker.camera.map(|(_, mut camera, aspect)| {
         // Focus on the scene's centre (depth along the view), for a later thin lens.
-        if let Some((lo, hi)) = super::bounds(&data.triangles, &[], &[]) {
+        if let Some((lo, hi)) = scene::primitive_bounds(&data.triangles, &[], &[]) {
             let forward = camera.look_at - camera.position;
             let depth = (0.5 * (lo + hi) - camera.position).dot(forward);
             if depth.is_finite() && depth > 0.0 {
@@ -627,11 +602,11 @@ fn mikktspace_tangents(
 fn default_material() -> Material {
     Material {
         name: "default".to_owned(),
-        kind: MaterialKind::Glossy {
+        kind: MaterialKind::Glossy(scene::Glossy {
             reflectance: Vec3::ONE,
             roughness: 1.0,
             diffuse: Vec3::ZERO,
-        },
+        }),
         emission: Vec3::ZERO,
         textures: None,
     }
@@ -772,11 +747,11 @@ fn material(
         }
     }
     let kind = if transmission > 0.0 {
-        MaterialKind::Dielectric {
+        MaterialKind::Dielectric(scene::Dielectric {
             ior: m.ior().unwrap_or(1.5),
-        }
+        })
     } else {
-        gltf_kind(base, metallic, roughness)
+        MetallicRoughness::kind(base, metallic, roughness)
     };
     let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
     let base_info = pbr.base_color_texture();
@@ -797,7 +772,7 @@ fn material(
             scale: normal.scale(),
         });
     }
-    let alpha_texture = maps.color.clone().filter(|t| t.image.has_alpha);
+    let alpha_texture = maps.color.clone().filter(|t| t.image.has_alpha());
     let mode = match m.alpha_mode() {
         gltf::material::AlphaMode::Opaque => None,
         gltf::material::AlphaMode::Mask => Some(AlphaMode::Mask {

@@ -1,4 +1,5 @@
-//! Reading image files into [`Image`]s, once per file.
+//! Reading image files into the runtime's [`Image`]s, once per file, and the size checks of
+//! image headers that come before any decoding.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -6,8 +7,8 @@ use std::sync::Arc;
 
 use image::{DynamicImage, ImageFormat, ImageReader};
 
-use super::{Image, Texels};
 use crate::error::LoadError;
+use scene::texture::{Image, Texels};
 
 /// Largest image accepted, in texels (a 8192 × 8192 image).
 pub(crate) const MAX_TEXELS: u64 = 64 << 20;
@@ -44,8 +45,8 @@ impl TextureCache {
             return Ok(Arc::clone(image));
         }
         // Through the loader's file source, so that scenes loaded from memory
-        // (`geometry::load_from`) find their textures there too.
-        let bytes = crate::load::files::read(path).map_err(|e| {
+        // (`import::load_from`) find their textures there too.
+        let bytes = crate::files::read(path).map_err(|e| {
             texture_error(
                 path,
                 format!(
@@ -190,51 +191,19 @@ pub(crate) fn decode(path: &Path, bytes: &[u8]) -> Result<Image, LoadError> {
 }
 
 /// An [`Image`] from decoded pixels: 8-bit images keep their bytes, float images become linear
-/// RGBA floats (checked for NaN and infinities).
+/// RGBA floats (checked for NaN and infinities by [`Image::new`]).
 pub(crate) fn from_dynamic(path: &Path, img: DynamicImage) -> Result<Image, LoadError> {
     let (width, height) = (img.width(), img.height());
-    if width == 0 || height == 0 {
-        return Err(texture_error(
-            path,
-            format!("texture has zero size ({width}x{height})"),
-        ));
-    }
     let alpha_channel = img.color().has_alpha();
     let float = matches!(
         img,
         DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
     );
     let texels = if float {
-        let rgba = img.into_rgba32f();
-        let texels: Vec<[f32; 4]> = rgba.pixels().map(|p| p.0).collect();
-        if let Some(i) = texels.iter().position(|t| !t.iter().all(|c| c.is_finite())) {
-            let (x, y) = (i as u32 % width, i as u32 / width);
-            let what = if texels[i].iter().any(|c| c.is_nan()) {
-                "nan"
-            } else {
-                "infinite"
-            };
-            return Err(texture_error(
-                path,
-                format!("texture has a {what} texel at ({x}, {y})"),
-            ));
-        }
-        Texels::Floats(texels)
+        Texels::Floats(img.into_rgba32f().pixels().map(|p| p.0).collect())
     } else {
         Texels::Bytes(img.into_rgba8().pixels().map(|p| p.0).collect())
     };
-    // An alpha channel counts when it masks something (some texel below ½): files whose mask
-    // is their grey channel often carry an all-but-opaque alpha channel as well.
-    let has_alpha = alpha_channel
-        && match &texels {
-            Texels::Bytes(t) => t.iter().any(|p| p[3] < 128),
-            Texels::Floats(t) => t.iter().any(|p| p[3] < 0.5),
-        };
-    Ok(Image {
-        path: path.to_path_buf(),
-        width,
-        height,
-        texels,
-        has_alpha,
-    })
+    Image::new(path.to_path_buf(), width, height, texels, alpha_channel)
+        .map_err(|e| texture_error(path, e.to_string()))
 }

@@ -26,9 +26,11 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 
 use super::{MeshData, polygon};
-use crate::description::{Material, MaterialKind};
 use crate::error::LoadError;
-use crate::texture::{Alpha, AlphaMode, MaterialTextures, NormalMap, TextureCache, TextureRef};
+use scene::texture::{Alpha, AlphaMode, MaterialTextures, NormalMap, TextureRef};
+use scene::{Material, MaterialKind};
+
+use crate::image_file::TextureCache;
 
 /// Albedo of the default material and of MTL materials without `Kd`.
 pub const DEFAULT_ALBEDO: f32 = 0.8;
@@ -129,9 +131,9 @@ pub(crate) fn load_obj(path: &Path) -> Result<MeshData, LoadError> {
 pub(crate) fn default_material_value() -> Material {
     Material {
         name: DEFAULT_MATERIAL_NAME.to_owned(),
-        kind: MaterialKind::Diffuse {
+        kind: MaterialKind::Diffuse(scene::Diffuse {
             albedo: Vec3::splat(DEFAULT_ALBEDO),
-        },
+        }),
         emission: Vec3::ZERO,
         textures: None,
     }
@@ -430,26 +432,26 @@ fn mtl_material(m: &tobj::Material, warnings: &mut Vec<String>) -> Material {
     let illum = m.illumination_model;
     let dissolve = m.dissolve.unwrap_or(1.0);
     let kind = if illum == Some(5) {
-        MaterialKind::Mirror {
+        MaterialKind::Mirror(scene::Mirror {
             reflectance: ks.unwrap_or(Vec3::ONE),
-        }
+        })
     } else if matches!(illum, Some(4 | 6 | 7)) {
-        MaterialKind::Dielectric {
+        MaterialKind::Dielectric(scene::Dielectric {
             ior: m.optical_density.unwrap_or(1.5),
-        }
+        })
     } else if let (true, Some(ior)) = (dissolve < 1.0, m.optical_density) {
-        MaterialKind::Dielectric { ior }
+        MaterialKind::Dielectric(scene::Dielectric { ior })
     } else {
         match ks {
             Some(ks) if ks.max_element() >= 0.9 && ns >= 1000.0 => {
-                MaterialKind::Mirror { reflectance: ks }
+                MaterialKind::Mirror(scene::Mirror { reflectance: ks })
             }
-            Some(ks) if ks.max_element() > 0.0 => MaterialKind::Glossy {
+            Some(ks) if ks.max_element() > 0.0 => MaterialKind::Glossy(scene::Glossy {
                 reflectance: ks,
                 roughness: (2.0 / (ns.max(0.0) + 2.0)).sqrt(),
                 diffuse: kd,
-            },
-            _ => MaterialKind::Diffuse { albedo: kd },
+            }),
+            _ => MaterialKind::Diffuse(scene::Diffuse { albedo: kd }),
         }
     };
     if let Some(ka) = m.ambient.map(Vec3::from)

@@ -16,7 +16,7 @@ use glam::{Vec2, Vec3};
 use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Encoding, Property, PropertyType, ScalarType};
 
-use super::import::IndexedMesh;
+use super::builder::IndexedMesh;
 use super::read_bytes;
 use crate::error::LoadError;
 

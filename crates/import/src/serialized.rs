@@ -13,7 +13,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use super::import::IndexedMesh;
+use super::builder::IndexedMesh;
 use super::read_bytes;
 use crate::error::LoadError;
 

@@ -12,7 +12,7 @@
 
 use glam::DVec3;
 
-use crate::description::Rgb;
+use scene::Rgb;
 
 /// First wavelength of the tables, nm.
 const CIE_MIN: f64 = 360.0;

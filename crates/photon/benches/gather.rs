@@ -7,16 +7,7 @@
 //!
 //! Run: `cargo bench -p photon --bench gather`. Divan reports items/s = queries per second.
 //! The table printed first is measured in thread CPU time, so it holds on a shared machine.
-//!
-//! Measured 2026-11-22 (2 shared cores, x86-64 baseline, other jobs running), default grid
-//! (`MeanRadius(4.0)`): 79 grid bytes per hitpoint (3.37 entries), build 0.30–0.33 s CPU single
-//! thread (0.15–0.28 s wall on 2 threads); gather 3.7–4.5 M queries/s per thread Morton-sorted,
-//! 1.3–1.5 M/s random order (CPU time); 2 threads sorted 7.2 M/s when the machine was quiet.
-//! obvhs `Bvh2` on the same setup (`crates.md`): 2.1–2.2 M/s sorted, 0.23–0.39 M/s random.
-//!
-//! 2026-11-22, after the grid stored position and R² once per hitpoint instead of once per
-//! entry (same machine, old and new binaries run back to back, CPU time): default grid 78.9 ->
-//! 38.5 B/hp, build 0.24 -> 0.17 s, gather 4.1 -> 6.9 M/s sorted, 1.2 -> 0.9 M/s random order.
+//! The figures it has given are in docs/performance.md.
 #![allow(clippy::unwrap_used, clippy::print_stdout, missing_docs)]
 
 use std::sync::LazyLock;

@@ -29,8 +29,8 @@ pub struct GridParams {
 }
 
 impl GridParams {
-    /// The measured default: base cell edge 4 × mean radius, rebuild when the mean radius has
-    /// shrunk to 0.8 of its build value (see `benches/gather.rs`).
+    /// The default: base cell edge 4 × mean radius, rebuild when the mean radius has shrunk to
+    /// 0.8 of its build value (chosen with `benches/gather.rs`).
     pub const DEFAULT: Self = Self {
         cell_size: CellSize::MeanRadius(4.0),
         rebuild_below: 0.8,
@@ -45,17 +45,16 @@ impl GridParams {
 /// e·2^(L−2) < R ≤ e·2^(L−1) (level 0: all R ≤ e/2), so a hitpoint spans at most 2–3 cells per
 /// axis; e comes from [`CellSize`]. Cells of all levels are hashed into one power-of-two table
 /// of about 2 × the number of occupied cells (at most 2 × the number of hitpoints);
-/// `cell_start[b]..cell_start[b + 1]` indexes bucket b's entries. Sized by the hitpoints, the
-/// table was mostly empty while radii are large (tens of hitpoints per cell): 8 bytes per
-/// hitpoint, a fifth of the grid, for buckets nobody looks up. Only infinite radii (or R > e·2^47) go to an overflow list scanned by every query.
+/// `cell_start[b]..cell_start[b + 1]` indexes bucket b's entries. Sized by the occupied cells
+/// rather than the hitpoints, the table stays small while radii are large (tens of hitpoints
+/// per cell). Only infinite radii (or R > e·2^47) go to an overflow list scanned by every
+/// query.
 /// An entry is a hitpoint index (4 bytes); the hitpoint's position and R² are stored once per
 /// hitpoint (16 bytes, one quarter of a cache line) and read through the index. Hitpoints given
 /// in a spatially coherent order (the Morton order of `morton_order`) keep those reads local:
-/// a cell's entries are nearby hitpoints, hence nearby indices. (The previous layout copied
-/// position and R² into every entry, 3.4 per hitpoint at the default cell size: 79 instead of
-/// 39 bytes per hitpoint, and with Morton-ordered hitpoints and photons it gathered slower,
-/// 4.1 against 6.9 M queries/s in `benches/gather.rs`; it was faster only for photons in
-/// random order, 1.2 against 0.9 M/s.)
+/// a cell's entries are nearby hitpoints, hence nearby indices. Copying position and R² into
+/// every entry instead takes more memory and gathers slower in Morton order
+/// (docs/performance.md).
 ///
 /// The stored R² is the largest `f32` not above the exact `f64` R², which makes the `f32` test
 /// `|p − x|² ≤ R²_f32` equivalent to [`crate::within_radius`]: the results are exact.

@@ -6,9 +6,9 @@
 //! least-significant-digit radix sort on the key. Ties (points in one cell) therefore keep their
 //! input order, and the order is a pure function of the points.
 //!
-//! The earlier 63-bit keys with one counting pass on the top bits and a comparison sort per
-//! bucket took three times as long to sort and sped up only ×1.3 on 2 threads (the counting
-//! pass was serial, the buckets of photons on walls uneven); see `morton_sort` for figures.
+//! A radix sort over all the keys, rather than buckets of a counting pass each sorted on its
+//! own, keeps every pass parallel and its work even, however unevenly the photons fill space
+//! (docs/performance.md has the figures).
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -42,10 +42,8 @@ pub fn morton_order(points: &[Vec3]) -> Vec<u32> {
 /// `scratch` and `out` are buffers the caller keeps across calls: their capacity is reused, so
 /// repeated sorts of similar sizes do not allocate.
 ///
-/// Cost (`ppm`'s `passes` bench, 2.4 million photons of 52 bytes (56 now that they carry a tag) from 489 chunks): 0.07 s for
-/// the bounding box and the keys, 0.05 s for the sort and 0.08 s for the copy on 1 thread
-/// (0.05, 0.04 and 0.045 s on 2), against 0.07, 0.16 and 0.085 s (0.04, 0.13 and 0.04 s) with
-/// the bucketed comparison sort of before.
+/// The bounding box with the keys and the final copy each cost more than the sort itself
+/// (docs/performance.md).
 ///
 /// # Panics
 /// If there are 2³² items or more.
@@ -93,8 +91,8 @@ pub struct MortonScratch {
     /// Index in the concatenation of the first item of each chunk.
     starts: Vec<usize>,
     /// Bits of the index in the chunk in an item, if chunk and index fit in 32 bits (the copy
-    /// then reads an item's chunk from its bits instead of searching `starts`, which cost four
-    /// times as much).
+    /// then reads an item's chunk from its bits instead of searching `starts`, which is
+    /// several times slower).
     item_bits: Option<u32>,
 }
 
@@ -197,8 +195,8 @@ fn morton_keys<T, C>(
     sort_keys(keys, spare);
 }
 
-/// Bits of one radix digit: three passes cover the 31-bit keys (8-bit digits and four passes
-/// were slower).
+/// Bits of one radix digit: three passes cover the 31-bit keys (8-bit digits need four, and
+/// measure slower).
 const DIGIT_BITS: u32 = 11;
 const RADIX: usize = 1 << DIGIT_BITS;
 /// Blocks of a radix pass at most (the same for any thread count, so the result is too).
@@ -259,7 +257,7 @@ fn radix_pass(src: &[u64], dst: &mut [u64], shift: u32, block_len: usize) -> boo
             // The block sorted by digit on its own (a counting sort into a buffer of its size,
             // with plain indices), then each digit's run copied to its range of `dst`: twice the
             // writes of scattering straight into `dst`, but without a cursor per digit to load
-            // and store back, which made that three times slower.
+            // and store back, which costs more than the extra writes.
             let mut next = [0_usize; RADIX];
             let mut run_start = 0;
             for (d, &c) in count.iter().enumerate() {

@@ -26,9 +26,9 @@
 //!
 //! The summary lines are medians over pass rounds of ratios or differences within a round (the
 //! passes compared ran seconds apart). Even so, the tracing phase's extra time of freq over
-//! ppm varies by ±0.03 s from run to run: the bookkeeping share read 6–14 % in runs of 9
-//! passes, 7.0–8.3 % in runs of 15 (hence 15 by default; `docs/performance.md` has it without
-//! that noise: about 7.5 %).
+//! ppm varies from run to run by a good part of the bookkeeping share itself, which is why 15
+//! passes are timed by default; `docs/performance.md` has the share measured without that
+//! noise.
 //!
 //! The frequency line splits freq's extra pass time into its bookkeeping (the tracing phase's
 //! extra time over ppm's: spectra and occlusion probes along the frequency photons' paths; plus
@@ -92,7 +92,7 @@ struct Run<'s> {
 /// shared machine drifts by ±20 % over minutes; measured one after the other, the ratios of the
 /// summary (frequency overhead, parallel speed-up) drifted with it.
 fn run<'s>(
-    scene: &'s geometry::Scene,
+    scene: &'s scene::Scene,
     configs: &[(Method, usize)],
     photons_per_pass: u32,
     passes: usize,
@@ -141,12 +141,12 @@ fn run<'s>(
 fn main() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/scenes/cornell_box/CornellBox-Sphere.obj");
-    let mut description = geometry::load(&path).unwrap();
-    description.film = geometry::Film {
+    let mut description = import::load(&path).unwrap();
+    description.film = scene::Film {
         width: 512,
         height: 512,
     };
-    let scene = geometry::Scene::new(description).unwrap();
+    let scene = scene::Scene::new(description).unwrap();
     let photons_per_pass: u32 = env_or("FPPM_BENCH_PHOTONS", 1_000_000);
     let passes: usize = env_or("FPPM_BENCH_PASSES", 15);
     println!(

@@ -16,15 +16,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let passes: u32 = args.get(3).map_or(Ok(10), |s| s.parse())?;
     let out = args.get(4).map_or("quick.png", String::as_str);
 
-    let mut description = geometry::load(Path::new(scene_path))?;
+    let mut description = import::load(Path::new(scene_path))?;
     if let Ok(size) = std::env::var("QUICK_FILM") {
         let size: u32 = size.parse()?;
-        description.film = geometry::Film {
+        description.film = scene::Film {
             width: size,
             height: size,
         };
     }
-    let scene = geometry::Scene::new(description)?;
+    let scene = scene::Scene::new(description)?;
     let mut params = ppm::RenderParams::preview();
     params.method = ppm::Method::from_name(method).ok_or("unknown method")?;
     if let Ok(depth) = std::env::var("QUICK_MAX_DEPTH") {

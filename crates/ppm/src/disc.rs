@@ -24,8 +24,8 @@
 //! two in radius is a factor of four in the variance the hold saves, and the bias of the
 //! level just below an edge is that of the shrinking PPM radius anyway.
 
-use geometry::{Ray, Scene};
 use glam::Vec3;
+use scene::{Ray, Scene};
 
 /// Probe directions in the tangent plane.
 pub(crate) const DIRECTIONS: usize = 8;
@@ -137,7 +137,7 @@ intensity = [1.0, 1.0, 1.0]
 "#;
 
     fn scene() -> Scene {
-        let description = geometry::load_toml_str(SCENE, Path::new("disc-test.toml"))
+        let description = import::load_toml_str(SCENE, Path::new("disc-test.toml"))
             .expect("the test scene parses");
         Scene::new(description).expect("the test scene builds")
     }

@@ -2,7 +2,7 @@
 //! (Hachisuka & Jensen 2009) and their frequency-guided variants (Belcour & Soler 2011), behind
 //! one progressive API.
 //!
-//! The principal type is [`Renderer`]: build it from a [`geometry::Scene`] and
+//! The principal type is [`Renderer`]: build it from a [`scene::Scene`] and
 //! [`RenderParams`], call [`Renderer::iterate`] once per pass (each returns [`PassStats`]) and
 //! read [`Renderer::image`] whenever you like.
 //!
@@ -22,8 +22,8 @@
 //!
 //! ```no_run
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
-//! let description = geometry::load(std::path::Path::new("scene.toml"))?;
-//! let scene = geometry::Scene::new(description)?;
+//! let description = import::load(std::path::Path::new("scene.toml"))?;
+//! let scene = scene::Scene::new(description)?;
 //! let mut params = ppm::RenderParams::preview();
 //! params.method = ppm::Method::FreqPpm;
 //! let mut renderer = ppm::Renderer::new(&scene, params)?;
@@ -57,6 +57,6 @@ pub use crate::renderer::{Aov, Renderer};
 pub use crate::rng::Sampler;
 #[doc(hidden)]
 pub use crate::state::surgery as checkpoint_surgery;
-pub use crate::state::{STATE_VERSION, StateError, StateHeader, scene_fingerprint};
+pub use crate::state::{STATE_VERSION, StateError, StateHeader};
 pub use crate::update::{FrequencyFloor, FrequencyRadius, GatherStats};
 pub use spectrum::{K_POSTER, K_STRICT, MergePolicy};

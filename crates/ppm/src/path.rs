@@ -3,9 +3,9 @@
 //! the photon mappers. It is deliberately simple: it is the independent ground truth the photon
 //! mappers are checked against, not a competitor.
 
-use geometry::{Bsdf, Hit, Rgb, Scene, TransportMode};
 use glam::Vec2;
 use rayon::prelude::*;
+use scene::{Bsdf, Hit, Rgb, Scene, TransportMode};
 
 use crate::params::RenderParams;
 use crate::rng::Sampler;

@@ -10,7 +10,7 @@
 
 use rayon::prelude::*;
 
-use geometry::{Rgb, Scene};
+use scene::{Rgb, Scene};
 
 use crate::params::{ParamError, RenderParams};
 use crate::path::PathTracer;

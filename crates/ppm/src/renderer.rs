@@ -1,8 +1,8 @@
 //! The one progressive API over every integrator.
 
-use geometry::{MaterialKind, Rgb, Scene};
 use glam::Vec2;
 use rayon::prelude::*;
+use scene::{Rgb, Scene};
 
 use crate::params::{Method, ParamError, RenderParams};
 use crate::path::PathTracer;
@@ -271,26 +271,12 @@ impl<'s> Renderer<'s> {
                         let albedo = self
                             .scene
                             .material(hit.material)
-                            .map_or(Rgb::ZERO, |m| albedo(m.kind))
+                            .map_or(Rgb::ZERO, |m| m.kind.albedo())
                             * self.scene.scattering_tint(&hit);
                         values.copy_from_slice(&albedo.to_array());
                     }
                 }
             });
         out
-    }
-}
-
-/// The reflectance a material shows at normal incidence, for the albedo AOV.
-fn albedo(kind: MaterialKind) -> Rgb {
-    match kind {
-        MaterialKind::Diffuse { albedo } => albedo,
-        MaterialKind::Mirror { reflectance } => reflectance,
-        MaterialKind::Dielectric { .. } => Rgb::ONE,
-        MaterialKind::Glossy {
-            reflectance,
-            diffuse,
-            ..
-        } => reflectance + diffuse,
     }
 }

@@ -9,9 +9,9 @@
 //! renderer whose next passes are bit-identical to those of the renderer that was saved; the
 //! hash grid is not stored (it is rebuilt, and gathers do not depend on its layout).
 
-use geometry::{EnvironmentRadiance, Light, MaterialKind, Scene, SceneDescription};
 use glam::Vec3;
 use photon::{HitPoints, NewHitPoint};
+use scene::Scene;
 use spectrum::{FrequencyEstimate, MergePolicy, Spectrum};
 
 use crate::params::{Method, ParamError, RenderParams};
@@ -23,7 +23,7 @@ use crate::update::FrequencyFloor;
 const MAGIC: &[u8; 8] = b"FPPMSTAT";
 /// Version of the checkpoint layout; bump it whenever the layout or the meaning of a field
 /// changes, so that old checkpoints are refused rather than misread.
-pub const STATE_VERSION: u32 = 6;
+pub const STATE_VERSION: u32 = 7;
 /// zstd level of the columns: the fastest; higher levels gain a few per cent for several times
 /// the time.
 const ZSTD_LEVEL: i32 = 1;
@@ -100,7 +100,7 @@ pub struct StateHeader {
     pub params: RenderParams,
     /// Passes completed.
     pub passes: u32,
-    /// Fingerprint of the scene ([`scene_fingerprint`]).
+    /// Fingerprint of the scene ([`scene::SceneDescription::fingerprint`]).
     pub scene_fingerprint: u64,
 }
 
@@ -124,7 +124,7 @@ impl<'s> Renderer<'s> {
         let mut w = Writer::default();
         w.bytes(MAGIC);
         w.u32(STATE_VERSION);
-        w.u64(scene_fingerprint(self.scene.description()));
+        w.u64(self.scene.description().fingerprint());
         w.str(note);
         write_params(&mut w, self.params());
         w.u32(self.passes());
@@ -162,7 +162,7 @@ impl<'s> Renderer<'s> {
     pub fn restore(scene: &'s Scene, bytes: &[u8]) -> Result<Self, StateError> {
         let mut r = Reader::new(bytes)?;
         let header = read_header(&mut r)?;
-        let expected = scene_fingerprint(scene.description());
+        let expected = scene.description().fingerprint();
         if header.scene_fingerprint != expected {
             return Err(StateError::SceneMismatch {
                 found: header.scene_fingerprint,
@@ -540,176 +540,6 @@ fn read_path_tracer(
     Ok(())
 }
 
-/// A 64-bit fingerprint of everything in a scene that affects rendering (camera, film,
-/// materials, triangles, spheres, cylinders, lights), so that a checkpoint is never resumed on
-/// another scene.
-#[must_use]
-pub fn scene_fingerprint(d: &SceneDescription) -> u64 {
-    let mut w = Writer::hashing();
-    let camera = &d.camera;
-    for v in [camera.position, camera.look_at, camera.up] {
-        v.to_array().iter().for_each(|&c| w.f32(c));
-    }
-    [camera.fov_y, camera.aperture_radius, camera.focus_distance]
-        .iter()
-        .for_each(|&c| w.f32(c));
-    w.u32(d.film.width);
-    w.u32(d.film.height);
-    w.u64(d.materials.len() as u64);
-    for m in &d.materials {
-        m.emission.to_array().iter().for_each(|&c| w.f32(c));
-        let (tag, values): (u32, [f32; 7]) = match m.kind {
-            MaterialKind::Diffuse { albedo } => {
-                (0, [albedo.x, albedo.y, albedo.z, 0.0, 0.0, 0.0, 0.0])
-            }
-            MaterialKind::Mirror { reflectance: r } => (1, [r.x, r.y, r.z, 0.0, 0.0, 0.0, 0.0]),
-            MaterialKind::Dielectric { ior } => (2, [ior, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
-            MaterialKind::Glossy {
-                reflectance: r,
-                roughness,
-                diffuse: k,
-            } => (3, [r.x, r.y, r.z, roughness, k.x, k.y, k.z]),
-        };
-        w.u32(tag);
-        values.iter().for_each(|&c| w.f32(c));
-        // Textures: how each is used and which image (file, resolution), not the texels.
-        if let Some(t) = &m.textures {
-            w.str("textures");
-            let mut texture = |name: &str, r: Option<&geometry::texture::TextureRef>| {
-                if let Some(r) = r {
-                    w.str(name);
-                    w.str(&r.image.path().to_string_lossy());
-                    let (width, height) = r.image.resolution();
-                    w.u32(width);
-                    w.u32(height);
-                    w.u32(u32::from(r.srgb));
-                    r.wrap.iter().for_each(|&m| w.u32(m as u32));
-                    r.transform.iter().for_each(|&c| w.f32(c));
-                }
-            };
-            texture("color", t.color.as_ref());
-            texture("emission", t.emission.as_ref());
-            texture("normal", t.normal.as_ref().map(|n| &n.texture));
-            texture("alpha", t.alpha.as_ref().and_then(|a| a.texture.as_ref()));
-            texture(
-                "metallic_roughness",
-                t.metallic_roughness.as_ref().map(|m| &m.texture),
-            );
-            if let Some(n) = &t.normal {
-                w.f32(n.scale);
-            }
-            if let Some(a) = &t.alpha {
-                w.f32(a.factor);
-                match a.mode {
-                    geometry::texture::AlphaMode::Mask { cutoff } => w.f32(cutoff),
-                    geometry::texture::AlphaMode::Blend => w.str("blend"),
-                }
-            }
-            // Only materials with a metallic-roughness texture hash it, so that other
-            // fingerprints stay as they were.
-            if let Some(mr) = &t.metallic_roughness {
-                mr.base.to_array().iter().for_each(|&c| w.f32(c));
-                w.f32(mr.metallic);
-                w.f32(mr.roughness);
-            }
-        }
-    }
-    w.u64(d.triangles.len() as u64);
-    for t in &d.triangles {
-        t.positions
-            .iter()
-            .for_each(|p| p.to_array().iter().for_each(|&c| w.f32(c)));
-        if let Some(normals) = t.normals {
-            normals
-                .iter()
-                .for_each(|n| n.to_array().iter().for_each(|&c| w.f32(c)));
-        }
-        w.u32(t.material);
-        if let Some(uv) = t.uv {
-            uv.iter()
-                .for_each(|v| v.to_array().iter().for_each(|&c| w.f32(c)));
-        }
-        // Only triangles with tangents hash them, so that other fingerprints stay as they were.
-        if let Some(tangents) = t.tangents {
-            w.str("tangents");
-            tangents.iter().flatten().for_each(|&c| w.f32(c));
-        }
-    }
-    w.u64(d.spheres.len() as u64);
-    for s in &d.spheres {
-        s.center.to_array().iter().for_each(|&c| w.f32(c));
-        w.f32(s.radius);
-        w.u32(s.material);
-    }
-    w.u64(d.cylinders.len() as u64);
-    for c in &d.cylinders {
-        [c.center, c.axis, c.facing]
-            .iter()
-            .for_each(|v| v.to_array().iter().for_each(|&x| w.f32(x)));
-        [c.radius, c.height, c.arc].iter().for_each(|&x| w.f32(x));
-        w.u32(c.material);
-    }
-    w.u64(d.lights.len() as u64);
-    for light in &d.lights {
-        match *light {
-            Light::Point {
-                position,
-                intensity,
-            } => {
-                w.u32(0);
-                [position, intensity]
-                    .iter()
-                    .for_each(|v| v.to_array().iter().for_each(|&c| w.f32(c)));
-            }
-            Light::Spot {
-                position,
-                direction,
-                intensity,
-                cone_angle,
-                falloff_start,
-            } => {
-                w.u32(1);
-                [position, direction, intensity]
-                    .iter()
-                    .for_each(|v| v.to_array().iter().for_each(|&c| w.f32(c)));
-                w.f32(cone_angle);
-                w.f32(falloff_start);
-            }
-            Light::Directional {
-                direction,
-                irradiance,
-            } => {
-                w.u32(2);
-                [direction, irradiance]
-                    .iter()
-                    .for_each(|v| v.to_array().iter().for_each(|&c| w.f32(c)));
-            }
-        }
-    }
-    // Only a scene with an environment hashes one, so that the fingerprints of scenes
-    // without stay what they were.
-    if let Some(env) = &d.environment {
-        w.u32(3);
-        w.f32(env.scale);
-        env.to_world.to_cols_array().iter().for_each(|&c| w.f32(c));
-        match &env.radiance {
-            EnvironmentRadiance::Constant(c) => {
-                w.u32(0);
-                c.to_array().iter().for_each(|&c| w.f32(c));
-            }
-            EnvironmentRadiance::Map(map) => {
-                w.u32(1);
-                w.u32(map.width);
-                w.u32(map.height);
-                for t in &map.texels {
-                    t.to_array().iter().for_each(|&c| w.f32(c));
-                }
-            }
-        }
-    }
-    w.hash.unwrap_or(FNV_OFFSET)
-}
-
 pub(crate) const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
 
 pub(crate) fn fnv1a(mut hash: u64, bytes: &[u8]) -> u64 {
@@ -720,26 +550,15 @@ pub(crate) fn fnv1a(mut hash: u64, bytes: &[u8]) -> u64 {
     hash
 }
 
-/// Little-endian encoder that either collects the bytes or only hashes them (the scene
-/// fingerprint of a million triangles need not be held in memory).
+/// Little-endian encoder.
 #[derive(Default)]
 struct Writer {
     out: Vec<u8>,
-    hash: Option<u64>,
 }
 
 impl Writer {
-    fn hashing() -> Self {
-        Self {
-            out: Vec::new(),
-            hash: Some(FNV_OFFSET),
-        }
-    }
     fn bytes(&mut self, b: &[u8]) {
-        match &mut self.hash {
-            Some(hash) => *hash = fnv1a(*hash, b),
-            None => self.out.extend_from_slice(b),
-        }
+        self.out.extend_from_slice(b);
     }
     fn u32(&mut self, v: u32) {
         self.bytes(&v.to_le_bytes());

@@ -4,15 +4,15 @@
 //! threads, from `/proc`): on a shared machine the latter stays close to the idle per-core rate when the
 //! former does not. On an idle machine the two agree for one thread.
 //!
-//! `cargo bench -p geometry` (scenes from `../shared/scenes` beside the checkout, or the paths given as arguments).
+//! `cargo bench -p scene` (scenes from `../shared/scenes` beside the checkout, or the paths given as arguments).
 #![allow(clippy::unwrap_used, clippy::print_stdout, missing_docs)]
 
 mod common;
 
 use std::{path::PathBuf, time::Instant};
 
-use geometry::{Ray, Scene};
 use rayon::prelude::*;
+use scene::{Ray, Scene};
 
 /// CPU time consumed so far by the threads of `pool`, in seconds.
 fn pool_cpu_seconds(pool: &rayon::ThreadPool) -> Option<f64> {

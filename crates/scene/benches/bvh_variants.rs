@@ -1,7 +1,7 @@
 //! Compares obvhs' own layouts and build presets (triangles only, RtTriangle) with ours
 //! (`Scene::intersect` / `Scene::occluded`, i.e. `src/bvh/`) on the same ray sets, single-threaded:
 //! the measurements behind the choice made in `src/bvh/mod.rs`.
-//! `cargo bench -p geometry --bench bvh_variants`.
+//! `cargo bench -p scene --bench bvh_variants`.
 #![allow(clippy::unwrap_used, clippy::print_stdout, missing_docs)]
 
 mod common;
@@ -11,7 +11,6 @@ use std::{
     time::{Duration, Instant},
 };
 
-use geometry::{Ray, Scene};
 use glam::Vec3A;
 use obvhs::{
     BvhBuildParams,
@@ -21,6 +20,7 @@ use obvhs::{
     rt_triangle::RtTriangle,
     triangle::Triangle,
 };
+use scene::{Ray, Scene};
 
 fn time<F: Fn(&BRay) -> bool>(rays: &[BRay], f: F) -> f64 {
     let mut best = f64::INFINITY;

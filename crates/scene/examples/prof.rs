@@ -1,7 +1,7 @@
 //! Runs one kind of ray query many times on one scene, for profilers (callgrind, perf):
 //!
 //! ```text
-//! cargo build --release -p geometry --example prof
+//! cargo build --release -p scene --example prof
 //! valgrind --tool=callgrind target/release/examples/prof <scene> <primary|bounce> <closest|occluded> [repeats]
 //! ```
 //!
@@ -19,7 +19,7 @@ mod common;
 
 use std::{path::Path, time::Instant};
 
-use geometry::{Ray, Scene};
+use scene::{Ray, Scene};
 
 #[inline(never)]
 fn run_queries(scene: &Scene, rays: &[Ray], occluded: bool) -> usize {
@@ -41,9 +41,9 @@ fn checksum(scene: &Scene, rays: &[Ray], occluded: bool) -> u64 {
         } else if let Some(hit) = scene.intersect(r) {
             mix(format!("{:?}", hit.primitive).len() as u64);
             mix(match hit.primitive {
-                geometry::Primitive::Triangle(i)
-                | geometry::Primitive::Sphere(i)
-                | geometry::Primitive::Cylinder(i) => u64::from(i),
+                scene::Primitive::Triangle(i)
+                | scene::Primitive::Sphere(i)
+                | scene::Primitive::Cylinder(i) => u64::from(i),
             });
             mix(u64::from(hit.t.to_bits()));
             mix(u64::from(hit.uv.x.to_bits()) << 32 | u64::from(hit.uv.y.to_bits()));

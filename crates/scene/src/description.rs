@@ -11,6 +11,8 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
+use crate::fingerprint::{Fingerprint, Fingerprinter};
+use crate::material::{MaterialKind, MaterialParam};
 use crate::texture::MaterialTextures;
 
 /// Linear Rec.709 RGB triple.
@@ -72,6 +74,9 @@ pub struct Camera {
     pub focus_distance: f32,
 }
 
+/// Largest film side accepted, in pixels.
+pub const MAX_FILM_SIDE: u32 = 16384;
+
 /// Image resolution in pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Film {
@@ -95,42 +100,11 @@ pub struct Material {
     pub textures: Option<Arc<MaterialTextures>>,
 }
 
-/// The scattering models of scene format version 1.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum MaterialKind {
-    /// Lambertian reflector.
-    Diffuse {
-        /// Albedo in [0, 1] per channel.
-        albedo: Rgb,
-    },
-    /// Perfect specular reflection.
-    Mirror {
-        /// Reflectance per channel.
-        reflectance: Rgb,
-    },
-    /// Smooth dielectric with exact unpolarised Fresnel.
-    Dielectric {
-        /// Index of refraction relative to the outside medium.
-        ior: f32,
-    },
-    /// Rough conductor with a GGX (Trowbridge–Reitz) distribution and Smith shadowing,
-    /// optionally over a Lambertian base (the OBJ `Kd` + `Ks` mapping).
-    Glossy {
-        /// Specular reflectance per channel.
-        reflectance: Rgb,
-        /// GGX α (not squared), > 0.
-        roughness: f32,
-        /// Albedo of the Lambertian base; zero for a pure conductor (the TOML `glossy`).
-        diffuse: Rgb,
-    },
-}
-
 /// One world-space triangle. The front face is where v0, v1, v2 appear counter-clockwise.
 ///
 /// In declaration order (`repr(C)`): what every hit reads (positions, normals, material) is
-/// the first 80 bytes, and the texture data after it is touched only by textured hits. The
-/// compiler's own order had put the normals first and the positions last, 120 bytes apart,
-/// so an untextured hit read three cache lines instead of two (docs/performance.md).
+/// the first 80 bytes, and the texture data after it is touched only by textured hits, so an
+/// untextured hit reads as few cache lines as it can (docs/performance.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct Triangle {
@@ -265,6 +239,193 @@ impl RenderDefaults {
         match self.params.iter_mut().find(|(key, _)| key == name) {
             Some(entry) => entry.1 = value,
             None => self.params.push((name.to_owned(), value)),
+        }
+    }
+}
+
+/// The axis-aligned bounds (min, max) of triangles, spheres and cylinders; `None` if there are
+/// none.
+#[must_use]
+pub fn primitive_bounds(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    cylinders: &[Cylinder],
+) -> Option<(Vec3, Vec3)> {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for p in triangles.iter().flat_map(|t| t.positions) {
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    for s in spheres {
+        lo = lo.min(s.center - Vec3::splat(s.radius));
+        hi = hi.max(s.center + Vec3::splat(s.radius));
+    }
+    for c in cylinders {
+        let b = c.bounds();
+        lo = lo.min(b.min);
+        hi = hi.max(b.max);
+    }
+    (lo.cmple(hi).all()).then_some((lo, hi))
+}
+
+impl SceneDescription {
+    /// A stable 64-bit fingerprint of everything in the scene that affects rendering (camera,
+    /// film, materials with their textures, triangles, spheres, cylinders, lights, environment;
+    /// not the file name, the `[render]` defaults or the loader's notes), so that a checkpoint
+    /// is never resumed on another scene. Textures count by file, size and use, not by texel;
+    /// an environment map by its texels.
+    #[must_use]
+    pub fn fingerprint(&self) -> u64 {
+        let mut h = Fingerprinter::new();
+        h.add(&self.camera);
+        h.add(&self.film);
+        h.list(&self.materials);
+        h.list(&self.triangles);
+        h.list(&self.spheres);
+        h.list(&self.cylinders);
+        h.list(&self.lights);
+        match &self.environment {
+            None => h.u32(0),
+            Some(env) => {
+                h.u32(1);
+                h.add(env);
+            }
+        }
+        h.finish()
+    }
+}
+
+impl Fingerprint for Camera {
+    fn fingerprint(&self, h: &mut Fingerprinter) {
+        [self.position, self.look_at, self.up]
+            .iter()
+            .for_each(|&v| h.vec3(v));
+        [self.fov_y, self.aperture_radius, self.focus_distance]
+            .iter()
+            .for_each(|&x| h.f32(x));
+    }
+}
+
+impl Fingerprint for Film {
+    fn fingerprint(&self, h: &mut Fingerprinter) {
+        h.u32(self.width);
+        h.u32(self.height);
+    }
+}
+
+impl Fingerprint for Material {
+    /// The model by name and parameters, the emission and the textures (the name in the file
+    /// does not count).
+    fn fingerprint(&self, h: &mut Fingerprinter) {
+        h.vec3(self.emission);
+        h.add(&self.kind);
+        match &self.textures {
+            None => h.u32(0),
+            Some(t) => {
+                h.u32(1);
+                h.add(&**t);
+            }
+        }
+    }
+}
+
+impl Fingerprint for MaterialKind {
+    fn fingerprint(&self, h: &mut Fingerprinter) {
+        h.str(self.name());
+        for param in self.params() {
+            match param {
+                MaterialParam::Colour(name, c) => {
+                    h.str(name);
+                    h.vec3(c);
+                }
+                MaterialParam::Positive(name, x) => {
+                    h.str(name);
+                    h.f32(x);
+                }
+            }
+        }
+    }
+}
+
+impl Fingerprint for Triangle {
+    fn fingerprint(&self, h: &mut Fingerprinter) {
+        self.positions.iter().for_each(|&p| h.vec3(p));
+        h.u32(self.material);
+        match self.normals {
+            None => h.u32(0),
+            Some(normals) => {
+                h.u32(1);
+                normals.iter().for_each(|&n| h.vec3(n));
+            }
+        }
+        match self.uv {
+            None => h.u32(0),
+            Some(uv) => {
+                h.u32(1);
+                uv.iter().for_each(|&v| h.vec2(v));
+            }
+        }
+        match self.tangents {
+            None => h.u32(0),
+            Some(tangents) => {
+                h.u32(1);
+                tangents.iter().flatten().for_each(|&c| h.f32(c));
+            }
+        }
+    }
+}
+
+impl Fingerprint for Sphere {
+    fn fingerprint(&self, h: &mut Fingerprinter) {
+        h.vec3(self.center);
+        h.f32(self.radius);
+        h.u32(self.material);
+    }
+}
+
+impl Fingerprint for Cylinder {
+    fn fingerprint(&self, h: &mut Fingerprinter) {
+        [self.center, self.axis, self.facing]
+            .iter()
+            .for_each(|&v| h.vec3(v));
+        [self.radius, self.height, self.arc]
+            .iter()
+            .for_each(|&x| h.f32(x));
+        h.u32(self.material);
+    }
+}
+
+impl Fingerprint for Light {
+    fn fingerprint(&self, h: &mut Fingerprinter) {
+        match *self {
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                h.str("point");
+                [position, intensity].iter().for_each(|&v| h.vec3(v));
+            }
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                cone_angle,
+                falloff_start,
+            } => {
+                h.str("spot");
+                [position, direction, intensity]
+                    .iter()
+                    .for_each(|&v| h.vec3(v));
+                [cone_angle, falloff_start].iter().for_each(|&x| h.f32(x));
+            }
+            Light::Directional {
+                direction,
+                irradiance,
+            } => {
+                h.str("directional");
+                [direction, irradiance].iter().for_each(|&v| h.vec3(v));
+            }
         }
     }
 }

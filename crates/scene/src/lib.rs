@@ -1,4 +1,4 @@
-//! Scenes, loaders, materials, lights, camera and BVH.
+//! The scene runtime: scene descriptions, materials, lights, textures, camera and BVH.
 //!
 //! The principal type is [`Scene`], built from a plain [`SceneDescription`] by [`Scene::new`].
 //! It answers closest-hit ([`Scene::intersect`]) and shadow ([`Scene::occluded`], [`Scene::visible`])
@@ -23,40 +23,21 @@
 //! obvhs builds the BVH; the crate collapses it into its own 8-wide SIMD layout for traversal
 //! (see `bvh/mod.rs`), which is exact: it never culls a primitive the ray meets.
 //!
-//! The loaders turn a scene file into a plain [`SceneDescription`]:
-//! [`load()`] picks the loader by extension (`.toml` scene files of format version 1, lone
-//! `.obj` files with their `.mtl`, `.gltf`/`.glb` files, Mitsuba 3 `.xml` and pbrt-v4 `.pbrt`
-//! scenes, whose mapping is in `docs/scene-import.md`), [`load_toml_str`] reads a TOML scene
-//! held in memory, [`load_from`] reads a scene and the files it refers to from a [`FileSource`]
-//! (e.g. [`MemoryFiles`]) instead of the file system, and [`load_with`] takes [`LoadOptions`] (e.g. to accept a scene without
-//! emitters for `fppm info`). Every failure is a [`LoadError`] naming the file.
-//! [`SceneDescription::summary`] gives a [`SceneSummary`] for reports and snapshots.
-//!
-//! What the loaders decide where the scene format (`shared/design/scene-format.md`) is silent:
-//! - no camera (lone OBJ, glTF without a perspective camera, TOML without `[camera]`): a
-//!   pinhole on the +Z side of the bounding box looking down −Z at its centre, up +Y,
-//!   [`FRAMED_FOV_Y_DEGREES`], far enough that the box's front face fills the image with a 5 %
-//!   margin ([`LoadNotes::camera_framed`] is set);
-//! - film [`DEFAULT_FILM_WIDTH`] × [`DEFAULT_FILM_HEIGHT`] unless given; a glTF camera's aspect
-//!   ratio sets the height; sides at most [`MAX_FILM_SIDE`];
-//! - OBJ faces without a (loadable) material get a diffuse material of albedo
-//!   [`DEFAULT_ALBEDO`]; a missing MTL file is a warning, a malformed one an error; `Ka` is
-//!   never emission (a warning says so when it looks like it was meant to be);
-//! - glTF materials with metallic ≥ [`METALLIC_THRESHOLD`] are conductors (mirror below
-//!   roughness 0.01, else glossy with α = roughness²);
-//! - zero-area triangles are skipped and counted in [`LoadNotes::degenerate_triangles`];
-//!   an emissive material left with no area is an error ([`LoadError::ZeroAreaEmitter`]).
+//! This crate is the scene runtime only: it reads no file. The `import` crate turns scene files
+//! (TOML, OBJ, glTF, Mitsuba 3, pbrt-v4) into a [`SceneDescription`], decoding the images they
+//! refer to into [`texture::Image`]s and [`EnvironmentMap`]s; a description built in code is
+//! just as good. What makes a description valid is checked in [`validate`], by the importers
+//! and by [`Scene::new`]. [`SceneDescription::summary`] gives a [`SceneSummary`] for reports
+//! and snapshots.
 
 mod aabb;
-mod bsdf;
 mod bvh;
 mod camera;
 mod description;
-mod error;
+pub mod fingerprint;
 mod frame;
-mod guard;
 mod light;
-mod load;
+mod material;
 mod ray;
 mod sampling;
 mod scene;
@@ -64,26 +45,22 @@ mod summary;
 #[cfg(test)]
 mod test_util;
 pub mod texture;
-mod validate;
+pub mod validate;
 
 pub use aabb::Aabb;
-pub use bsdf::{Bsdf, BsdfSample, Lobe, TransportMode, fresnel_dielectric};
 pub use camera::{CameraModel, LensConnection};
 pub use description::{
-    Camera, Cylinder, Film, Light, LoadNotes, Material, MaterialKind, RenderDefaults, Rgb,
-    SceneDescription, Sphere, Triangle,
+    Camera, Cylinder, Film, Light, LoadNotes, MAX_FILM_SIDE, Material, RenderDefaults, Rgb,
+    SceneDescription, Sphere, Triangle, primitive_bounds,
 };
-pub use error::LoadError;
 pub use frame::Frame;
-pub use guard::containing_a_panic;
 pub use light::{
     EmissionSample, EmitterShape, Environment, EnvironmentMap, EnvironmentRadiance, LightSample,
     LightSampler,
 };
-pub use load::{
-    DEFAULT_ALBEDO, DEFAULT_FILM_HEIGHT, DEFAULT_FILM_WIDTH, FRAMED_FOV_Y_DEGREES, FileSource,
-    LoadOptions, MAX_FILM_SIDE, METALLIC_THRESHOLD, MemoryFiles, load, load_from, load_toml_str,
-    load_toml_str_with, load_with,
+pub use material::{
+    Bsdf, BsdfSample, Dielectric, Diffuse, Glossy, Lobe, MaterialKind, MaterialParam, Mirror,
+    TransportMode, fresnel_dielectric, luminance,
 };
 pub use ray::{Hit, Primitive, Ray};
 pub use scene::{Scene, SceneError};

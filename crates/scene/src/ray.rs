@@ -150,8 +150,7 @@ pub(crate) fn offset_ray_origin(p: Vec3, error: Vec3, n: Vec3, w: Vec3) -> Vec3 
 /// Per component: `v.next_up()` where `o > 0`, `v.next_down()` where `o < 0`, else `v`; bit for
 /// bit, but without branches, which matters because the sign of `o` (an offset along a normal,
 /// toward a random direction) is unpredictable, and a zero `o` is common (axis-aligned walls).
-/// With `f32::next_up`/`next_down` behind branches, one offset origin cost about 1.1
-/// mispredicted branches (callgrind's branch simulator, photon paths of the `passes` bench).
+/// `f32::next_up`/`next_down` behind branches mispredict often (docs/performance.md).
 ///
 /// It uses next_down(v) = −next_up(−v): flipping the sign bit of `v` by that of `o` turns both
 /// directions into a `next_up` of `x`. That is the next bit pattern away from zero for x ≥ +0,

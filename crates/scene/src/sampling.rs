@@ -11,8 +11,8 @@ use glam::{Vec2, Vec3, Vec4};
 /// of q = π/4 · (other / r). So both wedges need sin q and cos q for |q| ≤ π/4 only, which
 /// [`sin_cos_quarter`] gives without range reduction, and the wedge only chooses which is which.
 /// Computed on vectors, so that the compiler blends rather than branches (the wedge is a coin
-/// toss per sample); with libm's `sincosf`, which branches on the range of θ, a diffuse bounce
-/// cost ~45 more instructions and half a misprediction.
+/// toss per sample), and without libm's `sincosf`, which branches on the range of θ
+/// (docs/performance.md).
 #[inline]
 pub(crate) fn concentric_disk(u: Vec2) -> Vec2 {
     let o = 2.0 * u - Vec2::ONE;

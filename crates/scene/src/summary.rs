@@ -5,7 +5,8 @@ use std::fmt;
 use glam::Vec3;
 use serde::{Serialize, Serializer};
 
-use crate::description::{Light, MaterialKind, SceneDescription};
+use crate::MaterialParam;
+use crate::description::{Light, SceneDescription};
 
 /// Counts and parameters of a [`SceneDescription`], for display and snapshots.
 ///
@@ -191,27 +192,23 @@ impl SceneDescription {
             .materials
             .iter()
             .map(|m| {
-                let (kind, albedo, reflectance, ior, roughness) = match m.kind {
-                    MaterialKind::Diffuse { albedo } => ("diffuse", Some(albedo), None, None, None),
-                    MaterialKind::Mirror { reflectance } => {
-                        ("mirror", None, Some(reflectance), None, None)
+                let (mut albedo, mut reflectance, mut ior, mut roughness) =
+                    (None, None, None, None);
+                for param in m.kind.params() {
+                    match param {
+                        MaterialParam::Colour("albedo", c) => albedo = Some(c),
+                        // A Lambertian base under another lobe shows as the albedo where it
+                        // reflects anything.
+                        MaterialParam::Colour("diffuse", c) if c != Vec3::ZERO => albedo = Some(c),
+                        MaterialParam::Colour("reflectance", c) => reflectance = Some(c),
+                        MaterialParam::Positive("ior", x) => ior = Some(x),
+                        MaterialParam::Positive("roughness", x) => roughness = Some(x),
+                        _ => {}
                     }
-                    MaterialKind::Dielectric { ior } => ("dielectric", None, None, Some(ior), None),
-                    MaterialKind::Glossy {
-                        reflectance,
-                        roughness,
-                        diffuse,
-                    } => (
-                        "glossy",
-                        (diffuse != Vec3::ZERO).then_some(diffuse),
-                        Some(reflectance),
-                        None,
-                        Some(roughness),
-                    ),
-                };
+                }
                 MaterialSummary {
                     name: m.name.clone(),
-                    kind,
+                    kind: m.kind.name(),
                     albedo,
                     reflectance,
                     ior,
@@ -276,7 +273,7 @@ impl SceneDescription {
                 focus_distance: c.focus_distance,
             },
             film: [self.film.width, self.film.height],
-            bounds: crate::load::bounds(&self.triangles, &self.spheres, &self.cylinders)
+            bounds: crate::primitive_bounds(&self.triangles, &self.spheres, &self.cylinders)
                 .map(|(min, max)| Bounds { min, max }),
             degenerate_triangles: self.notes.degenerate_triangles,
             camera_framed: self.notes.camera_framed,

@@ -50,9 +50,9 @@ impl Rng {
 pub(crate) fn diffuse(albedo: f32, emission: Vec3) -> Material {
     Material {
         name: "m".into(),
-        kind: MaterialKind::Diffuse {
+        kind: MaterialKind::Diffuse(crate::Diffuse {
             albedo: Vec3::splat(albedo),
-        },
+        }),
         emission,
         textures: None,
     }

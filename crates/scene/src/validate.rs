@@ -1,9 +1,9 @@
-//! What makes a scene description valid, checked in one place: by every loader when it
-//! finishes (`load::finish`, which reports a [`LoadError`] naming the file) and by
-//! `Scene::new` for descriptions built in code (a [`SceneError`]). What follows from these
+//! What makes a scene description valid, checked in one place: by every importer when it
+//! finishes (which reports the [`Invalid`] as an error naming the file) and by `Scene::new` for
+//! descriptions built in code (a [`SceneError`]). What follows from these
 //! checks (finite positions, unit directions, non-negative colours, material indices in range)
 //! is what the rest of the crate relies on: the BVH build cannot fail, and `LightSampler::new`
-//! takes the [`Powered`] emitters that only [`emitters`] makes, so it cannot fail either.
+//! takes the `Powered` emitters that only `emitters` makes, so it cannot fail either.
 
 use std::f32::consts::PI;
 use std::fmt;
@@ -11,22 +11,32 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use crate::description::{Cylinder, Light, Material, MaterialKind, SceneDescription};
+use crate::MaterialParam;
+use crate::SceneError;
+use crate::description::{Cylinder, Light, Material, SceneDescription};
 use crate::light::Emitters;
 use crate::sampling::Distribution1D;
 use crate::{Environment, EnvironmentRadiance};
-use crate::{LoadError, SceneError};
 
-/// One problem of a scene description.
+/// One problem of a scene description; the importers turn it into an error naming the file,
+/// `Scene::new` into a [`SceneError`].
 #[derive(Clone, Debug, PartialEq)]
-pub(crate) enum Invalid {
-    /// A value outside its domain: `key` names it as the scene does (`material "lamp"
-    /// emission`), `message` says what is wrong (`must be finite, got [inf, 0, 0]`).
-    Value { key: String, message: String },
+#[non_exhaustive]
+pub enum Invalid {
+    /// A value outside its domain.
+    Value {
+        /// The value as the scene names it (`material "lamp" emission`).
+        key: String,
+        /// What is wrong (`must be finite, got [inf, 0, 0]`).
+        message: String,
+    },
     /// A primitive refers to a material that does not exist.
     MaterialIndex {
+        /// The primitive, e.g. `triangle 12`.
         what: String,
+        /// The material index it gives.
         index: u32,
+        /// Number of materials.
         count: usize,
     },
     /// No light and no emitter has positive power (or every emitter has zero area).
@@ -54,25 +64,6 @@ impl Invalid {
         Self::Value {
             key: key.into(),
             message: message.into(),
-        }
-    }
-
-    /// The loader's error for this problem in the file `path`.
-    pub(crate) fn in_file(self, path: &Path) -> LoadError {
-        let message = self.to_string();
-        let (key, message) = match self {
-            Self::Value { key, message } => (key, message),
-            Self::MaterialIndex { what, .. } => (what, message),
-            Self::NoPower => {
-                return LoadError::NoEmitter {
-                    path: path.to_path_buf(),
-                };
-            }
-        };
-        LoadError::InvalidValue {
-            path: path.to_path_buf(),
-            key,
-            message,
         }
     }
 
@@ -127,12 +118,12 @@ pub(crate) fn emitters(emitters: Emitters) -> Result<Powered, Invalid> {
 }
 
 /// Formats a vector as `[x, y, z]`.
-pub(crate) fn fmt_vec(v: Vec3) -> String {
+pub fn fmt_vec(v: Vec3) -> String {
     format!("[{}, {}, {}]", v.x, v.y, v.z)
 }
 
 /// A colour (radiance, albedo, intensity): finite and non-negative.
-pub(crate) fn colour(key: &str, c: Vec3) -> Result<(), Invalid> {
+pub fn colour(key: &str, c: Vec3) -> Result<(), Invalid> {
     if !c.is_finite() {
         return Err(Invalid::value(
             key,
@@ -186,24 +177,17 @@ fn direction(key: String, v: Vec3) -> Result<(), Invalid> {
 pub(crate) fn material(m: &Material) -> Result<(), Invalid> {
     let key = |what: &str| format!("material {:?} {what}", m.name);
     colour(&key("emission"), m.emission)?;
-    match m.kind {
-        MaterialKind::Diffuse { albedo } => colour(&key("albedo"), albedo),
-        MaterialKind::Mirror { reflectance } => colour(&key("reflectance"), reflectance),
-        MaterialKind::Dielectric { ior } => positive(key("ior"), ior),
-        MaterialKind::Glossy {
-            reflectance,
-            roughness,
-            diffuse,
-        } => {
-            colour(&key("reflectance"), reflectance)?;
-            colour(&key("diffuse"), diffuse)?;
-            positive(key("roughness"), roughness)
+    for param in m.kind.params() {
+        match param {
+            MaterialParam::Colour(name, c) => colour(&key(name), c)?,
+            MaterialParam::Positive(name, x) => positive(key(name), x)?,
         }
     }
+    Ok(())
 }
 
 /// The colour that says how strong a light is (intensity or irradiance).
-pub(crate) fn light_power(light: &Light) -> Vec3 {
+pub fn light_power(light: &Light) -> Vec3 {
     match *light {
         Light::Point { intensity, .. } | Light::Spot { intensity, .. } => intensity,
         Light::Directional { irradiance, .. } => irradiance,
@@ -302,7 +286,7 @@ fn cylinder(i: usize, c: &Cylinder, materials: &[Material]) -> Result<(), Invali
 }
 
 /// Every check of a description: [`materials_and_lights`], then [`primitives`].
-pub(crate) fn description(d: &SceneDescription) -> Result<(), Invalid> {
+pub fn description(d: &SceneDescription) -> Result<(), Invalid> {
     materials_and_lights(&d.materials, &d.lights)?;
     if let Some(env) = &d.environment {
         environment(env)?;
@@ -313,7 +297,7 @@ pub(crate) fn description(d: &SceneDescription) -> Result<(), Invalid> {
 /// The environment light: a finite non-negative scale and rotation, a finite non-negative
 /// constant radiance, or a map of the size its texels say (finite, non-negative texels are
 /// checked when it is read, `EnvironmentMap::load`).
-pub(crate) fn environment(env: &Environment) -> Result<(), Invalid> {
+pub fn environment(env: &Environment) -> Result<(), Invalid> {
     if !(env.scale.is_finite() && env.scale >= 0.0) {
         return Err(Invalid::value(
             "environment scale",
@@ -363,10 +347,7 @@ pub(crate) fn environment(env: &Environment) -> Result<(), Invalid> {
 }
 
 /// Every material and light.
-pub(crate) fn materials_and_lights(
-    materials: &[Material],
-    lights: &[Light],
-) -> Result<(), Invalid> {
+pub fn materials_and_lights(materials: &[Material], lights: &[Light]) -> Result<(), Invalid> {
     for m in materials {
         material(m)?;
     }
@@ -377,7 +358,7 @@ pub(crate) fn materials_and_lights(
 }
 
 /// Each primitive's material index and geometry.
-pub(crate) fn primitives(d: &SceneDescription) -> Result<(), Invalid> {
+pub fn primitives(d: &SceneDescription) -> Result<(), Invalid> {
     let count = d.materials.len();
     let index = |what: String, index: u32| {
         if (index as usize) < count {

@@ -17,7 +17,7 @@ pub(super) struct Masks {
 ///
 /// Pixels that see no surface or an emitter (or neighbour one, see
 /// [`suite::transport_mask`]) belong to no mask.
-pub(super) fn build_masks(scene: &geometry::Scene, reference: &Image) -> Masks {
+pub(super) fn build_masks(scene: &scene::Scene, reference: &Image) -> Masks {
     let (w, h) = (reference.width, reference.height);
     let lum: Vec<f64> = reference
         .pixels
@@ -43,7 +43,7 @@ pub(super) fn build_masks(scene: &geometry::Scene, reference: &Image) -> Masks {
                 continue;
             }
             match material.kind {
-                geometry::MaterialKind::Diffuse { .. } => {
+                scene::MaterialKind::Diffuse(_) => {
                     let (mut sum, mut n) = (0.0, 0.0);
                     for yy in y.saturating_sub(2)..(y + 3).min(h) {
                         for xx in x.saturating_sub(2)..(x + 3).min(w) {

@@ -257,7 +257,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
 
 fn base_params(
     entry: &SuiteScene,
-    scene: &geometry::Scene,
+    scene: &scene::Scene,
     method: ppm::Method,
     flags: &Flags,
 ) -> Result<ppm::RenderParams> {
@@ -270,4 +270,41 @@ fn base_params(
     }
     flags.overrides.apply(&mut params)?;
     Ok(params)
+}
+
+#[cfg(test)]
+mod tests {
+    /// The README's `cargo xtask converge --scene cornell-original`, with every method of the
+    /// default list and budgets short enough for the test suite: it renders, plots and writes
+    /// its table.
+    #[test]
+    fn the_readme_command_runs_end_to_end_with_short_budgets() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let out = std::env::temp_dir().join(format!("fppm-converge-test-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&out);
+        let args: Vec<String> = [
+            "--scene",
+            "cornell-original",
+            "--budgets",
+            "0.01,0.02",
+            "--photons",
+            "2000",
+            "--out",
+        ]
+        .iter()
+        .map(|s| (*s).to_owned())
+        .chain([out.display().to_string()])
+        .collect();
+        assert!(super::run(&root, &args).unwrap());
+        let csv = std::fs::read_to_string(out.join("cornell-original.csv")).unwrap();
+        for method in ppm::Method::ALL {
+            assert!(
+                csv.lines()
+                    .any(|l| l.split(',').any(|f| f == method.name())),
+                "no row of {method} in\n{csv}"
+            );
+        }
+        assert!(out.join("cornell-original-time.svg").exists());
+        std::fs::remove_dir_all(&out).unwrap();
+    }
 }

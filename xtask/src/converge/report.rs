@@ -2,14 +2,18 @@
 
 use super::*;
 
-/// Line colours of the plots, per method in `ppm::Method::ALL` order.
-pub(super) const COLOURS: [(u8, u8, u8); 5] = [
-    (31, 119, 180),
-    (255, 127, 14),
-    (44, 160, 44),
-    (214, 39, 40),
-    (100, 100, 100),
-];
+/// The line colour of `method` in the plots: a match, so that a new method cannot be left
+/// without one.
+pub(super) fn colour(method: ppm::Method) -> (u8, u8, u8) {
+    match method {
+        ppm::Method::Ppm => (31, 119, 180),
+        ppm::Method::Sppm => (255, 127, 14),
+        ppm::Method::FreqPpm => (44, 160, 44),
+        ppm::Method::FreqSppm => (214, 39, 40),
+        ppm::Method::Appm => (148, 103, 189),
+        ppm::Method::Path => (100, 100, 100),
+    }
+}
 
 /// One snapshot of one method.
 pub(super) struct Row {
@@ -216,7 +220,7 @@ pub(super) fn plot(
         "relMSE (log scale)".into(),
     ));
     for (i, m) in methods.iter().copied().enumerate() {
-        let (r, g, b) = COLOURS[ppm::Method::ALL.iter().position(|x| *x == m).unwrap_or(0)];
+        let (r, g, b) = colour(m);
         let (lx, ly) = chart.backend_coord(&(x1, y1));
         texts.push((
             lx - 8,

@@ -4,7 +4,7 @@ use super::*;
 
 /// One-at-a-time parameter sweep at one budget.
 pub(super) fn sweep(
-    scene: &geometry::Scene,
+    scene: &scene::Scene,
     entry: &SuiteScene,
     reference: &Image,
     masks: &Masks,

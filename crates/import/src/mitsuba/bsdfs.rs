@@ -140,7 +140,7 @@ impl<'a> Importer<'a> {
                     .textured_colour(node, "reflectance", refl)?
                     .unwrap_or((Rgb::splat(DEFAULT_REFLECTANCE), None));
                 textures.color = texture;
-                MaterialKind::Diffuse { albedo }
+                MaterialKind::Diffuse(scene::Diffuse { albedo })
             }
             "twosided" => {
                 let inner = self.inner_bsdf(node)?;
@@ -175,13 +175,13 @@ impl<'a> Importer<'a> {
                     0.0
                 };
                 if alpha <= MIRROR_ALPHA {
-                    MaterialKind::Mirror { reflectance }
+                    MaterialKind::Mirror(scene::Mirror { reflectance })
                 } else {
-                    MaterialKind::Glossy {
+                    MaterialKind::Glossy(scene::Glossy {
                         reflectance,
                         roughness: alpha,
                         diffuse: Rgb::ZERO,
-                    }
+                    })
                 }
             }
             "dielectric" | "thindielectric" | "roughdielectric" => {
@@ -202,7 +202,7 @@ impl<'a> Importer<'a> {
                         "{label}: specular_reflectance/transmittance are ignored (fppm's dielectric is clear)"
                     ));
                 }
-                MaterialKind::Dielectric { ior: int / ext }
+                MaterialKind::Dielectric(scene::Dielectric { ior: int / ext })
             }
             "plastic" | "roughplastic" => {
                 let int = self.ior(node, "int_ior", 1.49)?;
@@ -231,7 +231,7 @@ impl<'a> Importer<'a> {
                      reflectance {f0:.4} = Fresnel at normal incidence, diffuse scaled by {:.4})",
                     1.0 - f0
                 ));
-                MaterialKind::Glossy {
+                MaterialKind::Glossy(scene::Glossy {
                     reflectance: specular * f0,
                     roughness: if alpha > 0.0 {
                         alpha
@@ -239,7 +239,7 @@ impl<'a> Importer<'a> {
                         SMOOTH_COAT_ALPHA
                     },
                     diffuse: diffuse * (1.0 - f0),
-                }
+                })
             }
             "principled" => {
                 let base = self
@@ -248,7 +248,7 @@ impl<'a> Importer<'a> {
                 self.builder.warn(format!(
                     "{label}: the principled BSDF is approximated by a diffuse one of its base_color"
                 ));
-                MaterialKind::Diffuse { albedo: base }
+                MaterialKind::Diffuse(scene::Diffuse { albedo: base })
             }
             "null" => {
                 self.builder.warn(format!(
@@ -262,7 +262,7 @@ impl<'a> Importer<'a> {
                     "{label}: the {other} BSDF is not supported; a diffuse grey {} stands in (material {name:?})",
                     super::super::fmt_vec(grey)
                 ));
-                MaterialKind::Diffuse { albedo: grey }
+                MaterialKind::Diffuse(scene::Diffuse { albedo: grey })
             }
         }))
     }

@@ -55,19 +55,19 @@ impl<'a> Importer<'a> {
             }
             "constant" => {
                 let radiance = self.colour(node, "radiance", em)?.unwrap_or(Rgb::ONE);
-                let env = crate::Environment {
-                    radiance: crate::EnvironmentRadiance::Constant(radiance),
+                let env = scene::Environment {
+                    radiance: scene::EnvironmentRadiance::Constant(radiance),
                     scale: 1.0,
                     to_world: glam::Mat3::IDENTITY,
                 };
-                import::set_environment(&mut self.builder, &label, env);
+                builder::set_environment(&mut self.builder, &label, env);
             }
             "envmap" => {
                 let Some(file) = self.string(node, "filename")? else {
                     return Err(self.err(node, "an envmap needs a filename"));
                 };
                 let path = self.doc.resolve(node, file);
-                let (mut env, negative) = crate::Environment::from_file(&path)?;
+                let (mut env, negative) = crate::environment_from_file(&path)?;
                 if negative > 0 {
                     self.builder.warn(format!(
                         "{label}: {negative} negative texels of {} read as 0",
@@ -75,12 +75,12 @@ impl<'a> Importer<'a> {
                     ));
                 }
                 env.scale = self.float(node, "scale")?.unwrap_or(1.0) as f32;
-                env.to_world = import::rotation_part(to_world)
+                env.to_world = builder::rotation_part(to_world)
                     .ok_or_else(|| self.err(node, "to_world must be a rotation for an envmap"))?;
-                import::set_environment(&mut self.builder, &label, env);
+                builder::set_environment(&mut self.builder, &label, env);
             }
             "sunsky" | "sky" | "sun" => {
-                import::environment_light_standin(&mut self.builder, &label);
+                builder::environment_light_standin(&mut self.builder, &label);
             }
             other => {
                 return Err(self.err(node, format!("emitter type \"{other}\" is not supported")));

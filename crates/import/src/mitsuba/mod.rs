@@ -11,7 +11,7 @@
 //! - `bitmap` textures of a diffuse reflectance, a plastic's diffuse reflectance and a `mask`'s
 //!   opacity become image textures (`textures.rs`); other textured colours stand in as a
 //!   constant (`Importer::texture_standin`); environment emitters that fppm cannot render are
-//!   skipped with a warning ([`super::import::environment_light_standin`]);
+//!   skipped with a warning ([`super::builder::environment_light_standin`]);
 //! - the integrator's `max_depth` (longest path in segments, Mitsuba's convention) becomes
 //!   fppm's `max_depth` (scattering events) minus one; its `rr_depth` is carried as is.
 
@@ -31,13 +31,11 @@ use glam::{DMat4, DVec3};
 
 use self::xml::{Document, Node};
 use super::LoadOptions;
-use super::import::{self, Builder, IndexedMesh};
+use super::builder::{self, Builder, IndexedMesh};
 use super::spectrum::{self, SpectrumUse};
-use crate::description::{
-    Camera, Film, Light, Material, MaterialKind, RenderDefaults, Rgb, SceneDescription,
-};
 use crate::error::LoadError;
-use crate::texture::MaterialTextures;
+use scene::texture::MaterialTextures;
+use scene::{Camera, Film, Light, Material, MaterialKind, RenderDefaults, Rgb, SceneDescription};
 
 /// Reflectance of Mitsuba's default BSDF (a shape without one) and of `diffuse` without one.
 const DEFAULT_REFLECTANCE: f32 = 0.5;
@@ -60,7 +58,7 @@ pub(crate) fn load_mitsuba(
         ids,
         builder: Builder::default(),
         bsdf_cache: HashMap::new(),
-        images: crate::texture::TextureCache::default(),
+        images: crate::image_file::TextureCache::default(),
     };
     let mut camera = None;
     let mut film = DEFAULT_FILM;
@@ -126,7 +124,7 @@ struct ConvertedBsdf {
     name: String,
     kind: Option<MaterialKind>,
     /// Its image textures (diffuse colour, cut-out), if any.
-    textures: Option<std::sync::Arc<crate::texture::MaterialTextures>>,
+    textures: Option<std::sync::Arc<scene::texture::MaterialTextures>>,
 }
 
 struct Importer<'a> {
@@ -136,7 +134,7 @@ struct Importer<'a> {
     /// BSDFs by node address, so that shared BSDFs convert (and warn) once.
     bsdf_cache: HashMap<usize, ConvertedBsdf>,
     /// The images of the scene's bitmaps, each decoded once.
-    images: crate::texture::TextureCache,
+    images: crate::image_file::TextureCache,
 }
 
 /// The property child named `name`.

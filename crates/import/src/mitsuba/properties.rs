@@ -212,7 +212,7 @@ impl<'a> Importer<'a> {
                     .string(tex, "filename")?
                     .ok_or_else(|| self.err(tex, "bitmap needs a filename"))?;
                 let path = self.doc.resolve(tex, file);
-                let (rgb, what) = import::image_texture_standin(&path)
+                let (rgb, what) = builder::image_texture_standin(&path)
                     .map_err(|e| self.err(tex, e.to_string()))?;
                 self.builder.warn(format!(
                     "{label} ({file}): this property cannot be textured in fppm; {what} {} stands in",
@@ -235,7 +235,7 @@ impl<'a> Importer<'a> {
                 Ok(rgb)
             }
             _ => {
-                let rgb = Rgb::splat(import::TEXTURE_STANDIN_GREY);
+                let rgb = Rgb::splat(builder::TEXTURE_STANDIN_GREY);
                 self.builder.warn(format!(
                     "{label}: this texture is not supported; grey {} stands in",
                     super::super::fmt_vec(rgb)

@@ -71,9 +71,9 @@ impl<'a> Importer<'a> {
             Some(b) => self.bsdf(b)?,
             None => ConvertedBsdf {
                 name: "default".to_owned(),
-                kind: Some(MaterialKind::Diffuse {
+                kind: Some(MaterialKind::Diffuse(scene::Diffuse {
                     albedo: Rgb::splat(DEFAULT_REFLECTANCE),
-                }),
+                })),
                 textures: None,
             },
         };
@@ -172,7 +172,7 @@ impl<'a> Importer<'a> {
             "disk" => {
                 self.builder.warn(format!(
                     "{label}: the disk is tessellated into {} triangles",
-                    import::DISK_SEGMENTS
+                    builder::DISK_SEGMENTS
                 ));
                 IndexedMesh::disk()
             }
@@ -204,7 +204,7 @@ impl<'a> Importer<'a> {
                         .warn(format!("{label}: flip_normals is ignored on a cylinder"));
                 }
                 let emissive = emission_of(&self.builder, material);
-                import::cylinder(&mut self.builder, p0, p1, radius, m, material, emissive);
+                builder::cylinder(&mut self.builder, p0, p1, radius, m, material, emissive);
                 return Ok(());
             }
             other => {

@@ -14,7 +14,7 @@
 //!   otherwise: fppm's stochastic cut-out.
 
 use super::*;
-use crate::texture::{Alpha, AlphaMode, TextureRef, Wrap};
+use scene::texture::{Alpha, AlphaMode, TextureRef, Wrap};
 
 /// A colour that may be an image: the constant factor and the texture it multiplies.
 pub(super) type Textured = (Rgb, Option<TextureRef>);

@@ -51,7 +51,7 @@ impl Parser {
         };
         type Converted = Option<(
             MaterialKind,
-            Option<std::sync::Arc<crate::texture::MaterialTextures>>,
+            Option<std::sync::Arc<scene::texture::MaterialTextures>>,
         )>;
         let mut material_cache: HashMap<String, Converted> = HashMap::new();
         let shapes = std::mem::take(&mut self.shapes);
@@ -82,7 +82,7 @@ impl Parser {
                             let mut color = None;
                             self.material(def, &label, &mut color)?.map(|kind| {
                                 let textures = color.map(|c| {
-                                    std::sync::Arc::new(crate::texture::MaterialTextures {
+                                    std::sync::Arc::new(scene::texture::MaterialTextures {
                                         color: Some(c),
                                         ..Default::default()
                                     })
@@ -91,9 +91,9 @@ impl Parser {
                             })
                         }
                         None => Some((
-                            MaterialKind::Diffuse {
+                            MaterialKind::Diffuse(scene::Diffuse {
                                 albedo: Rgb::splat(0.5),
-                            },
+                            }),
                             None,
                         )),
                     };
@@ -213,13 +213,13 @@ impl Parser {
                             "LightSource \"infinite\": \"illuminance\" is ignored; L × scale is used",
                         );
                     }
-                    let env = crate::Environment {
-                        radiance: crate::EnvironmentRadiance::Constant(l),
+                    let env = scene::Environment {
+                        radiance: scene::EnvironmentRadiance::Constant(l),
                         scale,
                         to_world: glam::Mat3::IDENTITY,
                     };
                     let file = self.files[light.loc.file].display().to_string();
-                    import::set_environment(
+                    builder::set_environment(
                         &mut builder,
                         &format!("LightSource \"infinite\" ({file}:{})", light.loc.line),
                         env,
@@ -243,24 +243,24 @@ impl Parser {
                     } else {
                         linear
                     };
-                    let to_world = import::rotation_part(glam::DMat4::from_mat3(unmirrored))
+                    let to_world = builder::rotation_part(glam::DMat4::from_mat3(unmirrored))
                         .ok_or_else(|| {
                             self.err(
                                 light.loc,
                                 "the infinite light's transform must be a rotation (and a uniform scale)",
                             )
                         })?;
-                    let (map, negative) = crate::EnvironmentMap::load_equal_area(&path, mirror)?;
+                    let (map, negative) = crate::environment::load_equal_area(&path, mirror)?;
                     if negative > 0 {
                         builder.warn(format!("{name}: {negative} negative texels read as 0"));
                     }
-                    let env = crate::Environment {
-                        radiance: crate::EnvironmentRadiance::Map(std::sync::Arc::new(map)),
+                    let env = scene::Environment {
+                        radiance: scene::EnvironmentRadiance::Map(std::sync::Arc::new(map)),
                         scale,
                         to_world,
                     };
                     let file = self.files[light.loc.file].display().to_string();
-                    import::set_environment(
+                    builder::set_environment(
                         &mut builder,
                         &format!("LightSource \"infinite\" ({file}:{})", light.loc.line),
                         env,

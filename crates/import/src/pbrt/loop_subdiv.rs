@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 
 use glam::Vec3;
 
-use crate::load::import::IndexedMesh;
+use crate::builder::IndexedMesh;
 
 /// Largest number of triangles a subdivision may produce.
 pub(crate) const MAX_TRIANGLES: usize = 1 << 25;

@@ -34,7 +34,7 @@ impl Parser {
                     )
                 })?;
                 let path = self.resolve(&file);
-                let (rgb, what) = import::image_texture_standin(&path)
+                let (rgb, what) = builder::image_texture_standin(&path)
                     .map_err(|e| self.err(def.loc, e.to_string()))?;
                 self.warn(format!(
                     "Texture \"{name}\" (imagemap {file}): this use cannot be textured in fppm; {what} {} stands in",
@@ -67,7 +67,7 @@ impl Parser {
                 rgb
             }
             other => {
-                let rgb = Rgb::splat(import::TEXTURE_STANDIN_GREY);
+                let rgb = Rgb::splat(builder::TEXTURE_STANDIN_GREY);
                 self.warn(format!(
                     "Texture \"{name}\" ({other}) is not supported; grey {} stands in",
                     super::super::fmt_vec(rgb)
@@ -133,7 +133,7 @@ impl Parser {
         &mut self,
         def: &MaterialDef,
         label: &str,
-        color: &mut Option<crate::texture::TextureRef>,
+        color: &mut Option<scene::texture::TextureRef>,
     ) -> Result<Option<MaterialKind>, LoadError> {
         let p = def.params.clone();
         let refl = SpectrumUse::Reflectance;
@@ -144,7 +144,7 @@ impl Parser {
                     .textured_colour(&p, "reflectance")?
                     .unwrap_or((Rgb::splat(0.5), None));
                 *color = texture;
-                MaterialKind::Diffuse { albedo }
+                MaterialKind::Diffuse(scene::Diffuse { albedo })
             }
             "conductor" | "coatedconductor" => {
                 let prefix = if def.kind == "coatedconductor" {
@@ -194,13 +194,13 @@ impl Parser {
                     ));
                 }
                 if alpha <= MIRROR_ALPHA {
-                    MaterialKind::Mirror { reflectance: r0 }
+                    MaterialKind::Mirror(scene::Mirror { reflectance: r0 })
                 } else {
-                    MaterialKind::Glossy {
+                    MaterialKind::Glossy(scene::Glossy {
                         reflectance: r0,
                         roughness: alpha,
                         diffuse: Rgb::ZERO,
-                    }
+                    })
                 }
             }
             "dielectric" | "thindielectric" => {
@@ -217,7 +217,7 @@ impl Parser {
                 if self.alpha(&p, "roughness", remap)? > 0.0 {
                     self.warn(format!("{label}: a rough dielectric is rendered smooth"));
                 }
-                MaterialKind::Dielectric { ior: eta }
+                MaterialKind::Dielectric(scene::Dielectric { ior: eta })
             }
             "coateddiffuse" => {
                 let (reflectance, texture) = self
@@ -244,28 +244,28 @@ impl Parser {
                      reflectance {f0:.4} = Fresnel at normal incidence, diffuse scaled by {:.4})",
                     1.0 - f0
                 ));
-                MaterialKind::Glossy {
+                MaterialKind::Glossy(scene::Glossy {
                     reflectance: Rgb::splat(f0),
                     roughness: alpha,
                     diffuse: reflectance * (1.0 - f0),
-                }
+                })
             }
             "interface" => return Ok(None),
             "mix" => {
                 self.warn(format!(
                     "{label}: a mix material stands in as diffuse grey 0.5"
                 ));
-                MaterialKind::Diffuse {
+                MaterialKind::Diffuse(scene::Diffuse {
                     albedo: Rgb::splat(0.5),
-                }
+                })
             }
             other => {
                 self.warn(format!(
                     "{label}: material \"{other}\" is not supported; diffuse grey 0.5 stands in"
                 ));
-                MaterialKind::Diffuse {
+                MaterialKind::Diffuse(scene::Diffuse {
                     albedo: Rgb::splat(0.5),
-                }
+                })
             }
         }))
     }

@@ -35,12 +35,10 @@ use glam::{DMat4, DVec3, Vec3};
 
 use self::tokenizer::{Tok, Token, tokenize};
 use super::LoadOptions;
-use super::import::{self, Builder, IndexedMesh};
+use super::builder::{self, Builder, IndexedMesh};
 use super::spectrum::{self, SpectrumUse};
-use crate::description::{
-    Camera, Film, Light, Material, MaterialKind, RenderDefaults, Rgb, SceneDescription,
-};
 use crate::error::LoadError;
+use scene::{Camera, Film, Light, Material, MaterialKind, RenderDefaults, Rgb, SceneDescription};
 
 /// Deepest `Include` nesting accepted (cycles are caught before that).
 const MAX_INCLUDE_DEPTH: usize = 64;
@@ -61,7 +59,7 @@ pub(crate) fn load_pbrt(path: &Path, options: &LoadOptions) -> Result<SceneDescr
         materials: Vec::new(),
         named_materials: HashMap::new(),
         textures: HashMap::new(),
-        images: crate::texture::TextureCache::default(),
+        images: crate::image_file::TextureCache::default(),
         shapes: Vec::new(),
         objects: HashMap::new(),
         current_object: None,
@@ -194,7 +192,7 @@ struct Parser {
     named_materials: HashMap<String, MaterialDef>,
     textures: HashMap<String, TextureDef>,
     /// The images of the imagemap textures, each decoded once.
-    images: crate::texture::TextureCache,
+    images: crate::image_file::TextureCache,
     shapes: Vec<ShapeRecord>,
     objects: HashMap<String, Vec<ShapeRecord>>,
     current_object: Option<(String, Vec<ShapeRecord>)>,

@@ -124,7 +124,7 @@ impl Parser {
                 }
                 builder.warn(format!(
                     "{label}: the disk is tessellated into {} triangles",
-                    import::DISK_SEGMENTS
+                    builder::DISK_SEGMENTS
                 ));
                 let mut mesh = IndexedMesh::disk();
                 for v in &mut mesh.positions {
@@ -144,7 +144,7 @@ impl Parser {
                 if self.float(p, "phimax")?.is_some_and(|x| x < 360.0) {
                     builder.warn(format!("{label}: phimax is ignored (a whole cylinder)"));
                 }
-                import::cylinder(
+                builder::cylinder(
                     builder,
                     Vec3::new(0.0, 0.0, zmin),
                     Vec3::new(0.0, 0.0, zmax),

@@ -10,7 +10,7 @@
 //! - `scale` multiplies the texel, `invert` takes 1 − texel (not supported here: warned).
 
 use super::*;
-use crate::texture::{TextureRef, Wrap};
+use scene::texture::{TextureRef, Wrap};
 
 /// A colour that may be an image: the constant factor and the texture it multiplies.
 pub(super) type Textured = (Rgb, Option<TextureRef>);

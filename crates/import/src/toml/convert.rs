@@ -1,12 +1,14 @@
 //! From the file as read to a `SceneDescription`: units, transforms, meshes, checks of each value.
 
-use crate::description::{
+use crate::error::LoadError;
+use crate::{LoadOptions, MAX_FILM_SIDE, MeshData, SceneParts, fmt_vec};
+use scene::texture::{Alpha, AlphaMode, MaterialTextures, TextureRef};
+use scene::{
     Camera, Cylinder, Film, Light, LoadNotes, Material, MaterialKind, RenderDefaults,
     SceneDescription, Sphere, Triangle,
 };
-use crate::error::LoadError;
-use crate::load::{LoadOptions, MAX_FILM_SIDE, MeshData, SceneParts, fmt_vec};
-use crate::texture::{Alpha, AlphaMode, MaterialTextures, TextureCache, TextureRef};
+
+use crate::image_file::TextureCache;
 use glam::{Mat3, Mat4, Vec3};
 use std::collections::{BTreeMap, HashSet};
 use std::path::Path;
@@ -46,7 +48,7 @@ impl Converter<'_> {
 
     pub(super) fn colour(&self, key: &str, v: [f32; 3]) -> Result<Vec3, LoadError> {
         let c = Vec3::from(v);
-        crate::validate::colour(key, c).map_err(|e| e.in_file(self.path))?;
+        scene::validate::colour(key, c).map_err(|e| crate::invalid_in_file(e, self.path))?;
         Ok(c)
     }
 
@@ -74,7 +76,7 @@ impl Converter<'_> {
         let camera = file.camera.map(|c| self.camera(c)).transpose()?;
         let film = match file.film {
             Some(f) => self.film(&f)?,
-            None => crate::load::default_film(),
+            None => crate::default_film(),
         };
 
         let mut names: BTreeMap<String, u32> = BTreeMap::new();
@@ -186,7 +188,7 @@ impl Converter<'_> {
                     let e2 = self.finite(&format!("{context} edge2"), edge2)?;
                     let m = lookup(&context, &material)?;
                     // Texture coordinates: the corner at the image's bottom left, edge1
-                    // along u, edge2 up the image (v grows downwards, see `crate::texture`).
+                    // along u, edge2 up the image (v grows downwards, see `scene::texture`).
                     let uv = |a: f32, b: f32| glam::Vec2::new(a, 1.0 - b);
                     acc.push(
                         [c, c + e1, c + e1 + e2],
@@ -259,7 +261,7 @@ impl Converter<'_> {
                         let n = n.filter(|n| n.iter().all(|v| *v != Vec3::ZERO));
                         let tangents = t
                             .tangents
-                            .and_then(|t| crate::load::transform_tangents(t, matrix, flip));
+                            .and_then(|t| crate::transform_tangents(t, matrix, flip));
                         acc.push(p, n, uv, tangents, material_of(t.material));
                     }
                 }
@@ -310,7 +312,7 @@ impl Converter<'_> {
             notes: acc.notes,
             degenerate_materials: acc.degenerate_materials,
         };
-        crate::load::finish(self.path, parts, options)
+        crate::finish(self.path, parts, options)
     }
 
     pub(super) fn camera(&self, c: CameraToml) -> Result<Camera, LoadError> {
@@ -382,7 +384,7 @@ impl Converter<'_> {
                 cutout_file = cutout;
                 let (albedo, texture) = self.colour_input(&key("albedo"), albedo, true)?;
                 color = texture;
-                (MaterialKind::Diffuse { albedo }, emission)
+                (MaterialKind::Diffuse(scene::Diffuse { albedo }), emission)
             }
             MaterialToml::Mirror {
                 reflectance,
@@ -396,12 +398,15 @@ impl Converter<'_> {
                     true,
                 )?;
                 color = texture;
-                (MaterialKind::Mirror { reflectance }, emission)
+                (
+                    MaterialKind::Mirror(scene::Mirror { reflectance }),
+                    emission,
+                )
             }
             MaterialToml::Dielectric { ior, emission } => (
-                MaterialKind::Dielectric {
+                MaterialKind::Dielectric(scene::Dielectric {
                     ior: self.positive(&key("ior"), ior)?,
-                },
+                }),
                 emission,
             ),
             MaterialToml::Glossy {
@@ -415,11 +420,11 @@ impl Converter<'_> {
                     self.colour_input(&key("reflectance"), reflectance, true)?;
                 color = texture;
                 (
-                    MaterialKind::Glossy {
+                    MaterialKind::Glossy(scene::Glossy {
                         reflectance,
                         roughness: self.positive(&key("roughness"), roughness)?,
                         diffuse: Vec3::ZERO,
-                    },
+                    }),
                     emission,
                 )
             }
@@ -561,13 +566,13 @@ impl Converter<'_> {
         radiance: Option<[f32; 3]>,
         scale: Option<f32>,
         rotate: Option<[f32; 3]>,
-    ) -> Result<(crate::Environment, usize), LoadError> {
+    ) -> Result<(scene::Environment, usize), LoadError> {
         let key = |k: &str| format!("{context} {k}");
         let (mut env, negative) = match (file, radiance) {
-            (Some(file), None) => crate::Environment::from_file(&self.dir.join(file))?,
+            (Some(file), None) => crate::environment_from_file(&self.dir.join(file))?,
             (None, Some(radiance)) => (
-                crate::Environment {
-                    radiance: crate::EnvironmentRadiance::Constant(
+                scene::Environment {
+                    radiance: scene::EnvironmentRadiance::Constant(
                         self.colour(&key("radiance"), radiance)?,
                     ),
                     scale: 1.0,
@@ -593,7 +598,7 @@ impl Converter<'_> {
         }
         if let Some(rotate) = rotate {
             env.to_world =
-                crate::Environment::rotation_degrees(self.finite(&key("rotate"), rotate)?);
+                scene::Environment::rotation_degrees(self.finite(&key("rotate"), rotate)?);
         }
         Ok((env, negative))
     }
@@ -644,7 +649,7 @@ impl Accumulator {
         tangents: Option<[[f32; 4]; 3]>,
         material: u32,
     ) {
-        if crate::load::is_degenerate(positions) {
+        if crate::is_degenerate(positions) {
             self.notes.degenerate_triangles += 1;
             self.degenerate_materials.insert(material);
         } else {
@@ -673,8 +678,8 @@ pub(super) fn load_mesh(path: &Path) -> Result<MeshData, LoadError> {
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     match extension.as_str() {
-        "obj" => crate::load::obj::load_obj(path),
-        "gltf" | "glb" => crate::load::gltf::load_gltf(path),
+        "obj" => crate::obj::load_obj(path),
+        "gltf" | "glb" => crate::gltf::load_gltf(path),
         _ => Err(LoadError::UnsupportedExtension {
             path: path.to_path_buf(),
             extension,

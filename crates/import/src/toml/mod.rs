@@ -17,9 +17,9 @@
 
 use std::path::Path;
 
-use crate::description::SceneDescription;
+use crate::LoadOptions;
 use crate::error::LoadError;
-use crate::load::LoadOptions;
+use scene::SceneDescription;
 
 mod convert;
 mod errors;

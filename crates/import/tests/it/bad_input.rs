@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use geometry::{LoadError, LoadOptions, load, load_toml_str, load_with};
+use import::{LoadError, LoadOptions, load, load_toml_str, load_with};
 
 use crate::{assert_names_file, fixture};
 
@@ -67,7 +67,7 @@ const GLTF_TEXTURED: &str = gltf_textured_uri!("tex.png");
 fn load_edited(
     from: &str,
     to: &str,
-) -> (Result<geometry::SceneDescription, LoadError>, &'static Path) {
+) -> (Result<scene::SceneDescription, LoadError>, &'static Path) {
     assert!(BASE.contains(from), "{from:?} not in the base scene");
     let path = Path::new("scenes/edited.toml");
     (load_toml_str(&BASE.replacen(from, to, 1), path), path)
@@ -856,7 +856,7 @@ fn a_good_environment_map_loads_and_lights_a_scene_alone() {
     assert_eq!(env.scale, 2.0);
     // 90° about y: the map's +z (its centre) looks toward world +x.
     assert!((env.to_world * glam::Vec3::Z - glam::Vec3::X).length() < 1e-6);
-    let geometry::EnvironmentRadiance::Map(map) = &env.radiance else {
+    let scene::EnvironmentRadiance::Map(map) = &env.radiance else {
         panic!("{env:?}");
     };
     assert_eq!((map.width, map.height), (16, 8));
@@ -870,7 +870,7 @@ fn a_good_environment_map_loads_and_lights_a_scene_alone() {
             .iter()
             .any(|w| w.contains("8 negative texels"))
     );
-    geometry::Scene::new(description).unwrap();
+    scene::Scene::new(description).unwrap();
 }
 
 /// The size bound on Radiance HDR files refuses only what a file cannot hold: a map stored
@@ -885,7 +885,7 @@ fn an_uncompressed_hdr_map_loads() {
         bytes.extend_from_slice(&[128, 128, 128, 129]);
     }
     std::fs::write(&path, &bytes).unwrap();
-    let (env, negative) = geometry::Environment::from_file(&path).unwrap();
+    let (env, negative) = import::environment_from_file(&path).unwrap();
     assert_eq!(negative, 0);
     let total = env.integrated_radiance();
     for c in [total.x, total.y, total.z] {

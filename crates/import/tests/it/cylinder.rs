@@ -4,8 +4,9 @@
 use std::f32::consts::{PI, TAU};
 use std::path::Path;
 
-use geometry::{LoadError, Primitive, Ray, Scene, load, load_toml_str};
 use glam::Vec3;
+use import::{LoadError, load, load_toml_str};
+use scene::{Primitive, Ray, Scene};
 
 use crate::{assert_names_file, fixture};
 
@@ -36,7 +37,7 @@ fn scene(shape: &str) -> String {
     format!("{HEAD}\n[[shapes]]\n{shape}")
 }
 
-fn load_shape(shape: &str) -> Result<geometry::SceneDescription, LoadError> {
+fn load_shape(shape: &str) -> Result<scene::SceneDescription, LoadError> {
     load_toml_str(&scene(shape), Path::new("scenes/cylinder.toml"))
 }
 

@@ -4,21 +4,17 @@
 use std::io;
 use std::path::Path;
 
-use geometry::{LoadError, LoadOptions, MemoryFiles, load_from};
+use import::{LoadError, LoadOptions, MemoryFiles, load_from};
 
 use crate::assert_names_file;
 
 /// Loads `main` (a path in `files`) accepting scenes without emitters, as `fppm info` does.
-fn load_memory(main: &str, files: MemoryFiles) -> Result<geometry::SceneDescription, LoadError> {
+fn load_memory(main: &str, files: MemoryFiles) -> Result<scene::SceneDescription, LoadError> {
     load_from(Path::new(main), files, &LoadOptions::allow_no_emitter())
 }
 
 #[track_caller]
-fn assert_gltf_error(
-    result: Result<geometry::SceneDescription, LoadError>,
-    file: &str,
-    needle: &str,
-) {
+fn assert_gltf_error(result: Result<scene::SceneDescription, LoadError>, file: &str, needle: &str) {
     let err = result.expect_err("the file must be refused");
     assert!(matches!(err, LoadError::Gltf { .. }), "{err:?}");
     assert_names_file(&err, Path::new(file));

@@ -1,8 +1,9 @@
 //! A hand-written glTF: node hierarchy, negative scale, camera, spot light, a skipped
 //! line primitive, emissive strength.
 
-use geometry::{Light, LoadError, load};
 use glam::Vec3;
+use import::{LoadError, load};
+use scene::Light;
 
 fn assert_close(a: Vec3, b: Vec3) {
     assert!((a - b).length() < 1e-5, "{a} != {b}");
@@ -71,9 +72,9 @@ fn hierarchy_camera_light_and_materials() {
     assert_eq!(glow.emission, Vec3::splat(2.0));
     assert_eq!(
         glow.kind,
-        geometry::MaterialKind::Diffuse {
+        scene::MaterialKind::Diffuse(scene::Diffuse {
             albedo: Vec3::splat(0.5)
-        }
+        })
     );
 
     // Camera: world position (0, 0, 5), looking down −z; film from the aspect ratio.
@@ -246,7 +247,7 @@ fn image_data_uri_read_as_a_file_gives_the_same_texels() {
     let from_file = load(&path).unwrap();
     let uri = format!("data:image/png;base64,{}", base64::encode(red_blue_png()));
     let from_uri = load(&write("gltf_data_uri_vs_file2", &gltf_with_image(&uri))).unwrap();
-    let texture = |s: &geometry::SceneDescription| {
+    let texture = |s: &scene::SceneDescription| {
         s.materials[0]
             .textures
             .as_deref()
@@ -400,9 +401,9 @@ fn generated_tangents_match_the_files_own() {
     let copy = crate::temp_dir("gltf_generated_tangents").join("no-tangents.gltf");
     std::fs::write(&copy, serde_json::to_string(&json).unwrap()).unwrap();
 
-    let options = geometry::LoadOptions::allow_no_emitter();
-    let with = geometry::load_with(&original, &options).unwrap();
-    let without = geometry::load_with(&copy, &options).unwrap();
+    let options = import::LoadOptions::allow_no_emitter();
+    let with = import::load_with(&original, &options).unwrap();
+    let without = import::load_with(&copy, &options).unwrap();
     assert_eq!(with.triangles.len(), without.triangles.len());
     let (mut corners, mut close, mut same_sign) = (0usize, 0usize, 0usize);
     for (a, b) in with.triangles.iter().zip(&without.triangles) {

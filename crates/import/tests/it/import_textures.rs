@@ -9,8 +9,9 @@
 
 use std::path::{Path, PathBuf};
 
-use geometry::{LoadOptions, MemoryFiles, Ray, Scene, load_from, load_with};
 use glam::{Vec2, Vec3};
+use import::{LoadOptions, MemoryFiles, load_from, load_with};
+use scene::{Ray, Scene};
 
 use crate::shared_scenes;
 
@@ -225,9 +226,9 @@ Texture "tex" "spectrum" "scale" "texture tex" "img" "float scale" 0.5"#;
         .unwrap();
     assert_eq!(
         textured.kind,
-        geometry::MaterialKind::Diffuse {
+        scene::MaterialKind::Diffuse(scene::Diffuse {
             albedo: Vec3::splat(0.5)
-        }
+        })
     );
 }
 

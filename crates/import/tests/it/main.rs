@@ -22,8 +22,7 @@ pub(crate) fn shared_scenes() -> PathBuf {
 
 /// A fresh, empty directory for one test's fixtures.
 pub(crate) fn temp_dir(test: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("fppm-geometry-tests-{}-{test}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("fppm-import-tests-{}-{test}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
@@ -40,7 +39,7 @@ pub(crate) fn fixture(test: &str, files: &[(&str, &str)]) -> PathBuf {
 
 /// Asserts that the error's message is one line and starts with the file's path.
 #[track_caller]
-pub(crate) fn assert_names_file(err: &geometry::LoadError, file: &Path) {
+pub(crate) fn assert_names_file(err: &import::LoadError, file: &Path) {
     let msg = err.to_string();
     assert!(
         msg.starts_with(&file.display().to_string()),

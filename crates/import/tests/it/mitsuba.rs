@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use geometry::{LoadError, LoadOptions, load, load_with};
+use import::{LoadError, LoadOptions, load, load_with};
 
 use crate::{assert_names_file, fixture, shared_scenes};
 
@@ -139,12 +139,12 @@ fn envmap_only_scene_loads_with_its_environment() {
     let path = mitsuba("docs/scenes/shape_ply_bunny.xml");
     let scene = load(&path).unwrap();
     let env = scene.environment.as_ref().unwrap();
-    let geometry::EnvironmentRadiance::Map(map) = &env.radiance else {
+    let scene::EnvironmentRadiance::Map(map) = &env.radiance else {
         panic!("{env:?}");
     };
     assert!(map.path.ends_with("museum.exr"), "{}", map.path.display());
     assert_eq!((map.width, map.height), (512, 256));
-    geometry::Scene::new(scene).unwrap();
+    scene::Scene::new(scene).unwrap();
 }
 
 /// A small valid scene: a rectangle lit by a point light, with a parameter.
@@ -177,7 +177,7 @@ fn load_edited(
     test: &str,
     from: &str,
     to: &str,
-) -> (Result<geometry::SceneDescription, LoadError>, PathBuf) {
+) -> (Result<scene::SceneDescription, LoadError>, PathBuf) {
     assert!(BASE.contains(from), "{from:?} not in the base scene");
     let path = fixture(test, &[("scene.xml", &BASE.replacen(from, to, 1))]);
     (load(&path), path)
@@ -499,7 +499,7 @@ fn spectral_eta_k_match_mitsuba() {
     let eta = glam::Vec3::new(0.079_870_5, 0.404_652, 1.558_97);
     let k = glam::Vec3::new(3.386_75, 2.500_71, 1.768_91);
     let expected = ((eta - 1.0) * (eta - 1.0) + k * k) / ((eta + 1.0) * (eta + 1.0) + k * k);
-    let geometry::MaterialKind::Mirror { reflectance } = scene.materials[0].kind else {
+    let scene::MaterialKind::Mirror(scene::Mirror { reflectance }) = scene.materials[0].kind else {
         panic!("{:?}", scene.materials[0]);
     };
     assert!(

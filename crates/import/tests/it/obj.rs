@@ -1,7 +1,8 @@
 //! OBJ specifics: non-convex polygon triangulation, shading normals, the MTL mapping.
 
-use geometry::{LoadOptions, MaterialKind, SceneDescription, Triangle, load_with};
 use glam::{Vec2, Vec3};
+use import::{LoadOptions, load_with};
+use scene::{MaterialKind, SceneDescription, Triangle};
 
 use crate::fixture;
 
@@ -221,43 +222,46 @@ Ka 3 3 3
     };
     assert_eq!(
         kind("matte"),
-        MaterialKind::Diffuse {
+        MaterialKind::Diffuse(scene::Diffuse {
             albedo: Vec3::new(0.5, 0.25, 0.125)
-        }
+        })
     );
     assert_eq!(
         kind("mirror_illum"),
-        MaterialKind::Mirror {
+        MaterialKind::Mirror(scene::Mirror {
             reflectance: Vec3::new(0.9, 0.8, 0.7)
-        }
+        })
     );
     assert_eq!(
         kind("mirror_shiny"),
-        MaterialKind::Mirror {
+        MaterialKind::Mirror(scene::Mirror {
             reflectance: Vec3::splat(0.95)
-        }
+        })
     );
-    assert_eq!(kind("glass_illum"), MaterialKind::Dielectric { ior: 1.33 });
+    assert_eq!(
+        kind("glass_illum"),
+        MaterialKind::Dielectric(scene::Dielectric { ior: 1.33 })
+    );
     assert_eq!(
         kind("glass_dissolve"),
-        MaterialKind::Dielectric { ior: 1.7 }
+        MaterialKind::Dielectric(scene::Dielectric { ior: 1.7 })
     );
     // α = √(2 / (Ns + 2)) = √(2 / 100).
     assert_eq!(
         kind("plastic"),
-        MaterialKind::Glossy {
+        MaterialKind::Glossy(scene::Glossy {
             reflectance: Vec3::splat(0.5),
             roughness: 0.02f32.sqrt(),
             diffuse: Vec3::new(0.2, 0.3, 0.4)
-        }
+        })
     );
     let lamp = scene.materials.iter().find(|m| m.name == "lamp").unwrap();
     assert_eq!(lamp.emission, Vec3::new(4.0, 5.0, 6.0));
     assert_eq!(
         kind("grey"),
-        MaterialKind::Diffuse {
+        MaterialKind::Diffuse(scene::Diffuse {
             albedo: Vec3::splat(0.3)
-        }
+        })
     );
     assert!(
         scene
@@ -280,9 +284,9 @@ fn faces_without_material_get_the_default() {
     assert_eq!(scene.materials[0].name, "default");
     assert_eq!(
         scene.materials[0].kind,
-        MaterialKind::Diffuse {
-            albedo: Vec3::splat(geometry::DEFAULT_ALBEDO)
-        }
+        MaterialKind::Diffuse(scene::Diffuse {
+            albedo: Vec3::splat(import::DEFAULT_ALBEDO)
+        })
     );
 }
 
@@ -293,7 +297,7 @@ fn lone_obj_gets_a_framed_camera() {
     let c = scene.camera;
     assert_eq!(c.look_at, Vec3::new(0.0, 1.0, 0.0));
     assert_eq!(c.up, Vec3::Y);
-    assert!((c.fov_y - geometry::FRAMED_FOV_Y_DEGREES.to_radians()).abs() < 1e-6);
+    assert!((c.fov_y - import::FRAMED_FOV_Y_DEGREES.to_radians()).abs() < 1e-6);
     // Looking down −z from beyond the box's front face, far enough that its
     // half-height 1 fits within tan(20°) · distance.
     assert_eq!((c.position.x, c.position.y), (0.0, 1.0));
@@ -344,7 +348,7 @@ fn mtl_textures_and_texture_coordinates() {
          usemtl lamp\nf 1/1 2/2 3/3\nusemtl bumpy\nf 1/1 2/2 3/3\n",
     )
     .unwrap();
-    let scene = geometry::load(&dir.join("quad.obj")).unwrap();
+    let scene = import::load(&dir.join("quad.obj")).unwrap();
     let lamp = &scene.materials[0];
     assert_eq!(lamp.emission, glam::Vec3::ONE);
     let t = lamp.textures.as_deref().unwrap();

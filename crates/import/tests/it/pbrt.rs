@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use geometry::{LoadError, load};
+use import::{LoadError, load};
 
 use crate::{assert_names_file, fixture, shared_scenes};
 
@@ -171,7 +171,7 @@ fn load_edited(
     test: &str,
     from: &str,
     to: &str,
-) -> (Result<geometry::SceneDescription, LoadError>, PathBuf) {
+) -> (Result<scene::SceneDescription, LoadError>, PathBuf) {
     assert!(BASE.contains(from), "{from:?} not in the base scene");
     let path = fixture(test, &[("scene.pbrt", &BASE.replacen(from, to, 1))]);
     (load(&path), path)
@@ -314,7 +314,7 @@ fn infinite_lights_constant_and_octahedral_map() {
     let env = scene.unwrap().environment.unwrap();
     assert_eq!(
         env.radiance,
-        geometry::EnvironmentRadiance::Constant(glam::Vec3::new(1.0, 2.0, 3.0))
+        scene::EnvironmentRadiance::Constant(glam::Vec3::new(1.0, 2.0, 3.0))
     );
     assert_eq!(env.scale, 2.0);
     // An equal-area octahedral map: written here with distinct texels where pbrt's
@@ -353,11 +353,11 @@ fn infinite_lights_constant_and_octahedral_map() {
             .lights
             .iter()
             .map(|l| match *l {
-                geometry::Light::Point { position, .. } => position.normalize(),
+                scene::Light::Point { position, .. } => position.normalize(),
                 ref other => panic!("{other:?}"),
             })
             .collect();
-        let scene = geometry::Scene::new(description).unwrap();
+        let scene = scene::Scene::new(description).unwrap();
         for (axis, want) in positions.iter().zip([10.0, 20.0, 30.0]) {
             let got = scene.lights().environment_radiance(*axis);
             assert_eq!(

@@ -5,7 +5,8 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-use geometry::{LoadError, LoadOptions, SceneDescription, load, load_with};
+use import::{LoadError, LoadOptions, load, load_with};
+use scene::SceneDescription;
 use serde_json::Value;
 
 /// What an independent reading of a file says the loader must find.
@@ -301,7 +302,7 @@ fn gltf_punctual_lights_and_emissive_strength() {
     assert_eq!(lamp.lights.len(), 5);
     // "Point.002" has intensity 1.5 and the default white colour.
     assert!(lamp.lights.iter().any(|l| matches!(l,
-        geometry::Light::Point { intensity, .. } if (*intensity - glam::Vec3::splat(1.5)).length() < 1e-6)));
+        scene::Light::Point { intensity, .. } if (*intensity - glam::Vec3::splat(1.5)).length() < 1e-6)));
 
     let emissive = load(&root.join("EmissiveStrengthTest/glTF/EmissiveStrengthTest.gltf")).unwrap();
     let emit16 = emissive
@@ -313,7 +314,7 @@ fn gltf_punctual_lights_and_emissive_strength() {
 }
 
 /// The summary with the source made relative, so snapshots do not depend on the checkout.
-fn snapshot_summary(rel: &Path) -> geometry::SceneSummary {
+fn snapshot_summary(rel: &Path) -> scene::SceneSummary {
     let path = crate::shared_scenes().join(rel);
     let scene = load_with(&path, &LoadOptions::allow_no_emitter()).unwrap();
     let mut summary = scene.summary();

@@ -2,8 +2,9 @@
 
 use std::path::Path;
 
-use geometry::{Light, MaterialKind, load, load_toml_str};
 use glam::Vec3;
+use import::{load, load_toml_str};
+use scene::{Light, MaterialKind};
 
 const SCENE: &str = r#"format = 1
 
@@ -145,24 +146,27 @@ fn every_key_of_the_format() {
     let kind = |name: &str| scene.materials[find(name) as usize].kind;
     assert_eq!(
         kind("white"),
-        MaterialKind::Diffuse {
+        MaterialKind::Diffuse(scene::Diffuse {
             albedo: Vec3::splat(0.8)
-        }
+        })
     );
     assert_eq!(
         kind("silver"),
-        MaterialKind::Mirror {
+        MaterialKind::Mirror(scene::Mirror {
             reflectance: Vec3::ONE
-        }
+        })
     );
-    assert_eq!(kind("glass"), MaterialKind::Dielectric { ior: 1.5 });
+    assert_eq!(
+        kind("glass"),
+        MaterialKind::Dielectric(scene::Dielectric { ior: 1.5 })
+    );
     assert_eq!(
         kind("brushed"),
-        MaterialKind::Glossy {
+        MaterialKind::Glossy(scene::Glossy {
             reflectance: Vec3::splat(0.9),
             roughness: 0.1,
             diffuse: Vec3::ZERO
-        }
+        })
     );
     assert_eq!(
         scene.materials[find("lamp") as usize].emission,
@@ -170,9 +174,9 @@ fn every_key_of_the_format() {
     );
     assert_eq!(
         kind("meshes/flat.obj/paper"),
-        MaterialKind::Diffuse {
+        MaterialKind::Diffuse(scene::Diffuse {
             albedo: Vec3::splat(0.5)
-        }
+        })
     );
 
     // Mesh 1: material override and scale → rotate x, y, z → translate.
@@ -316,9 +320,9 @@ cone_angle = 10
     assert_eq!((scene.film.width, scene.film.height), (512, 512));
     assert_eq!(
         scene.materials[0].kind,
-        MaterialKind::Mirror {
+        MaterialKind::Mirror(scene::Mirror {
             reflectance: Vec3::ONE
-        }
+        })
     );
     let Light::Spot {
         cone_angle,
@@ -329,7 +333,7 @@ cone_angle = 10
         panic!()
     };
     assert_eq!(cone_angle, falloff_start);
-    assert_eq!(scene.render, geometry::RenderDefaults::default());
+    assert_eq!(scene.render, scene::RenderDefaults::default());
     assert_eq!(scene.summary().emissive_spheres, 1);
 }
 
@@ -352,7 +356,7 @@ fn paths_resolve_relative_to_the_source() {
     assert_eq!(scene, load(&path).unwrap());
     // From another directory the mesh file is missing, and the error names it.
     let err = load_toml_str(&text, Path::new("elsewhere/scene.toml")).unwrap_err();
-    assert!(matches!(err, geometry::LoadError::Io { .. }), "{err:?}");
+    assert!(matches!(err, import::LoadError::Io { .. }), "{err:?}");
     crate::assert_names_file(&err, Path::new("elsewhere/meshes/tri.obj"));
 }
 

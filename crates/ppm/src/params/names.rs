@@ -454,7 +454,7 @@ impl RenderParams {
     /// whose value does not read.
     pub fn with_scene_defaults(
         mut self,
-        defaults: &geometry::RenderDefaults,
+        defaults: &scene::RenderDefaults,
     ) -> Result<Self, ParamError> {
         for (name, value) in &defaults.params {
             self.set(name, value)?;

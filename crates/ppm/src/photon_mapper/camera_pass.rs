@@ -2,10 +2,10 @@
 //! specular bounces to its first non-specular surface, where it leaves a visible point; the
 //! emission it sees on the way is summed per slot.
 
-use geometry::{Bsdf, Hit, Rgb, TransportMode};
 use glam::{Vec2, Vec3};
 use photon::{HitPoints, NewHitPoint};
 use rayon::prelude::*;
+use scene::{Bsdf, Hit, Rgb, TransportMode};
 
 use super::frequency::SlotFrequency;
 use super::{NO_VISIBLE_POINT, PhotonMapper, SLOT_CHUNK, Setup};

@@ -8,10 +8,10 @@
 //! record a frequency photon), `photon_pass` (tags and deposits), `update` (probes and the
 //! frequency radius of each slot), and the AOVs.
 
-use geometry::{Bsdf, EmitterShape, Hit, Lobe as MaterialLobe, Ray, Rgb};
 use glam::Vec3;
 use photon::{Gathered, HitPoints};
 use rayon::prelude::*;
+use scene::{Bsdf, EmitterShape, Hit, Lobe as MaterialLobe, Ray, Rgb};
 use spectrum::{Caps, FrequencyEstimate, Lobe, Spectrum};
 
 use super::photon_pass::NOT_IN_GRID;
@@ -546,7 +546,7 @@ impl Setup<'_> {
         // Offsets in the receiver's tangent plane, so that the probe's target lies on the
         // receiving surface and the surface itself cannot block it; blockers in the last
         // [`CONTACT_FRACTION`] of the probe (contact shadows, a curving receiver) are ignored.
-        let frame = geometry::Frame::from_normal(hit.geometric_normal);
+        let frame = scene::Frame::from_normal(hit.geometric_normal);
         let phi = std::f32::consts::TAU * u.x;
         let side = frame.to_world(Vec3::new(phi.cos(), phi.sin(), 0.0));
         let probe = |offset: f32| -> Ray {
@@ -572,7 +572,7 @@ impl Setup<'_> {
                 lo = mid;
             }
         }
-        // `occluded` and `intersect` agree on whether a ray is blocked (tested in geometry);
+        // `occluded` and `intersect` agree on whether a ray is blocked (tested in the scene crate);
         // `None` cannot happen, and would mean no occlusion.
         let t_blocker = self.scene.intersect(&probe(hi)).map(|hit| hit.t)?;
         let t_b = f64::from(t_blocker).clamp(0.0, distance);
@@ -621,9 +621,9 @@ pub(super) fn scatter_spectrum(
     spectrum: Spectrum,
     hit: &Hit,
     arrived_from: Vec3,
-    sample: &geometry::BsdfSample,
+    sample: &scene::BsdfSample,
     bsdf: &Bsdf,
-    material: &geometry::Material,
+    material: &scene::Material,
     caps: &Caps,
 ) -> Axes {
     let normal = hit.shading_normal;
@@ -631,10 +631,7 @@ pub(super) fn scatter_spectrum(
     let mu_o = f64::from(sample.incoming.dot(normal).abs());
     let curvature = f64::from(hit.curvature);
     if sample.is_transmission {
-        let ior = match material.kind {
-            geometry::MaterialKind::Dielectric { ior } => f64::from(ior),
-            _ => 1.0,
-        };
+        let ior = material.kind.refractive_index().map_or(1.0, f64::from);
         let (eta_i, eta_t) = if hit.front_face {
             (1.0, ior)
         } else {

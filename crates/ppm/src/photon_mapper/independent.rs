@@ -104,7 +104,7 @@ pub(super) fn schedule_squared(pass: u64, alpha: f64) -> f64 {
 
 /// The pilot: `params.freq_pilot` passes of freq-sppm from the same seed; each slot's radius
 /// after them (or the automatic radius everywhere without a pilot).
-pub(crate) fn pilot_kernels(scene: &geometry::Scene, params: RenderParams) -> Vec<f64> {
+pub(crate) fn pilot_kernels(scene: &scene::Scene, params: RenderParams) -> Vec<f64> {
     let film = scene.description().film;
     let n_slots = film.width as usize * film.height as usize * params.samples_per_pixel as usize;
     let mut pilot_params = params;

@@ -24,9 +24,9 @@ mod update;
 
 use std::time::Instant;
 
-use geometry::Scene;
 use photon::HitPoints;
 use rayon::prelude::*;
+use scene::Scene;
 use spectrum::Caps;
 
 pub(crate) use self::frequency::SlotFrequency;

@@ -5,9 +5,9 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-use geometry::{Bsdf, MaterialKind, Rgb};
 use photon::{AcceptParams, GatherScratch, MortonScratch, Photon};
 use rayon::prelude::*;
+use scene::{Bsdf, Rgb};
 
 use super::frequency::FrequencyPhoton;
 use super::trace::{LightTracing, TracedPhotons};
@@ -208,19 +208,7 @@ impl PhotonMapper<'_> {
             accepts.then(|| {
                 let material = setup.scene.material(slots.material_idx()[slot])?;
                 let (normal, outgoing) = (slots.shading_normal()[slot], slots.outgoing()[slot]);
-                let f = match material.kind {
-                    // `Bsdf::eval` of a Lambertian without building the shading frame: the
-                    // same hemisphere test on the same dot products (the frame's z is the
-                    // normal), the same value.
-                    MaterialKind::Diffuse { albedo } => {
-                        if outgoing.dot(normal) * photon.incoming.dot(normal) <= 0.0 {
-                            Rgb::ZERO
-                        } else {
-                            albedo * std::f32::consts::FRAC_1_PI
-                        }
-                    }
-                    kind => Bsdf::from_normal(kind, normal, true).eval(outgoing, photon.incoming),
-                };
+                let f = Bsdf::eval_about(material.kind, normal, outgoing, photon.incoming);
                 let mut flux = f * photon.power * slots.weight()[slot];
                 if let Some(&weight) = merge_weight.get(slot) {
                     flux *= weight;

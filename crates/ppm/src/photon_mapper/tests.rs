@@ -3,7 +3,7 @@
 use super::frequency::{TagLayout, UNTAGGED};
 use super::{PassStats, PhotonMapper};
 use crate::{Method, RenderParams};
-use geometry::Scene;
+use scene::Scene;
 
 #[test]
 fn tags_pack_chunk_and_record_indices_when_they_fit() {
@@ -28,8 +28,8 @@ fn tags_pack_chunk_and_record_indices_when_they_fit() {
 fn cornell_sphere_24() -> Scene {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/scenes/cornell_box/CornellBox-Sphere.obj");
-    let mut description = geometry::load(&path).unwrap();
-    description.film = geometry::Film {
+    let mut description = import::load(&path).unwrap();
+    description.film = scene::Film {
         width: 24,
         height: 24,
     };

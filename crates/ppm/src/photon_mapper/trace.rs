@@ -1,9 +1,9 @@
 //! Tracing one photon path: emission, Russian roulette, scattering, and the photons it stores
 //! on non-specular surfaces (with the frequency steps of `frequency.rs` for frequency photons).
 
-use geometry::{Bsdf, Hit, MaterialKind, Rgb, TransportMode};
 use glam::{Vec2, Vec3};
 use photon::Photon;
+use scene::{Bsdf, Hit, Rgb, TransportMode};
 
 use super::Setup;
 use super::frequency::{FrequencyPhoton, arrived, scatter_spectrum};
@@ -192,8 +192,8 @@ impl Setup<'_> {
                 (1.0 - ratio).max(0.0)
             };
             // The survival probability, when the roulette is decided before sampling.
-            let decided = match bsdf.kind() {
-                MaterialKind::Diffuse { albedo } if roulette => {
+            let decided = match bsdf.lambertian_albedo() {
+                Some(albedo) if roulette => {
                     let q = kill_probability(power * albedo);
                     if u_roulette < q {
                         break;

@@ -153,7 +153,7 @@ intensity = [10.0, 10.0, 10.0]
 
 /// The exact pixel averages of the plane scene: 8×8 sub-pixel rays per pixel through the
 /// camera model, intersected with y = 0 analytically.
-pub(crate) fn plane_reference(scene: &geometry::Scene) -> Vec<f64> {
+pub(crate) fn plane_reference(scene: &scene::Scene) -> Vec<f64> {
     let (width, height) = scene.camera().resolution();
     let light = glam::Vec3::new(0.0, 1.0, 0.0);
     let mut out = Vec::new();
@@ -241,7 +241,7 @@ fn point_light_over_a_plane_matches_the_inverse_square_law_pixel_by_pixel() {
 }
 
 /// The analytic radiance of the plane scene at film position `film`.
-fn plane_radiance_at(scene: &geometry::Scene, film: Vec2) -> f64 {
+fn plane_radiance_at(scene: &scene::Scene, film: Vec2) -> f64 {
     let ray = scene.camera().generate_ray(film, Vec2::splat(0.5));
     let t = -ray.origin.y / ray.direction.y;
     if t <= 0.0 {

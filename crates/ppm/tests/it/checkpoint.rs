@@ -102,14 +102,14 @@ fn the_fingerprint_covers_textures() {
         let text = format!(
             "format = 1\n[materials.m]\ntype = \"diffuse\"\nalbedo = {albedo}\nemission = [1, 1, 1]\n[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n"
         );
-        geometry::load_toml_str(&text, &dir.join("scene.toml")).unwrap()
+        import::load_toml_str(&text, &dir.join("scene.toml")).unwrap()
     };
-    let a = ppm::scene_fingerprint(&scene("{ texture = \"a.png\" }"));
-    let b = ppm::scene_fingerprint(&scene("{ texture = \"b.png\" }"));
-    let plain = ppm::scene_fingerprint(&scene("[1, 1, 1]"));
+    let a = scene("{ texture = \"a.png\" }").fingerprint();
+    let b = scene("{ texture = \"b.png\" }").fingerprint();
+    let plain = scene("[1, 1, 1]").fingerprint();
     assert_ne!(a, b);
     assert_ne!(a, plain);
-    assert_eq!(a, ppm::scene_fingerprint(&scene("{ texture = \"a.png\" }")));
+    assert_eq!(a, scene("{ texture = \"a.png\" }").fingerprint());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -118,15 +118,15 @@ fn the_fingerprint_covers_textures() {
 #[test]
 fn the_fingerprint_covers_tangents() {
     let mut scene = cornell("CornellBox-Sphere.obj", 4, 4).description().clone();
-    let plain = ppm::scene_fingerprint(&scene);
+    let plain = scene.fingerprint();
     scene.triangles[0].tangents = Some([[1.0, 0.0, 0.0, 1.0]; 3]);
-    let with = ppm::scene_fingerprint(&scene);
+    let with = scene.fingerprint();
     scene.triangles[0].tangents = Some([[1.0, 0.0, 0.0, -1.0]; 3]);
-    let mirrored = ppm::scene_fingerprint(&scene);
+    let mirrored = scene.fingerprint();
     assert_ne!(plain, with);
     assert_ne!(with, mirrored);
     scene.triangles[0].tangents = None;
-    assert_eq!(plain, ppm::scene_fingerprint(&scene));
+    assert_eq!(plain, scene.fingerprint());
 }
 
 const PNG_HEX: &str = "89504e470d0a1a0a0000000d49484452000000010000000108060000001f15c4890000000d4944415478da636460f85f0f0002870180eb47ba920000000049454e44ae426082";

@@ -31,7 +31,7 @@ radiance = [1.0, 1.0, 1.0]
 
 /// Pixels whose whole square lies on the sphere (all four corners' rays hit it), and those
 /// whose square misses it.
-fn masks(scene: &geometry::Scene) -> (Vec<bool>, Vec<bool>) {
+fn masks(scene: &scene::Scene) -> (Vec<bool>, Vec<bool>) {
     let film = scene.description().film;
     let hits = |x: f32, y: f32| {
         let ray = scene
@@ -99,19 +99,19 @@ fn white_furnace_is_one_everywhere_for_every_method() {
 
 /// The shared Cornell box with the sphere (open at the front), lit by the shared `museum.exr`
 /// besides its own lamp, at 24 × 24.
-fn museum_cornell() -> geometry::Scene {
+fn museum_cornell() -> scene::Scene {
     let shared = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
-    let options = geometry::LoadOptions {
+    let options = import::LoadOptions {
         environment: Some(shared.join("mitsuba3/common/textures/museum.exr")),
         ..Default::default()
     };
     let mut description =
-        geometry::load_with(&shared.join("cornell_box/CornellBox-Sphere.obj"), &options).unwrap();
-    description.film = geometry::Film {
+        import::load_with(&shared.join("cornell_box/CornellBox-Sphere.obj"), &options).unwrap();
+    description.film = scene::Film {
         width: 24,
         height: 24,
     };
-    geometry::Scene::new(description).unwrap()
+    scene::Scene::new(description).unwrap()
 }
 
 #[test]
@@ -139,7 +139,7 @@ fn environment_lit_images_are_bit_identical_for_1_and_3_threads() {
 
 /// A 64 × 32 map: a bright 3 × 2-texel sun at θ ≈ 58°, a colour gradient elsewhere, built in
 /// code (texels row-major, top row first).
-fn sun_map() -> geometry::EnvironmentMap {
+fn sun_map() -> scene::EnvironmentMap {
     let (w, h) = (64u32, 32u32);
     let texels = (0..h)
         .flat_map(|y| {
@@ -152,7 +152,7 @@ fn sun_map() -> geometry::EnvironmentMap {
             })
         })
         .collect();
-    geometry::EnvironmentMap {
+    scene::EnvironmentMap {
         path: "sun.exr".into(),
         width: w,
         height: h,
@@ -163,7 +163,7 @@ fn sun_map() -> geometry::EnvironmentMap {
 /// The irradiance on an upward surface under `map` (unrotated, +y up), per channel, summed
 /// texel by texel in closed form: a texel of rows θ₀..θ₁ gives L·(2π/W)·(sin²θ₁ − sin²θ₀)/2
 /// over the upper hemisphere.
-fn upward_irradiance(map: &geometry::EnvironmentMap) -> [f64; 3] {
+fn upward_irradiance(map: &scene::EnvironmentMap) -> [f64; 3] {
     let (w, h) = (map.width as usize, map.height as usize);
     let mut e = [0.0f64; 3];
     for y in 0..h / 2 {
@@ -217,14 +217,13 @@ material = "grey"
 type = "environment"
 radiance = [1.0, 1.0, 1.0]
 "#;
-    let mut description =
-        geometry::load_toml_str(toml, std::path::Path::new("floor.toml")).unwrap();
-    description.environment = Some(geometry::Environment {
-        radiance: geometry::EnvironmentRadiance::Map(std::sync::Arc::new(map)),
+    let mut description = import::load_toml_str(toml, std::path::Path::new("floor.toml")).unwrap();
+    description.environment = Some(scene::Environment {
+        radiance: scene::EnvironmentRadiance::Map(std::sync::Arc::new(map)),
         scale: 1.0,
         to_world: glam::Mat3::IDENTITY,
     });
-    let scene = geometry::Scene::new(description).unwrap();
+    let scene = scene::Scene::new(description).unwrap();
     let channel_means = |image: &[[f32; 3]]| {
         let mut m = [0.0f64; 3];
         for p in image {

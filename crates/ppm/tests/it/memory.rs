@@ -6,13 +6,13 @@ use ppm::{MemoryEstimate, Method, Renderer};
 
 use crate::support::params;
 
-fn repo_scene(name: &str, width: u32, height: u32) -> geometry::Scene {
+fn repo_scene(name: &str, width: u32, height: u32) -> scene::Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../scenes")
         .join(name);
-    let mut description = geometry::load(&path).unwrap();
-    description.film = geometry::Film { width, height };
-    geometry::Scene::new(description).unwrap()
+    let mut description = import::load(&path).unwrap();
+    description.film = scene::Film { width, height };
+    scene::Scene::new(description).unwrap()
 }
 
 /// On a caustic, a box and an indirectly lit room, for the classical and the frequency-guided

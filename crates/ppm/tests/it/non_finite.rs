@@ -115,12 +115,12 @@ fn overflowing_photon_power_is_dropped_and_counted() {
 /// Emission whose power is beyond f32 is refused with the scene, by name, not rendered black.
 #[test]
 fn emission_beyond_f32_is_refused() {
-    let description = geometry::load_toml_str(
+    let description = import::load_toml_str(
         &box_scene(3.0e38, 0.3, ""),
         std::path::Path::new("hot.toml"),
     )
     .unwrap();
-    let Err(error) = geometry::Scene::new(description) else {
+    let Err(error) = scene::Scene::new(description) else {
         panic!("accepted");
     };
     let message = error.to_string();

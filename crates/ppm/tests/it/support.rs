@@ -2,12 +2,12 @@
 
 use std::path::Path;
 
-use geometry::Scene;
 use ppm::{Method, RenderParams, Renderer};
+use scene::Scene;
 
 /// A scene from TOML text (paths relative to this directory).
 pub(crate) fn scene(toml: &str) -> Scene {
-    let description = geometry::load_toml_str(toml, Path::new("test-scene.toml")).unwrap();
+    let description = import::load_toml_str(toml, Path::new("test-scene.toml")).unwrap();
     Scene::new(description).unwrap()
 }
 
@@ -16,8 +16,8 @@ pub(crate) fn cornell(name: &str, width: u32, height: u32) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/scenes/cornell_box")
         .join(name);
-    let mut description = geometry::load(&path).unwrap();
-    description.film = geometry::Film { width, height };
+    let mut description = import::load(&path).unwrap();
+    description.film = scene::Film { width, height };
     Scene::new(description).unwrap()
 }
 

@@ -11,17 +11,17 @@
 
 use std::path::Path;
 
-use geometry::{Film, Light, Ray, Scene, SceneDescription};
 use glam::{Vec2, Vec3};
+use scene::{Film, Light, Ray, Scene, SceneDescription};
 
 /// A scene file loaded with the crate's own loaders (emitters not required), rendered at
 /// 1024×1024, with a point light above the bounding box if the file has no light at all.
 pub fn load_triangles(path: &Path) -> SceneDescription {
-    let options = geometry::LoadOptions {
+    let options = import::LoadOptions {
         require_emitter: false,
         ..Default::default()
     };
-    let mut description = geometry::load_with(path, &options).unwrap();
+    let mut description = import::load_with(path, &options).unwrap();
     description.film = Film {
         width: 1024,
         height: 1024,
@@ -86,7 +86,7 @@ pub fn diffuse_bounce_rays(scene: &Scene, primary: &[Ray]) -> Vec<Ray> {
         let r = u1.sqrt();
         let phi = std::f32::consts::TAU * u2;
         let local = Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u1).max(0.0).sqrt());
-        let frame = geometry::Frame::from_normal(hit.geometric_normal);
+        let frame = scene::Frame::from_normal(hit.geometric_normal);
         rays.push(hit.spawn_ray(frame.to_world(local)));
     }
     rays

@@ -8,8 +8,8 @@
 //! obvhs types never leave this module.
 //!
 //! Why a layout of our own: obvhs' `CwBvh` is a GPU layout whose compressed nodes are decoded
-//! per node on the CPU; this one is tested as it is stored. docs/performance.md ("BVH
-//! traversal") has the measurements behind each choice, and what did not pay.
+//! per node on the CPU; this one is tested as it is stored. docs/notes/bvh-traversal.md
+//! has the measurements behind each choice, and what did not pay.
 //!
 //! Exactness: the box test is conservative (exit distances are widened by 1 + 2γ₃, and every
 //! primitive's box is padded by a few ulps so that no primitive touches a box face), so the BVH
@@ -148,7 +148,7 @@ impl Leaves for Query<'_> {
 /// instead of 3.
 ///
 /// Faster builds trace slower and slower ones do not trace faster on our scenes; the
-/// measurements are in docs/performance.md ("BVH traversal").
+/// measurements are in docs/notes/bvh-traversal.md.
 fn build_params() -> BvhBuildParams {
     BvhBuildParams {
         max_prims_per_leaf: LANES as u32,

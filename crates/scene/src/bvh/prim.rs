@@ -171,9 +171,9 @@ impl TriPack {
     /// [0, tmax) (a comparison result), and t per lane (meaningful only in those lanes).
     ///
     /// Also returns the barycentrics u (of v1) and v (of v2) per lane. A closest-hit query reports
-    /// those of the hit lane rather than recomputing them for the one triangle (which cost about
-    /// 50 instructions per ray, and gave numbers that could differ by rounding from the ones the
-    /// inside test accepted: glam's `cross` uses FMA where the CPU has it).
+    /// those of the hit lane rather than recomputing them for the one triangle, which would cost
+    /// instructions and could give numbers that differ by rounding from the ones the inside test
+    /// accepted (glam's `cross` uses FMA where the CPU has it).
     #[inline(always)]
     pub(super) fn intersect(&self, ray: &Ray8, tmax: f32) -> (F8, F8, F8, F8) {
         let [ox, oy, oz] = ray.origin;

@@ -8,8 +8,7 @@
 //! same number.
 //!
 //! Eight lanes rather than four, AVX intrinsics rather than lane-by-lane code, and compressing
-//! stores for the pushed children each paid on incoherent rays (docs/performance.md, "BVH
-//! traversal").
+//! stores for the pushed children each paid on incoherent rays (docs/notes/bvh-traversal.md).
 
 use std::mem::MaybeUninit;
 
@@ -56,7 +55,7 @@ const STACK_SMALL: usize = 64;
 const STACK_LARGE: usize = 256;
 
 /// The primitive tests of the leaves, as the traversals call them. A trait with inlined methods
-/// rather than closures, which the compiler left as calls (the speed difference was within noise).
+/// rather than closures, which the compiler leaves as calls.
 pub(super) trait Leaves {
     /// Lowers `tmax` to the closest hit in `leaf` below it, if any.
     fn closest(&mut self, leaf: Leaf, tmax: &mut f32);
@@ -239,8 +238,8 @@ impl BoxRay {
 /// The traversal stack: child references and the distances at which the ray enters their boxes,
 /// in two arrays, so that the children a node test leaves behind are pushed with one compressing
 /// store each ([`compress`]). The storage is borrowed (on the machine stack for trees of ordinary
-/// depth, on the heap otherwise) and left uninitialised: zeroing it cost about 5 % of the
-/// instructions of an incoherent ray.
+/// depth, on the heap otherwise) and left uninitialised, since zeroing it per ray is a noticeable
+/// share of an incoherent ray's instructions (docs/performance.md).
 struct Stack<'a> {
     /// `refs[..len]` and `dist[..len]` are initialised.
     refs: &'a mut [MaybeUninit<u32>],
@@ -304,8 +303,8 @@ impl<'a> Stack<'a> {
 }
 
 /// Makes `$stack`, a [`Stack`] for a tree of [`Wide::stack_need`] `$need`, and evaluates `$body`
-/// with it. A macro rather than a function taking a closure, which the compiler did not inline
-/// (the traversal then read the ray from memory: 10 % more instructions).
+/// with it. A macro rather than a function taking a closure, which the compiler does not inline:
+/// the traversal would then read the ray from memory (docs/performance.md).
 macro_rules! with_stack {
     ($need:expr, |$stack:ident| $body:expr) => {{
         const SMALL: usize = STACK_SMALL + WIDTH;
@@ -490,9 +489,9 @@ impl<F: Fn(u32, u32) -> bool> Collapse<'_, F> {
 impl Wide {
     /// Collapses a `Bvh2` (no spatial splits, at least one primitive) into the wide nodes that
     /// [`Plan`] chooses: each wide node takes up to [`WIDTH`] binary nodes under the binary node
-    /// it replaces. (The greedy collapse, which opened the inner child of largest surface area
-    /// while there was room, left many nodes near the leaves with two or three children: on the
-    /// bunny 3886 nodes for 11805 leaves against the plan's 2406.) Nodes are laid out depth
+    /// it replaces. (A greedy collapse, which opens the inner child of largest surface area
+    /// while there is room, leaves many nodes near the leaves with two or three children;
+    /// docs/notes/bvh-traversal.md.) Nodes are laid out depth
     /// first. `mixed(first, count)` says whether a leaf's primitives are not all triangles.
     pub(super) fn from_bvh2(bvh2: &Bvh2, mixed: &impl Fn(u32, u32) -> bool) -> Self {
         let mut c = Collapse {
@@ -601,7 +600,7 @@ impl Wide {
                             continue;
                         }
                         // Two or more: continue with the nearest, push the others (in lane order:
-                        // sorting them cost more than it saved, measured).
+                        // sorting them costs more than it saves).
                         let nearest = nearest_lane(tnear);
                         stack.push(mask & !(1 << nearest), node, tnear);
                         current = node.children[nearest & (WIDTH - 1)];

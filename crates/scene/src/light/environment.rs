@@ -22,14 +22,15 @@
 //! power is π r² ∫ L dω.
 
 use std::f32::consts::PI;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use glam::{Mat3, Vec2, Vec3};
 
-use crate::bsdf::luminance;
+use crate::fingerprint::{Fingerprint, Fingerprinter};
+use crate::material::luminance;
 use crate::sampling::{concentric_disk, uniform_sphere};
-use crate::{Aabb, Frame, LoadError, Rgb};
+use crate::{Aabb, Frame, Rgb};
 
 /// An environment light as a scene describes it.
 #[derive(Clone, Debug, PartialEq)]
@@ -75,31 +76,18 @@ impl std::fmt::Debug for EnvironmentMap {
 }
 
 impl EnvironmentMap {
-    /// Reads an equirectangular map from an OpenEXR (`.exr`) or Radiance (`.hdr`) file.
-    /// Negative texels (filter ringing in some tools) become zero; the count of them is returned
-    /// for a warning.
+    /// The equirectangular map of twice `side` in height resampled, nearest texel as pbrt-v4
+    /// looks it up, from a square equal-area octahedral map (pbrt-v4's `infinite` light) of
+    /// `side` × `side` texels, row-major: the map's frame is pbrt's light frame with its x axis
+    /// negated when `mirror_x` (for a light transform with a reflection).
     ///
-    /// # Errors
-    /// [`LoadError::Io`] when the file cannot be read, [`LoadError::EnvironmentMap`] when it has
-    /// another extension, cannot be decoded, has zero size, is not 2:1, holds a NaN or infinite
-    /// texel, or is black everywhere.
-    pub fn load(path: &Path) -> Result<(Self, usize), LoadError> {
-        Self::read(path, false)
-    }
-
-    /// Reads a square equal-area octahedral map (pbrt-v4's `infinite` light, `.exr` or `.hdr`)
-    /// and resamples it, nearest texel as pbrt looks it up, into an equirectangular map of
-    /// twice its side in height, so that the map's frame is pbrt's light frame with its x axis
-    /// negated when `mirror_x` (for a light transform with a reflection: see
-    /// `load/pbrt/build.rs`).
-    ///
-    /// # Errors
-    /// As [`EnvironmentMap::load`], with "not square" in place of "not 2:1".
-    pub(crate) fn load_equal_area(path: &Path, mirror_x: bool) -> Result<(Self, usize), LoadError> {
-        let (square, negative) = Self::read(path, true)?;
-        let n = square.width as usize;
+    /// # Panics
+    /// If `texels` holds fewer than `side × side` texels.
+    #[must_use]
+    pub fn from_equal_area(path: PathBuf, side: u32, texels: &[Rgb], mirror_x: bool) -> Self {
+        let n = side as usize;
         let (w, h) = (4 * n, 2 * n);
-        let mut texels = Vec::with_capacity(w * h);
+        let mut out = Vec::with_capacity(w * h);
         for y in 0..h {
             for x in 0..w {
                 let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
@@ -110,177 +98,39 @@ impl EnvironmentMap {
                 let st = equal_area_sphere_to_square(d);
                 let i = ((st.x * n as f32) as usize).min(n - 1);
                 let j = ((st.y * n as f32) as usize).min(n - 1);
-                texels.push(square.texels[j * n + i]);
+                out.push(texels[j * n + i]);
             }
         }
-        Ok((
-            Self {
-                path: square.path,
-                width: w as u32,
-                height: h as u32,
-                texels,
-            },
-            negative,
-        ))
-    }
-
-    /// Decodes `path` and checks it: 2:1, or square when `square`.
-    fn read(path: &Path, square: bool) -> Result<(Self, usize), LoadError> {
-        let bad = |message: String| LoadError::EnvironmentMap {
-            path: path.to_path_buf(),
-            message,
-        };
-        let extension = path
-            .extension()
-            .map(|e| e.to_string_lossy().to_ascii_lowercase())
-            .unwrap_or_default();
-        let format = match extension.as_str() {
-            "exr" => image::ImageFormat::OpenExr,
-            "hdr" => image::ImageFormat::Hdr,
-            _ => {
-                return Err(bad(format!(
-                    "unsupported image format {extension:?} (expected .exr or .hdr)"
-                )));
-            }
-        };
-        let bytes = crate::load::read_bytes(path)?;
-        let cannot_decode = |e: String| {
-            bad(format!(
-                "cannot decode image: {}",
-                crate::error::lower_first(&e)
-            ))
-        };
-        // The size the header declares is checked before anything is decoded: a file of a few
-        // hundred bytes can declare a billion texels.
-        // `image` reports an EXR's display window, so the data windows (what is decoded) are
-        // read with `exr`.
-        if format == image::ImageFormat::OpenExr {
-            let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(&bytes), false)
-                .map_err(|e| cannot_decode(e.to_string()))?;
-            for header in &meta.headers {
-                let size = header.layer_size;
-                let (w, h) = (
-                    u32::try_from(size.0).unwrap_or(u32::MAX),
-                    u32::try_from(size.1).unwrap_or(u32::MAX),
-                );
-                Self::check_size(w, h, square).map_err(bad)?;
-            }
-            crate::texture::check_exr_header(&bytes, MAX_MAP_TEXELS).map_err(bad)?;
+        Self {
+            path,
+            width: w as u32,
+            height: h as u32,
+            texels: out,
         }
-        let (width, height) = image::ImageReader::with_format(std::io::Cursor::new(&bytes), format)
-            .into_dimensions()
-            .map_err(|e| cannot_decode(e.to_string()))?;
-        Self::check_size(width, height, square).map_err(bad)?;
-        if format == image::ImageFormat::Hdr {
-            crate::texture::check_hdr_size(&bytes, width, height).map_err(bad)?;
-        }
-        let (width, height, rgb) = decode_hdr_image(&bytes, format).map_err(cannot_decode)?;
-        drop(bytes);
-        Self::check_size(width, height, square).map_err(bad)?;
-        // The decoded floats become the texels in place (a map may hold 64 M texels: a copy
-        // would double the peak memory).
-        let mut texels: Vec<Vec3> = bytemuck::allocation::try_cast_vec(rgb)
-            .unwrap_or_else(|(_, rgb)| rgb.chunks_exact(3).map(Vec3::from_slice).collect());
-        let mut negative = 0;
-        for (i, texel) in texels.iter_mut().enumerate() {
-            let t = *texel;
-            if !t.is_finite() {
-                let (x, y) = (i as u32 % width, i as u32 / width);
-                return Err(bad(format!(
-                    "texel ({x}, {y}) is not finite ({}, {}, {})",
-                    t.x, t.y, t.z
-                )));
-            }
-            if t.cmplt(Vec3::ZERO).any() {
-                negative += 1;
-            }
-            *texel = t.max(Vec3::ZERO);
-        }
-        if texels.iter().all(|&t| luminance(t) <= 0.0) {
-            return Err(bad(
-                "every texel is black: the environment emits nothing".into()
-            ));
-        }
-        Ok((
-            Self {
-                path: path.to_path_buf(),
-                width,
-                height,
-                texels,
-            },
-            negative,
-        ))
     }
 }
 
-impl EnvironmentMap {
-    /// Whether a map of `width` × `height` texels can be used: not empty, 2:1 (square when
-    /// `square`), and at most [`MAX_MAP_TEXELS`] texels once resampled (a square map of side n
-    /// becomes 4n × 2n).
-    fn check_size(width: u32, height: u32, square: bool) -> Result<(), String> {
-        if width == 0 || height == 0 {
-            return Err(format!("image has zero size ({width}×{height})"));
+impl Fingerprint for Environment {
+    /// The scale, the rotation and the radiance: a constant, or a map by its texels.
+    fn fingerprint(&self, h: &mut Fingerprinter) {
+        h.f32(self.scale);
+        h.mat3(self.to_world);
+        match &self.radiance {
+            EnvironmentRadiance::Constant(c) => {
+                h.u32(0);
+                h.vec3(*c);
+            }
+            EnvironmentRadiance::Map(map) => {
+                h.u32(1);
+                h.u32(map.width);
+                h.u32(map.height);
+                map.texels.iter().for_each(|&t| h.vec3(t));
+            }
         }
-        if !(if square {
-            width == height
-        } else {
-            width == 2 * height
-        }) {
-            return Err(if square {
-                format!("image is {width}×{height}, not square (an equal-area octahedral map)")
-            } else {
-                format!(
-                    "image is {width}×{height}, not 2:1 (an equirectangular map is twice as wide as high)"
-                )
-            });
-        }
-        let texels = u64::from(width) * u64::from(height) * if square { 8 } else { 1 };
-        if texels > MAX_MAP_TEXELS {
-            return Err(format!(
-                "image of {width}×{height} texels is larger than the {MAX_MAP_TEXELS} texels accepted{}",
-                if square {
-                    " once resampled to 4n × 2n"
-                } else {
-                    ""
-                }
-            ));
-        }
-        Ok(())
     }
-}
-
-/// Largest environment map accepted, in texels (the image textures' bound: 8192 × 8192).
-const MAX_MAP_TEXELS: u64 = 64 << 20;
-
-/// Decodes an HDR image file into linear RGB floats (width, height, 3 values per texel).
-/// The one place this module touches an image decoder.
-fn decode_hdr_image(
-    bytes: &[u8],
-    format: image::ImageFormat,
-) -> Result<(u32, u32, Vec<f32>), String> {
-    let image = image::load_from_memory_with_format(bytes, format).map_err(|e| e.to_string())?;
-    let rgb = image.into_rgb32f();
-    Ok((rgb.width(), rgb.height(), rgb.into_raw()))
 }
 
 impl Environment {
-    /// The environment of `file` (`.exr` or `.hdr`), unscaled and unrotated, with the count of
-    /// negative texels set to zero.
-    ///
-    /// # Errors
-    /// As [`EnvironmentMap::load`].
-    pub fn from_file(path: &Path) -> Result<(Self, usize), LoadError> {
-        let (map, negative) = EnvironmentMap::load(path)?;
-        Ok((
-            Self {
-                radiance: EnvironmentRadiance::Map(Arc::new(map)),
-                scale: 1.0,
-                to_world: Mat3::IDENTITY,
-            },
-            negative,
-        ))
-    }
-
     /// The rotation of `rotate = [x, y, z]`: degrees about x, then y, then z (Rz·Ry·Rx).
     #[must_use]
     pub fn rotation_degrees(r: Vec3) -> Mat3 {

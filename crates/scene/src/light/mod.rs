@@ -19,7 +19,7 @@ use glam::{Vec2, Vec3};
 
 use crate::{
     Aabb, Frame, Hit, Light, Primitive, Ray, Rgb, SceneDescription,
-    bsdf::luminance,
+    material::luminance,
     ray::offset_ray_origin,
     sampling::{
         Distribution1D, concentric_disk, cosine_hemisphere, uniform_cone, uniform_sphere,
@@ -146,7 +146,7 @@ enum Emitter {
         area: f32,
         radiance: Rgb,
         /// What [`LightSampler::sample_emission`] needs, computed once here by the same
-        /// expressions it evaluated per photon before (so photons are bit-identical):
+        /// expressions as it would per photon (so hoisting them changes no photon):
         /// `p0 + e1`, `p0 + e2`, the frame about `normal`, √area and π·L·A.
         p1: Vec3,
         p2: Vec3,

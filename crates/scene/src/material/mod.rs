@@ -1,34 +1,35 @@
-//! Scattering models (BSDFs) of the scene format: Lambert, mirror, smooth dielectric and a GGX
-//! conductor over an optional Lambertian base.
+//! Scattering models (BSDFs), one module per model, each with its evaluation, sampling,
+//! density, albedo and frequency lobe together:
+//! - `diffuse.rs`: Lambert;
+//! - `mirror.rs`: a perfect specular conductor of constant reflectance;
+//! - `dielectric.rs`: a smooth dielectric with exact unpolarised Fresnel;
+//! - `glossy.rs`: a GGX conductor over an optional Lambertian base.
+//!
+//! [`MaterialKind`] is a material's model as a scene describes it, and [`Bsdf`] a model at one
+//! surface point. A new model is a module here implementing [`Model`], a variant of
+//! [`MaterialKind`] with its line in `with_model!`, and the importers' lines that read it:
+//! checks ([`crate::validate`]), summaries and fingerprints read its [`Model::params`].
 //!
 //! Conventions (pbrt's): `outgoing` and `incoming` are world-space unit vectors pointing away from
 //! the surface; `outgoing` points back along the path being traced (toward the camera for camera
 //! paths, toward the light for photon paths). [`Bsdf::eval`] returns f without the cosine.
 //! All materials scatter on both sides: a reflection needs `outgoing` and `incoming` on the same
 //! side of the shading normal, whichever side that is.
-//!
-//! The glossy model is a GGX conductor over a Lambertian base, coupled so that it never reflects
-//! more than it receives (the MTL `Kd` + `Ks` it comes from is additive, and reflected up to 1.3
-//! of the incident light with Kd = 0.6, Ks = 0.7):
-//! f = f_d + D·G₂·F/(4 cos θₒ cos θᵢ), with GGX D, height-correlated Smith G₂ and Schlick's
-//! F = F₀ + (1 − F₀)(1 − cos θ_d)⁵ with F₀ = `reflectance`, and the base of Ashikhmin and Shirley
-//! (2000), f_d = 28/(23π)·diffuse·(1 − F₀)·(1 − (1 − cos θᵢ/2)⁵)·(1 − (1 − cos θₒ/2)⁵): reciprocal,
-//! weighted by what the specular layer leaves (1 − F₀), and fading at grazing angles where
-//! Schlick's F → 1. Its directional albedo stays ≤ 1 for every roughness, `reflectance` and
-//! `diffuse` in [0, 1] (tested on a grid). Single-scattering GGX loses energy at high roughness
-//! (≈ 0.69 albedo at α = 0.5, 0.31 at α = 1, normal incidence).
 
-use std::f32::consts::{FRAC_1_PI, PI};
+mod dielectric;
+mod diffuse;
+mod glossy;
+mod mirror;
+#[cfg(test)]
+mod tests;
 
 use glam::{Vec2, Vec3};
 
-use crate::{
-    Frame, Hit, Material, MaterialKind, Rgb,
-    sampling::{concentric_disk, cosine_hemisphere},
-};
-
-#[cfg(test)]
-mod tests;
+pub use self::dielectric::{Dielectric, fresnel_dielectric};
+pub use self::diffuse::Diffuse;
+pub use self::glossy::Glossy;
+pub use self::mirror::Mirror;
+use crate::{Frame, Hit, Material, Rgb};
 
 /// What a path carries, which matters for refraction (Veach 1997, §5.2; pbrt's `TransportMode`).
 ///
@@ -72,38 +73,161 @@ pub struct BsdfSample {
     pub is_transmission: bool,
 }
 
-/// A material's scattering at one surface point, in the hit's shading frame.
+/// The scattering models of scene format version 1 (and its extensions): each variant holds
+/// the parameters of one model.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Bsdf {
-    /// The unit shading normal. The shading frame is built from it where a method needs one
+pub enum MaterialKind {
+    /// Lambertian reflector.
+    Diffuse(Diffuse),
+    /// Perfect specular reflection.
+    Mirror(Mirror),
+    /// Smooth dielectric with exact unpolarised Fresnel.
+    Dielectric(Dielectric),
+    /// Rough conductor with a GGX (Trowbridge–Reitz) distribution and Smith shadowing,
+    /// optionally over a Lambertian base.
+    Glossy(Glossy),
+}
+
+/// Evaluates `$body` with `$model` bound to the model inside `$kind`, whichever it is: the one
+/// place that lists every model.
+macro_rules! with_model {
+    ($kind:expr, $model:ident => $body:expr) => {
+        match $kind {
+            MaterialKind::Diffuse($model) => $body,
+            MaterialKind::Mirror($model) => $body,
+            MaterialKind::Dielectric($model) => $body,
+            MaterialKind::Glossy($model) => $body,
+        }
+    };
+}
+
+/// One named parameter of a model, as the description checks, summaries and fingerprints read
+/// it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MaterialParam {
+    /// A colour, each channel finite and ≥ 0 (an albedo or reflectance also ≤ 1 in practice).
+    Colour(&'static str, Rgb),
+    /// A finite positive number.
+    Positive(&'static str, f32),
+}
+
+/// What a model needs of the surface point besides its own parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Shading {
+    /// The unit shading normal. The shading frame is built from it where a model needs one
     /// (`Frame::from_normal` is a pure function of it): a photon killed by the roulette, or a
     /// Lambertian evaluated against a normal, never needs the tangents.
-    normal: Vec3,
-    kind: MaterialKind,
-    /// For dielectrics: η on the far side of the shading normal over η on its side.
-    eta: f32,
-    /// A texture's colour multiplying a glossy BSDF (one otherwise: a diffuse albedo or a mirror
-    /// reflectance takes the texture into `kind` itself).
-    tint: Rgb,
+    pub(crate) normal: Vec3,
+    /// η on the far side of the shading normal over η on its side ([`Model::eta`]).
+    pub(crate) eta: f32,
+    /// A texture's colour that the model keeps apart from its parameters ([`Model::tint`]).
+    pub(crate) tint: Rgb,
+}
+
+/// The interface of a scattering model. Local directions are in the shading frame (z along the
+/// shading normal).
+pub(crate) trait Model: Copy {
+    /// Its name in scene files and summaries.
+    fn name(&self) -> &'static str;
+    /// The lobe for the frequency operators.
+    fn lobe(&self) -> Lobe;
+    /// The reflectance it shows at normal incidence (the albedo AOV).
+    fn albedo(&self) -> Rgb;
+    /// Its parameters, in the order the description checks report them.
+    fn params(&self) -> Vec<MaterialParam>;
+    /// Folds a texture's colour into the model where the colour is one of its parameters, and
+    /// returns the factor it keeps apart instead (one where it folded or ignores it).
+    fn tint(&mut self, tint: Rgb) -> Rgb;
+    /// Its albedo if it is Lambertian: the photon loop then decides the roulette and evaluates
+    /// gathered photons without the shading frame.
+    fn lambertian_albedo(&self) -> Option<Rgb> {
+        None
+    }
+    /// η on the far side of the shading normal over η on its side, where the normal faces the
+    /// outside if `front_face`; one for models that do not refract.
+    fn eta(&self, _front_face: bool) -> f32 {
+        1.0
+    }
+    /// The index of refraction relative to the outside, for models that refract.
+    fn refractive_index(&self) -> Option<f32> {
+        None
+    }
+    /// f(outgoing, incoming) computed without the shading frame, where the model can.
+    fn eval_world(&self, _s: &Shading, _outgoing: Vec3, _incoming: Vec3) -> Option<Rgb> {
+        None
+    }
+    /// f for local directions on the same side, both mirrored into the upper hemisphere; zero
+    /// for delta lobes.
+    fn eval_local(&self, s: &Shading, wo: Vec3, wi: Vec3) -> Rgb;
+    /// The solid-angle density of [`Model::sample_local`] for local directions on the same
+    /// side, both in the upper hemisphere; zero for delta lobes.
+    fn pdf_local(&self, wo: Vec3, wi: Vec3) -> f32;
+    /// Draws `incoming` for the local `wo` (either side, finite, z ≠ 0).
+    fn sample_local(
+        &self,
+        s: &Shading,
+        frame: &Frame,
+        wo: Vec3,
+        u_lobe: f32,
+        u: Vec2,
+        mode: TransportMode,
+    ) -> Option<BsdfSample>;
 }
 
 impl MaterialKind {
-    /// The lobe for the frequency operators. A glossy material with a diffuse base reports its GGX lobe.
+    /// The model's name in scene files and summaries: `diffuse`, `mirror`, `dielectric`,
+    /// `glossy`.
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        with_model!(self, m => m.name())
+    }
+
+    /// The lobe for the frequency operators. A glossy material with a diffuse base reports its
+    /// GGX lobe.
+    #[must_use]
     pub fn lobe(&self) -> Lobe {
-        match *self {
-            MaterialKind::Diffuse { .. } => Lobe::Lambert,
-            MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. } => Lobe::Specular,
-            MaterialKind::Glossy { roughness, .. } => Lobe::Ggx { alpha: roughness },
-        }
+        with_model!(self, m => m.lobe())
     }
 
     /// Whether every lobe is a delta (mirror, smooth dielectric).
+    #[must_use]
     pub fn is_specular(&self) -> bool {
-        matches!(
-            self,
-            MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. }
-        )
+        self.lobe() == Lobe::Specular
     }
+
+    /// The reflectance the material shows at normal incidence (the albedo AOV): a diffuse
+    /// albedo, a mirror's reflectance, one for a dielectric, specular plus diffuse for a glossy
+    /// material.
+    #[must_use]
+    pub fn albedo(&self) -> Rgb {
+        with_model!(self, m => m.albedo())
+    }
+
+    /// The model's parameters, by name.
+    #[must_use]
+    pub fn params(&self) -> Vec<MaterialParam> {
+        with_model!(self, m => m.params())
+    }
+
+    /// The albedo of a Lambertian model, `None` for every other model.
+    #[inline]
+    #[must_use]
+    pub fn lambertian_albedo(&self) -> Option<Rgb> {
+        with_model!(self, m => m.lambertian_albedo())
+    }
+
+    /// The index of refraction relative to the outside, for a model that refracts.
+    #[must_use]
+    pub fn refractive_index(&self) -> Option<f32> {
+        with_model!(self, m => m.refractive_index())
+    }
+}
+
+/// A material's scattering at one surface point, in the hit's shading frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bsdf {
+    kind: MaterialKind,
+    shading: Shading,
 }
 
 impl Bsdf {
@@ -118,21 +242,13 @@ impl Bsdf {
     /// outside of a dielectric.
     #[inline]
     pub fn from_normal(kind: MaterialKind, normal: Vec3, front_face: bool) -> Self {
-        let eta = match kind {
-            MaterialKind::Dielectric { ior } => {
-                if front_face {
-                    ior
-                } else {
-                    1.0 / ior
-                }
-            }
-            _ => 1.0,
-        };
         Self {
-            normal,
             kind,
-            eta,
-            tint: Rgb::ONE,
+            shading: Shading {
+                normal,
+                eta: with_model!(kind, m => m.eta(front_face)),
+                tint: Rgb::ONE,
+            },
         }
     }
 
@@ -142,12 +258,7 @@ impl Bsdf {
     #[inline]
     pub fn tinted(kind: MaterialKind, normal: Vec3, front_face: bool, tint: Rgb) -> Self {
         let mut bsdf = Self::from_normal(kind, normal, front_face);
-        match &mut bsdf.kind {
-            MaterialKind::Diffuse { albedo } => *albedo *= tint,
-            MaterialKind::Mirror { reflectance } => *reflectance *= tint,
-            MaterialKind::Glossy { .. } => bsdf.tint = tint,
-            MaterialKind::Dielectric { .. } => {}
-        }
+        bsdf.shading.tint = with_model!(&mut bsdf.kind, m => m.tint(tint));
         bsdf
     }
 
@@ -160,7 +271,7 @@ impl Bsdf {
     /// The shading frame (its `n` is the shading normal).
     #[inline]
     pub fn frame(&self) -> Frame {
-        Frame::from_normal(self.normal)
+        Frame::from_normal(self.shading.normal)
     }
 
     /// Whether the BSDF is purely specular (mirror, smooth dielectric): [`Bsdf::eval`] is then always zero.
@@ -173,36 +284,40 @@ impl Bsdf {
         self.kind.lobe()
     }
 
+    /// The albedo of a Lambertian BSDF (texture included), `None` for every other model: what
+    /// the photon loop needs to decide its roulette before sampling.
+    #[inline]
+    pub fn lambertian_albedo(&self) -> Option<Rgb> {
+        self.kind.lambertian_albedo()
+    }
+
+    /// f(outgoing, incoming) of `kind` about the unit `normal` (which faces its outside), as
+    /// [`Bsdf::eval`] gives it: a Lambertian evaluated here, inline and without a frame (the
+    /// photon gather's inner loop), every other model through [`Bsdf::eval`].
+    #[inline]
+    pub fn eval_about(kind: MaterialKind, normal: Vec3, outgoing: Vec3, incoming: Vec3) -> Rgb {
+        match kind.lambertian_albedo() {
+            Some(albedo) => diffuse::eval_world(albedo, normal, outgoing, incoming),
+            None => Self::from_normal(kind, normal, true).eval(outgoing, incoming),
+        }
+    }
+
     /// The BSDF value f(outgoing, incoming), without the cosine; zero for delta lobes.
     pub fn eval(&self, outgoing: Vec3, incoming: Vec3) -> Rgb {
-        if let MaterialKind::Diffuse { albedo } = self.kind {
-            // The local z of both directions, without the tangents.
-            return if outgoing.dot(self.normal) * incoming.dot(self.normal) <= 0.0 {
-                Rgb::ZERO
-            } else {
-                albedo * FRAC_1_PI
-            };
-        }
-        let frame = self.frame();
-        let (wo, wi) = (frame.to_local(outgoing), frame.to_local(incoming));
-        if wo.z * wi.z <= 0.0 {
-            return Rgb::ZERO;
-        }
-        // Two-sided: mirror both into the upper hemisphere.
-        let (wo, wi) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
-        match self.kind {
-            MaterialKind::Diffuse { albedo } => albedo * FRAC_1_PI,
-            MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. } => Rgb::ZERO,
-            MaterialKind::Glossy {
-                reflectance,
-                roughness,
-                diffuse,
-            } => {
-                (coupled_diffuse(wo, wi, reflectance, diffuse)
-                    + ggx_eval(wo, wi, roughness, reflectance))
-                    * self.tint
+        let s = &self.shading;
+        with_model!(self.kind, m => {
+            if let Some(f) = m.eval_world(s, outgoing, incoming) {
+                return f;
             }
-        }
+            let frame = self.frame();
+            let (wo, wi) = (frame.to_local(outgoing), frame.to_local(incoming));
+            if wo.z * wi.z <= 0.0 {
+                return Rgb::ZERO;
+            }
+            // Two-sided: mirror both into the upper hemisphere.
+            let (wo, wi) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
+            m.eval_local(s, wo, wi)
+        })
     }
 
     /// Solid-angle density with which [`Bsdf::sample`] draws `incoming`; zero for delta lobes.
@@ -213,18 +328,7 @@ impl Bsdf {
             return 0.0;
         }
         let (wo, wi) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
-        match self.kind {
-            MaterialKind::Diffuse { .. } => wi.z * FRAC_1_PI,
-            MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. } => 0.0,
-            MaterialKind::Glossy {
-                reflectance,
-                roughness,
-                diffuse,
-            } => {
-                let p_spec = specular_probability(reflectance, diffuse, wo.z);
-                p_spec * ggx_pdf(wo, wi, roughness) + (1.0 - p_spec) * wi.z * FRAC_1_PI
-            }
-        }
+        with_model!(self.kind, m => m.pdf_local(wo, wi))
     }
 
     /// Draws `incoming` for `outgoing` with `u_lobe` ∈ [0, 1) choosing a lobe (Fresnel reflection vs
@@ -242,231 +346,16 @@ impl Bsdf {
         if wo.z == 0.0 || !wo.is_finite() {
             return None;
         }
-        match self.kind {
-            MaterialKind::Diffuse { albedo } => {
-                if albedo == Rgb::ZERO {
-                    return None;
-                }
-                let mut wi = cosine_hemisphere(u);
-                if wo.z < 0.0 {
-                    wi.z = -wi.z;
-                }
-                let pdf = wi.z.abs() * FRAC_1_PI;
-                (pdf > 0.0).then(|| BsdfSample {
-                    incoming: frame.to_world(wi),
-                    weight: albedo,
-                    pdf,
-                    is_specular: false,
-                    is_transmission: false,
-                })
-            }
-            MaterialKind::Mirror { reflectance } => {
-                if reflectance == Rgb::ZERO {
-                    return None;
-                }
-                Some(BsdfSample {
-                    incoming: frame.to_world(Vec3::new(-wo.x, -wo.y, wo.z)),
-                    weight: reflectance,
-                    pdf: 1.0,
-                    is_specular: true,
-                    is_transmission: false,
-                })
-            }
-            MaterialKind::Dielectric { .. } => self.sample_dielectric(&frame, wo, u_lobe, mode),
-            MaterialKind::Glossy {
-                reflectance,
-                roughness,
-                diffuse,
-            } => {
-                if reflectance == Rgb::ZERO && diffuse == Rgb::ZERO {
-                    return None;
-                }
-                let flip = wo.z < 0.0;
-                let wo_up = if flip { -wo } else { wo };
-                let p_spec = specular_probability(reflectance, diffuse, wo_up.z);
-                let wi_up = if u_lobe < p_spec {
-                    let wm = ggx_sample_visible_normal(wo_up, roughness, u);
-                    reflect(wo_up, wm)
-                } else {
-                    cosine_hemisphere(u)
-                };
-                if wi_up.z <= 0.0 {
-                    return None;
-                }
-                let f = coupled_diffuse(wo_up, wi_up, reflectance, diffuse)
-                    + ggx_eval(wo_up, wi_up, roughness, reflectance);
-                let pdf = p_spec * ggx_pdf(wo_up, wi_up, roughness)
-                    + (1.0 - p_spec) * wi_up.z * FRAC_1_PI;
-                if pdf.is_nan() || pdf <= 0.0 {
-                    return None;
-                }
-                let wi = if flip { -wi_up } else { wi_up };
-                Some(BsdfSample {
-                    incoming: frame.to_world(wi),
-                    weight: f * (wi_up.z / pdf) * self.tint,
-                    pdf,
-                    is_specular: false,
-                    is_transmission: false,
-                })
-            }
-        }
+        with_model!(self.kind, m => m.sample_local(&self.shading, &frame, wo, u_lobe, u, mode))
     }
-
-    fn sample_dielectric(
-        &self,
-        frame: &Frame,
-        wo: Vec3,
-        u_lobe: f32,
-        mode: TransportMode,
-    ) -> Option<BsdfSample> {
-        // Relative η across the boundary, seen from the side of `wo`.
-        let eta = if wo.z > 0.0 { self.eta } else { 1.0 / self.eta };
-        let r = fresnel_dielectric(wo.z.abs(), eta);
-        if u_lobe < r {
-            return Some(BsdfSample {
-                incoming: frame.to_world(Vec3::new(-wo.x, -wo.y, wo.z)),
-                weight: Rgb::ONE,
-                pdf: r,
-                is_specular: true,
-                is_transmission: false,
-            });
-        }
-        let wi = refract(wo, eta)?;
-        let scale = match mode {
-            TransportMode::Radiance => 1.0 / (eta * eta),
-            TransportMode::Importance => 1.0,
-        };
-        Some(BsdfSample {
-            incoming: frame.to_world(wi),
-            weight: Rgb::splat(scale),
-            pdf: 1.0 - r,
-            is_specular: true,
-            is_transmission: true,
-        })
-    }
-}
-
-/// The Lambertian base of a glossy material under its specular layer (Ashikhmin and Shirley
-/// 2000, eq. 5): 28/(23π)·diffuse·(1 − F₀)·(1 − (1 − cos θᵢ/2)⁵)·(1 − (1 − cos θₒ/2)⁵), with
-/// both directions in the upper hemisphere.
-fn coupled_diffuse(wo: Vec3, wi: Vec3, reflectance: Rgb, diffuse: Rgb) -> Rgb {
-    if diffuse == Rgb::ZERO {
-        return Rgb::ZERO;
-    }
-    let fade = |cos: f32| 1.0 - (1.0 - 0.5 * cos.abs()).powi(5);
-    diffuse * (Rgb::ONE - reflectance) * (28.0 / (23.0 * PI) * fade(wo.z) * fade(wi.z))
-}
-
-/// Probability of sampling the GGX lobe of a glossy material seen at cosine `cos_o`: proportional
-/// to the lobes' albedos there (luminance of Schlick's Fresnel at that angle, which grows toward
-/// grazing even for a black `reflectance`, vs the diffuse base under the specular layer).
-fn specular_probability(reflectance: Rgb, diffuse: Rgb, cos_o: f32) -> f32 {
-    let c = (1.0 - cos_o.abs().min(1.0)).powi(5);
-    let s = luminance(reflectance + (Rgb::ONE - reflectance) * c);
-    let d = luminance(diffuse * (Rgb::ONE - reflectance));
-    if s + d > 0.0 { s / (s + d) } else { 0.5 }
 }
 
 /// Rec.709 luminance.
-pub(crate) fn luminance(c: Rgb) -> f32 {
+pub fn luminance(c: Rgb) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
 /// Mirror of `w` about the unit normal `n` (both pointing away from the surface).
 fn reflect(w: Vec3, n: Vec3) -> Vec3 {
     -w + 2.0 * w.dot(n) * n
-}
-
-/// Unpolarised Fresnel reflectance of a smooth dielectric boundary for light arriving at
-/// `cos_theta_i` (≥ 0) from the side with η₁, where `eta` = η₂/η₁. Total internal reflection gives 1.
-pub fn fresnel_dielectric(cos_theta_i: f32, eta: f32) -> f32 {
-    let cos_i = cos_theta_i.clamp(0.0, 1.0);
-    let sin2_i = 1.0 - cos_i * cos_i;
-    let sin2_t = sin2_i / (eta * eta);
-    if sin2_t >= 1.0 {
-        return 1.0;
-    }
-    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
-    let r_parallel = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let r_perpendicular = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    0.5 * (r_parallel * r_parallel + r_perpendicular * r_perpendicular)
-}
-
-/// Refraction of the local direction `wo` (either side of z) through the z = 0 boundary with relative
-/// η = η(far side)/η(side of `wo`); `None` under total internal reflection.
-fn refract(wo: Vec3, eta: f32) -> Option<Vec3> {
-    let n = if wo.z > 0.0 { Vec3::Z } else { -Vec3::Z };
-    let cos_i = wo.z.abs();
-    let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
-    let sin2_t = sin2_i / (eta * eta);
-    if sin2_t >= 1.0 {
-        return None;
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    Some((-wo / eta + (cos_i / eta - cos_t) * n).normalize())
-}
-
-/// GGX normal distribution D(ωm) for roughness α.
-fn ggx_d(wm: Vec3, alpha: f32) -> f32 {
-    let a2 = alpha * alpha;
-    let c2 = wm.z * wm.z;
-    let denom = c2 * (a2 - 1.0) + 1.0;
-    a2 / (PI * denom * denom)
-}
-
-/// Smith Λ(ω) for GGX.
-fn ggx_lambda(w: Vec3, alpha: f32) -> f32 {
-    let c2 = w.z * w.z;
-    let s2 = (1.0 - c2).max(0.0);
-    if c2 == 0.0 {
-        return f32::INFINITY;
-    }
-    let tan2 = s2 / c2;
-    0.5 * ((1.0 + alpha * alpha * tan2).sqrt() - 1.0)
-}
-
-/// The GGX conductor: D·G₂·F/(4 cos θₒ cos θᵢ) with height-correlated Smith G₂ and Schlick's Fresnel
-/// with `reflectance` as F₀. Both directions in the upper hemisphere.
-fn ggx_eval(wo: Vec3, wi: Vec3, alpha: f32, reflectance: Rgb) -> Rgb {
-    let wm = wo + wi;
-    if wm == Vec3::ZERO || wo.z <= 0.0 || wi.z <= 0.0 {
-        return Rgb::ZERO;
-    }
-    let wm = wm.normalize();
-    let g2 = 1.0 / (1.0 + ggx_lambda(wo, alpha) + ggx_lambda(wi, alpha));
-    let c = (1.0 - wi.dot(wm).clamp(0.0, 1.0)).powi(5);
-    let fresnel = reflectance + (Rgb::ONE - reflectance) * c;
-    fresnel * (ggx_d(wm, alpha) * g2 / (4.0 * wo.z * wi.z))
-}
-
-/// Density of [`ggx_sample_visible_normal`] followed by reflection: D(ωm)·G₁(ωₒ)/(4 cos θₒ).
-fn ggx_pdf(wo: Vec3, wi: Vec3, alpha: f32) -> f32 {
-    let wm = wo + wi;
-    if wm == Vec3::ZERO || wo.z <= 0.0 || wi.z <= 0.0 {
-        return 0.0;
-    }
-    let wm = wm.normalize();
-    let g1 = 1.0 / (1.0 + ggx_lambda(wo, alpha));
-    ggx_d(wm, alpha) * g1 / (4.0 * wo.z)
-}
-
-/// Samples a microfacet normal from the distribution of normals visible from `wo` (Heitz 2018,
-/// "Sampling the GGX Distribution of Visible Normals"); `wo.z > 0`.
-fn ggx_sample_visible_normal(wo: Vec3, alpha: f32, u: Vec2) -> Vec3 {
-    // Stretch to the hemisphere configuration.
-    let vh = Vec3::new(alpha * wo.x, alpha * wo.y, wo.z).normalize();
-    let len2 = vh.x * vh.x + vh.y * vh.y;
-    let t1 = if len2 > 0.0 {
-        Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt()
-    } else {
-        Vec3::X
-    };
-    let t2 = vh.cross(t1);
-    // A point on the projected disc, warped toward the visible half.
-    let p = concentric_disk(u);
-    let s = 0.5 * (1.0 + vh.z);
-    let py = (1.0 - s) * (1.0 - p.x * p.x).max(0.0).sqrt() + s * p.y;
-    let nh = p.x * t1 + py * t2 + (1.0 - p.x * p.x - py * py).max(0.0).sqrt() * vh;
-    // Unstretch.
-    Vec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(1e-6)).normalize()
 }

@@ -19,17 +19,17 @@ fn outgoing(b: &Bsdf, theta_deg: f32) -> Vec3 {
 }
 
 fn diffuse(a: f32) -> MaterialKind {
-    MaterialKind::Diffuse {
+    MaterialKind::Diffuse(crate::Diffuse {
         albedo: Rgb::splat(a),
-    }
+    })
 }
 
 fn glossy(roughness: f32, reflectance: f32, diffuse: f32) -> MaterialKind {
-    MaterialKind::Glossy {
+    MaterialKind::Glossy(crate::Glossy {
         reflectance: Rgb::splat(reflectance),
         roughness,
         diffuse: Rgb::splat(diffuse),
-    }
+    })
 }
 
 /// ∫ f cos dω over the sphere by stratified uniform sampling of eval.
@@ -72,13 +72,13 @@ fn white_furnace() {
         assert!((albedo_by_eval(&lambert, wo) - 1.0).abs() < 2e-3);
         assert!((albedo_by_sampling(&lambert, wo, TransportMode::Radiance) - 1.0).abs() < 1e-6);
 
-        let mirror = bsdf(MaterialKind::Mirror {
+        let mirror = bsdf(MaterialKind::Mirror(crate::Mirror {
             reflectance: Rgb::ONE,
-        });
+        }));
         assert!((albedo_by_sampling(&mirror, wo, TransportMode::Radiance) - 1.0).abs() < 1e-6);
 
         for ior in [1.33, 1.5, 2.4] {
-            let glass = bsdf(MaterialKind::Dielectric { ior });
+            let glass = bsdf(MaterialKind::Dielectric(crate::Dielectric { ior }));
             // Flux is conserved: R + T = 1.
             let e = albedo_by_sampling(&glass, wo, TransportMode::Importance);
             assert!((e - 1.0).abs() < 1e-6, "{e}");
@@ -163,7 +163,11 @@ fn dielectric_fresnel_and_refraction() {
 
     let n = Vec3::new(0.3, -0.2, 0.9).normalize();
     for front_face in [true, false] {
-        let glass = Bsdf::from_normal(MaterialKind::Dielectric { ior: 1.5 }, n, front_face);
+        let glass = Bsdf::from_normal(
+            MaterialKind::Dielectric(crate::Dielectric { ior: 1.5 }),
+            n,
+            front_face,
+        );
         // η of the side `incoming` refracts into, over η of the side of `outgoing`.
         let eta = if front_face { 1.5 } else { 1.0 / 1.5 };
         for theta in [0.0f32, 20.0, 40.0, 60.0, 80.0] {
@@ -357,14 +361,17 @@ fn sampling_matches_pdf_chi_square() {
 fn lobes_for_frequency_analysis() {
     assert_eq!(diffuse(0.5).lobe(), Lobe::Lambert);
     assert_eq!(
-        MaterialKind::Mirror {
+        MaterialKind::Mirror(crate::Mirror {
             reflectance: Rgb::ONE
-        }
+        })
         .lobe(),
         Lobe::Specular
     );
-    assert_eq!(MaterialKind::Dielectric { ior: 1.5 }.lobe(), Lobe::Specular);
+    assert_eq!(
+        MaterialKind::Dielectric(crate::Dielectric { ior: 1.5 }).lobe(),
+        Lobe::Specular
+    );
     assert_eq!(glossy(0.3, 1.0, 0.0).lobe(), Lobe::Ggx { alpha: 0.3 });
-    assert!(bsdf(MaterialKind::Dielectric { ior: 1.5 }).is_specular());
+    assert!(bsdf(MaterialKind::Dielectric(crate::Dielectric { ior: 1.5 })).is_specular());
     assert!(!bsdf(glossy(0.3, 1.0, 0.0)).is_specular());
 }

@@ -593,9 +593,9 @@ fn scene_rejects_bad_cylinders() {
     assert!(err.to_string().contains("cannot"), "{err}");
     let mirror = Material {
         name: "m".into(),
-        kind: MaterialKind::Mirror {
+        kind: MaterialKind::Mirror(crate::Mirror {
             reflectance: Vec3::ONE,
-        },
+        }),
         emission: Vec3::ZERO,
         textures: None,
     };

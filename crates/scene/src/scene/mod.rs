@@ -283,8 +283,8 @@ impl Scene {
     ///
     /// `TEXTURED_HITS` must be [`Scene::textured_hits`] (debug builds assert it): the caller
     /// compiles its loop once per value and picks the copy once, so that the loop of an
-    /// untextured scene holds no trace of the textured case (in one loop, the test and the
-    /// join of the two cases cost a photon path about 130 instructions; docs/performance.md).
+    /// untextured scene holds no trace of the textured case: neither the test nor the join of
+    /// the two cases (docs/performance.md).
     /// With `false` in a scene that has textured hits, their cut-outs, normal maps and
     /// metallic-roughness textures would be ignored.
     #[doc(hidden)]
@@ -302,7 +302,7 @@ impl Scene {
 
     /// The closest hit in a scene with cut-outs or normal maps: the closest one the alpha
     /// tests let through. Out of line, returning the small `RawHit`, so that the queries of
-    /// untextured scenes compile as before.
+    /// untextured scenes compile without the textured case.
     #[inline(never)]
     fn intersect_raw_textured(&self, ray: &Ray) -> Option<RawHit> {
         if self.cutouts {
@@ -317,9 +317,8 @@ impl Scene {
     /// a scene that has either.
     ///
     /// The textured case is a call that takes the hit by value and returns only what it
-    /// changes: had it written a whole `Hit` through memory (as returning `Option<Hit>` from
-    /// an out-of-line query did), the untextured case inlined beside it would have had to
-    /// build its hit in that memory too, about 28 instructions more per photon bounce.
+    /// changes, so that the untextured case inlined beside it builds its hit in registers
+    /// rather than in memory (docs/performance.md).
     #[inline(always)]
     fn finish_hit(&self, ray: &Ray, raw: RawHit) -> Hit {
         let mut hit = self.hit(ray, raw);
@@ -403,8 +402,8 @@ impl Scene {
 
     /// The arithmetic is on `Vec3A` (one SSE instruction per vector operation instead of three
     /// scalar ones): the same IEEE operations in the same order as on `Vec3`, lane by lane, so the
-    /// same bits (dot products and lengths sum x, y, z in that order either way), for about 60
-    /// fewer instructions per hit.
+    /// same bits (dot products and lengths sum x, y, z in that order either way), in fewer
+    /// instructions (docs/performance.md).
     #[inline(always)]
     fn triangle_hit(&self, ray: &Ray, index: u32, t: f32, b1: f32, b2: f32) -> Hit {
         let tri = &self.description.triangles[index as usize];
@@ -431,8 +430,8 @@ impl Scene {
                 let [n0, n1, n2] = normals.map(Vec3A::from);
                 // The geometric normal where the interpolated one has no direction. Not
                 // `normalize_or_zero` and a comparison with zero, which is the same but compiles
-                // to a branch on n.x = 0 first: data dependent (axis-aligned walls against
-                // curved meshes), about two mispredictions per photon path in the Cornell box.
+                // to a branch on n.x = 0 first, which is data dependent (axis-aligned walls
+                // against curved meshes) and often mispredicted.
                 let n = (b0 * n0 + b1 * n1 + b2 * n2).normalize_or(geometric_normal);
                 if n.dot(geometric_normal) < 0.0 { -n } else { n }
             }
@@ -453,9 +452,9 @@ impl Scene {
     }
 
     /// Inlined, as [`Scene::cylinder_hit`] is, so that the hit of every kind of primitive is
-    /// built in registers: with these two called, the inlined triangle hit was written to the
-    /// memory their results arrive in, and reloaded from it with wide loads that the stores
-    /// just made could not forward, about 4 % of the photon loop's time (docs/performance.md).
+    /// built in registers: called, their results arrive in memory, where the inlined triangle
+    /// hit would be stored too and reloaded with wide loads that the stores just made cannot
+    /// forward (docs/performance.md).
     #[inline(always)]
     fn sphere_hit(&self, ray: &Ray, index: u32, t: f32) -> Hit {
         let s = &self.description.spheres[index as usize];
@@ -551,8 +550,8 @@ fn triangle_extra(tri: &crate::Triangle) -> TriangleExtra {
         }
         None => [0.0, 0.0],
     };
-    // The centroid and the bounds are the same expressions `triangle_hit` evaluated per hit
-    // before they were hoisted here, so hits are bit-identical.
+    // The centroid and the bounds are computed by the same expressions `triangle_hit` would
+    // evaluate per hit, so hoisting them here changes no bit.
     TriangleExtra {
         front_normal: front_normal.into(),
         curvature,

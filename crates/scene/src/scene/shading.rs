@@ -37,8 +37,8 @@ impl Scene {
     }
 
     /// The BSDF of `material` at `hit` (whose material it is), with its colour texture.
-    /// Inlined into the photon loop for untextured materials (as `Bsdf::new` was; outlined, the
-    /// call cost about 1 % of a photon path's instructions), the textured case out of line.
+    /// Inlined into the photon loop for untextured materials, where an outlined call would be
+    /// a noticeable share of a photon path (docs/performance.md); the textured case out of line.
     #[inline(always)]
     pub fn material_bsdf(&self, material: &Material, hit: &Hit) -> Bsdf {
         match material.textures.as_deref().and_then(|t| t.color.as_ref()) {

@@ -300,7 +300,7 @@ fn metallic_roughness_quad() -> Scene {
     d.materials.push(with_textures(
         crate::Material {
             name: "metal".into(),
-            kind: MaterialKind::Diffuse { albedo: base },
+            kind: MaterialKind::Diffuse(crate::Diffuse { albedo: base }),
             emission: Vec3::ZERO,
             textures: None,
         },
@@ -325,19 +325,19 @@ fn metallic_roughness_textures_choose_the_model_per_texel() {
     // Texel centres at x = 1/8, 3/8, 5/8, 7/8; the expected kinds are glTF's mapping of
     // each texel's (metallic, roughness), written out here rather than taken from the loader.
     let expected = [
-        MaterialKind::Diffuse { albedo: base },
-        MaterialKind::Mirror { reflectance: base },
-        MaterialKind::Glossy {
+        MaterialKind::Diffuse(crate::Diffuse { albedo: base }),
+        MaterialKind::Mirror(crate::Mirror { reflectance: base }),
+        MaterialKind::Glossy(crate::Glossy {
             reflectance: base,
             // Roughness 128/255 rounds to level 32 of 64: 0.5, α = 0.25.
             roughness: 0.25,
             diffuse: Vec3::ZERO,
-        },
-        MaterialKind::Glossy {
+        }),
+        MaterialKind::Glossy(crate::Glossy {
             reflectance: base,
             roughness: 1.0,
             diffuse: Vec3::ZERO,
-        },
+        }),
     ];
     let materials = scene.materials().len() as u32;
     for (i, want) in expected.iter().enumerate() {
@@ -377,7 +377,7 @@ fn metallic_roughness_levels_round_to_the_nearest() {
             let variant = mr.variant(Vec2::splat(0.5));
             let expected = if r < 0.01 { 1 } else { 1 + k };
             assert_eq!(variant, expected, "r = {r}");
-            if let crate::MaterialKind::Glossy { roughness, .. } =
+            if let crate::MaterialKind::Glossy(crate::Glossy { roughness, .. }) =
                 mr.variant_kinds()[variant as usize]
             {
                 assert!((roughness.sqrt() - r).abs() <= 0.5 / 64.0 + 1e-6, "r = {r}");

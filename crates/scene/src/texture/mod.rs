@@ -11,16 +11,16 @@
 //! for data (normal maps, alpha) and always for the alpha channel. EXR and Radiance HDR images
 //! hold linear floats and are never sRGB-decoded.
 
-mod image_file;
-
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use glam::{Vec2, Vec3, Vec4};
 
-pub(crate) use image_file::{TextureCache, check_exr_header, check_hdr_size};
+use crate::MaterialKind;
+use crate::fingerprint::{Fingerprint, Fingerprinter};
 
-/// A decoded image, loaded once per file and shared by every material that uses it.
+/// A decoded image, loaded once per file and shared by every material that uses it. The
+/// importers decode files into it ([`Image::new`]); nothing here reads a file.
 #[derive(Clone)]
 pub struct Image {
     path: PathBuf,
@@ -29,15 +29,53 @@ pub struct Image {
     texels: Texels,
     /// Whether the file has an alpha channel that masks something (some texel below ½);
     /// otherwise a cut-out reads the first channel (a grey mask).
-    pub(crate) has_alpha: bool,
+    has_alpha: bool,
+    /// [`Image::mean`] of the linear and the sRGB-decoded colours, computed on first use: every
+    /// emissive triangle under an emission texture weighs itself with it.
+    means: [OnceLock<Vec3>; 2],
 }
 
+/// The texels of an [`Image`], row-major from the top-left.
 #[derive(Clone)]
-enum Texels {
+pub enum Texels {
     /// 8-bit RGBA as stored in the file (sRGB-encoded or data).
     Bytes(Vec<[u8; 4]>),
     /// Linear RGBA floats (EXR, Radiance HDR).
     Floats(Vec<[f32; 4]>),
+}
+
+/// Why texels cannot make an [`Image`].
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ImageError {
+    /// The image has no texels.
+    #[error("texture has zero size ({width}x{height})")]
+    ZeroSize {
+        /// Width in texels.
+        width: u32,
+        /// Height in texels.
+        height: u32,
+    },
+    /// The texel count is not width × height.
+    #[error("texture of {width}x{height} texels holds {found} texels")]
+    WrongLength {
+        /// Width in texels.
+        width: u32,
+        /// Height in texels.
+        height: u32,
+        /// Texels given.
+        found: usize,
+    },
+    /// A float texel is NaN or infinite.
+    #[error("texture has a {} texel at ({x}, {y})", if *.nan { "nan" } else { "infinite" })]
+    NotFinite {
+        /// Column of the first such texel.
+        x: u32,
+        /// Row of the first such texel.
+        y: u32,
+        /// Whether it is a NaN (else an infinity).
+        nan: bool,
+    },
 }
 
 impl std::fmt::Debug for Image {
@@ -76,6 +114,65 @@ fn srgb_table() -> &'static [f32; 256] {
 }
 
 impl Image {
+    /// The image of `width` × `height` texels read from `path` (which names it in reports and
+    /// tells two textures apart). `alpha_channel` says whether the file has an alpha channel:
+    /// it counts as a mask only where some texel is below ½, since files whose mask is their
+    /// grey channel often carry an all-but-opaque alpha channel as well.
+    ///
+    /// # Errors
+    /// [`ImageError`] if the image is empty, the texels are not `width × height`, or a float
+    /// texel is NaN or infinite.
+    pub fn new(
+        path: PathBuf,
+        width: u32,
+        height: u32,
+        texels: Texels,
+        alpha_channel: bool,
+    ) -> Result<Self, ImageError> {
+        if width == 0 || height == 0 {
+            return Err(ImageError::ZeroSize { width, height });
+        }
+        let found = match &texels {
+            Texels::Bytes(t) => t.len(),
+            Texels::Floats(t) => t.len(),
+        };
+        if found as u64 != u64::from(width) * u64::from(height) {
+            return Err(ImageError::WrongLength {
+                width,
+                height,
+                found,
+            });
+        }
+        if let Texels::Floats(t) = &texels
+            && let Some(i) = t.iter().position(|t| !t.iter().all(|c| c.is_finite()))
+        {
+            return Err(ImageError::NotFinite {
+                x: i as u32 % width,
+                y: i as u32 / width,
+                nan: t[i].iter().any(|c| c.is_nan()),
+            });
+        }
+        let has_alpha = alpha_channel
+            && match &texels {
+                Texels::Bytes(t) => t.iter().any(|p| p[3] < 128),
+                Texels::Floats(t) => t.iter().any(|p| p[3] < 0.5),
+            };
+        Ok(Self {
+            path,
+            width,
+            height,
+            texels,
+            has_alpha,
+            means: Default::default(),
+        })
+    }
+
+    /// Whether the file's alpha channel masks something (some texel below ½); otherwise a
+    /// cut-out reads the first channel (a grey mask).
+    pub fn has_alpha(&self) -> bool {
+        self.has_alpha
+    }
+
     /// The file the image was read from.
     pub fn path(&self) -> &Path {
         &self.path
@@ -145,7 +242,11 @@ impl Image {
     }
 
     /// The mean of the image's colour channels (linear, sRGB-decoded if `srgb`).
-    pub(crate) fn mean(&self, srgb: bool) -> Vec3 {
+    pub fn mean(&self, srgb: bool) -> Vec3 {
+        *self.means[usize::from(srgb)].get_or_init(|| self.mean_of_texels(srgb))
+    }
+
+    fn mean_of_texels(&self, srgb: bool) -> Vec3 {
         let mut sum = glam::DVec3::ZERO;
         for y in 0..self.height {
             for x in 0..self.width {
@@ -166,6 +267,7 @@ pub(crate) fn test_image(width: u32, height: u32, texels: Vec<[u8; 4]>) -> Arc<I
         height,
         texels: Texels::Bytes(texels),
         has_alpha,
+        means: Default::default(),
     })
 }
 
@@ -283,6 +385,12 @@ pub struct NormalMap {
     pub scale: f32,
 }
 
+/// Metallic factor from which a glTF material counts as a conductor.
+pub const METALLIC_THRESHOLD: f32 = 0.5;
+
+/// Roughness below which a glTF conductor is a perfect mirror.
+pub const MIRROR_ROUGHNESS: f32 = 0.01;
+
 /// glTF's metallic-roughness texture, read per texel: metallic = `metallic` × blue, roughness
 /// = `roughness` × green (linear data). Each hit becomes the material glTF's mapping gives for
 /// its texel's values (diffuse, mirror or glossy, as glTF materials are mapped), with the
@@ -307,16 +415,36 @@ impl MetallicRoughness {
 
     /// The material kinds a hit can take, in variant order: the diffuse base, the mirror, then
     /// the conductor at each roughness level.
-    pub fn variant_kinds(&self) -> Vec<crate::MaterialKind> {
+    pub fn variant_kinds(&self) -> Vec<MaterialKind> {
         let mut kinds = vec![
-            crate::load::gltf_kind(self.base, 0.0, 1.0),
-            crate::load::gltf_kind(self.base, 1.0, 0.0),
+            Self::kind(self.base, 0.0, 1.0),
+            Self::kind(self.base, 1.0, 0.0),
         ];
         kinds.extend(
-            (1..=Self::LEVELS)
-                .map(|k| crate::load::gltf_kind(self.base, 1.0, k as f32 / Self::LEVELS as f32)),
+            (1..=Self::LEVELS).map(|k| Self::kind(self.base, 1.0, k as f32 / Self::LEVELS as f32)),
         );
         kinds
+    }
+
+    /// glTF's mapping of an opaque metallic-roughness material with base colour `base` to a
+    /// scattering model: a conductor (mirror below [`MIRROR_ROUGHNESS`], else glossy with
+    /// α = roughness² and no diffuse base) from metallic [`METALLIC_THRESHOLD`] on, else diffuse
+    /// with the base colour. The glTF importer maps untextured materials with it too.
+    #[must_use]
+    pub fn kind(base: Vec3, metallic: f32, roughness: f32) -> MaterialKind {
+        if metallic >= METALLIC_THRESHOLD {
+            if roughness < MIRROR_ROUGHNESS {
+                MaterialKind::Mirror(crate::Mirror { reflectance: base })
+            } else {
+                MaterialKind::Glossy(crate::Glossy {
+                    reflectance: base,
+                    roughness: roughness * roughness,
+                    diffuse: Vec3::ZERO,
+                })
+            }
+        } else {
+            MaterialKind::Diffuse(crate::Diffuse { albedo: base })
+        }
     }
 
     /// The variant (an index into [`MetallicRoughness::variant_kinds`]) at `uv`.
@@ -324,9 +452,9 @@ impl MetallicRoughness {
     pub fn variant(&self, uv: Vec2) -> u32 {
         let texel = self.texture.lookup(uv);
         let (metallic, roughness) = (self.metallic * texel.z, self.roughness * texel.y);
-        if metallic < crate::load::METALLIC_THRESHOLD {
+        if metallic < METALLIC_THRESHOLD {
             0
-        } else if roughness < crate::load::MIRROR_ROUGHNESS {
+        } else if roughness < MIRROR_ROUGHNESS {
             1
         } else {
             let level = (roughness.min(1.0) * Self::LEVELS as f32).round() as u32;
@@ -397,6 +525,55 @@ impl MaterialTextures {
         match alpha.mode {
             AlphaMode::Mask { cutoff } => a >= cutoff,
             AlphaMode::Blend => u < a,
+        }
+    }
+}
+
+impl Fingerprint for TextureRef {
+    /// The image by file and size (not its texels), and how it is read.
+    fn fingerprint(&self, h: &mut Fingerprinter) {
+        h.str(&self.image.path().to_string_lossy());
+        let (width, height) = self.image.resolution();
+        h.u32(width);
+        h.u32(height);
+        h.u32(u32::from(self.srgb));
+        self.wrap.iter().for_each(|&m| h.u32(m as u32));
+        self.transform.iter().for_each(|&c| h.f32(c));
+    }
+}
+
+impl Fingerprint for MaterialTextures {
+    /// Each use's texture (or its absence), with the use's own parameters.
+    fn fingerprint(&self, h: &mut Fingerprinter) {
+        let mut texture = |r: Option<&TextureRef>| match r {
+            None => h.u32(0),
+            Some(r) => {
+                h.u32(1);
+                h.add(r);
+            }
+        };
+        texture(self.color.as_ref());
+        texture(self.emission.as_ref());
+        texture(self.normal.as_ref().map(|n| &n.texture));
+        texture(self.alpha.as_ref().and_then(|a| a.texture.as_ref()));
+        texture(self.metallic_roughness.as_ref().map(|m| &m.texture));
+        if let Some(n) = &self.normal {
+            h.f32(n.scale);
+        }
+        if let Some(a) = &self.alpha {
+            h.f32(a.factor);
+            match a.mode {
+                AlphaMode::Mask { cutoff } => {
+                    h.str("mask");
+                    h.f32(cutoff);
+                }
+                AlphaMode::Blend => h.str("blend"),
+            }
+        }
+        if let Some(mr) = &self.metallic_roughness {
+            h.vec3(mr.base);
+            h.f32(mr.metallic);
+            h.f32(mr.roughness);
         }
     }
 }

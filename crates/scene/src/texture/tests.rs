@@ -11,6 +11,7 @@ fn image(width: u32, height: u32, texels: Vec<[u8; 4]>) -> Arc<Image> {
         height,
         texels: Texels::Bytes(texels),
         has_alpha: true,
+        means: Default::default(),
     })
 }
 

@@ -1,14 +1,14 @@
 //! Ray-query robustness on real data: McGuire's Cornell box (OBJ).
 #![allow(clippy::unwrap_used, missing_docs)]
 
-use geometry::{Film, Frame, Ray, Scene};
 use glam::{Vec2, Vec3};
+use scene::{Film, Frame, Ray, Scene};
 
 /// McGuire's Cornell box, read in place from the shared scenes beside the checkout.
 fn cornell() -> Scene {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/scenes/cornell_box/CornellBox-Original.obj");
-    let mut description = geometry::load(&path).unwrap();
+    let mut description = import::load(&path).unwrap();
     description.film = Film {
         width: 64,
         height: 64,
