@@ -6,13 +6,13 @@
 //! decompress; this one reaches the column decoder. A restored renderer runs one pass.
 #![no_main]
 
-use std::sync::LazyLock;
+use std::sync::{Arc, LazyLock};
 
 use fppm_fuzz::{checkpoint_scene, column_checkpoints};
-use scene::Scene;
 use libfuzzer_sys::fuzz_target;
+use scene::Scene;
 
-static SCENE: LazyLock<Scene> = LazyLock::new(checkpoint_scene);
+static SCENE: LazyLock<Arc<Scene>> = LazyLock::new(checkpoint_scene);
 static HEADS: LazyLock<Vec<Vec<u8>>> = LazyLock::new(|| {
     column_checkpoints(&SCENE)
         .into_iter()
@@ -26,7 +26,7 @@ fuzz_target!(|data: &[u8]| {
     };
     let head = &HEADS[usize::from(which) % HEADS.len()];
     let bytes = ppm::checkpoint_surgery::join(head, columns);
-    let Ok(mut renderer) = ppm::Renderer::restore(&SCENE, &bytes) else {
+    let Ok(mut renderer) = ppm::Renderer::restore(Arc::clone(&SCENE), &bytes) else {
         return;
     };
     renderer.iterate();

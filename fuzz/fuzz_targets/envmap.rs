@@ -18,10 +18,10 @@
 use std::sync::{Arc, LazyLock};
 
 use fppm_fuzz::{envmap_files, envmap_pbrt_files, fuzzed};
-use scene::{Environment, EnvironmentMap, EnvironmentRadiance, Scene, SceneDescription};
-use import::LoadOptions;
 use glam::{Vec2, Vec3};
+use import::LoadOptions;
 use libfuzzer_sys::fuzz_target;
+use scene::{Environment, EnvironmentMap, EnvironmentRadiance, Scene, SceneDescription};
 
 /// The scene with a constant sky, whose environment mode 2 replaces.
 static BASE: LazyLock<SceneDescription> = LazyLock::new(|| {

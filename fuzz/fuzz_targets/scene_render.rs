@@ -5,10 +5,13 @@
 #![no_main]
 
 use arbitrary::{Arbitrary, Unstructured};
-use scene::{Camera, Cylinder, Film, Light, LoadNotes, Material, MaterialKind, RenderDefaults, SceneDescription, Sphere, Triangle};
 use glam::Vec3;
 use libfuzzer_sys::fuzz_target;
 use ppm::{FrequencyFloor, MergePolicy, Method, RenderParams, Renderer};
+use scene::{
+    Camera, Cylinder, Film, Light, LoadNotes, Material, MaterialKind, RenderDefaults,
+    SceneDescription, Sphere, Triangle,
+};
 
 /// A float as the fuzzer picks it: mostly a small multiple of 1/16 (so that many scenes are
 /// valid and reach the integrators), sometimes a special value (zero, ±0, tiny, huge, NaN,
@@ -201,38 +204,38 @@ fn description(input: &Input) -> SceneDescription {
 fn params(input: &Input) -> RenderParams {
     let mut p = RenderParams::preview();
     p.method = Method::ALL[usize::from(input.method) % Method::ALL.len()];
-    p.photons_per_pass = u32::from(input.photons % 64) + 1;
-    p.max_depth = u32::from(input.max_depth % 12);
+    p.budget.photons_per_pass = u32::from(input.photons % 64) + 1;
+    p.budget.max_depth = u32::from(input.max_depth % 12);
     p.seed = input.seed;
     // Mostly in range, so that passes run; 0 is out of range for α and K.
-    p.alpha = f64::from(input.alpha) / 255.0;
-    p.freq_fraction = f64::from(input.freq_fraction) / 255.0;
-    p.kernel_k = f64::from(input.kernel_k) / 32.0;
-    p.freq_grow = 1.0 + f64::from(input.freq_grow) / 64.0;
+    p.kernel.alpha = f64::from(input.alpha) / 255.0;
+    p.frequency.fraction = f64::from(input.freq_fraction) / 255.0;
+    p.frequency.kernel_k = f64::from(input.kernel_k) / 32.0;
+    p.frequency.grow = 1.0 + f64::from(input.freq_grow) / 64.0;
     if let Some((which, value)) = input.wild {
         match which % 5 {
-            0 => p.alpha = value,
-            1 => p.freq_fraction = value,
-            2 => p.kernel_k = value,
-            3 => p.freq_grow = value,
-            _ => p.freq_hold_alpha = value,
+            0 => p.kernel.alpha = value,
+            1 => p.frequency.fraction = value,
+            2 => p.frequency.kernel_k = value,
+            3 => p.frequency.grow = value,
+            _ => p.frequency.hold_alpha = value,
         }
     }
-    p.freq_pilot = u32::from(input.freq_pilot % 4);
-    p.freq_merge = if input.options & 1 == 0 {
+    p.frequency.pilot = u32::from(input.freq_pilot % 4);
+    p.frequency.merge = if input.options & 1 == 0 {
         MergePolicy::MinRadius
     } else {
         MergePolicy::PosterMax
     };
-    p.freq_floor = if input.options & 2 == 0 {
+    p.frequency.floor = if input.options & 2 == 0 {
         FrequencyFloor::Keep
     } else {
         FrequencyFloor::Clamp
     };
-    p.freq_occlusion = input.options & 4 != 0;
-    p.freq_geometry = input.options & 8 != 0;
-    p.direct_lighting = input.options & 16 != 0;
-    p.freq_clear_cap = input.options & 32 != 0;
+    p.frequency.occlusion = input.options & 4 != 0;
+    p.frequency.geometry = input.options & 8 != 0;
+    p.connections.direct_lighting = input.options & 16 != 0;
+    p.frequency.clear_cap = input.options & 32 != 0;
     p
 }
 
@@ -240,7 +243,7 @@ fuzz_target!(|input: Input| {
     let Some(scene) = fppm_fuzz::build(description(&input)) else {
         return;
     };
-    let Ok(mut renderer) = Renderer::new(&scene, params(&input)) else {
+    let Ok(mut renderer) = Renderer::new(scene, params(&input)) else {
         return;
     };
     renderer.iterate();

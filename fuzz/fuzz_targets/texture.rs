@@ -7,11 +7,11 @@
 #![no_main]
 
 use fppm_fuzz::texture_files;
+use glam::{Vec2, Vec3};
+use import::LoadOptions;
+use libfuzzer_sys::fuzz_target;
 use scene::texture::{TextureRef, Wrap};
 use scene::{Ray, Scene};
-use import::LoadOptions;
-use glam::{Vec2, Vec3};
-use libfuzzer_sys::fuzz_target;
 
 /// Texture coordinates at the edges, outside [0, 1], huge and not finite.
 const UVS: [(f32, f32); 10] = [
@@ -29,8 +29,7 @@ const UVS: [(f32, f32); 10] = [
 
 fuzz_target!(|data: &[u8]| {
     let (path, files) = texture_files(data.to_vec());
-    let Ok(description) = import::load_from(&path, files, &LoadOptions::allow_no_emitter())
-    else {
+    let Ok(description) = import::load_from(&path, files, &LoadOptions::allow_no_emitter()) else {
         return;
     };
     let textures: Vec<TextureRef> = description

@@ -68,10 +68,10 @@ pub fn split_nul(data: &[u8]) -> (&[u8], &[u8]) {
 ///
 /// If [`CHECKPOINT_SCENE`] does not load (a bug of the harness, caught by xtask's tests).
 #[must_use]
-pub fn checkpoint_scene() -> scene::Scene {
+pub fn checkpoint_scene() -> std::sync::Arc<scene::Scene> {
     let description = import::load_toml_str(CHECKPOINT_SCENE, &fuzzed("checkpoint_scene.toml"))
         .expect("the checkpoint scene loads");
-    scene::Scene::new(description).expect("the checkpoint scene builds")
+    std::sync::Arc::new(scene::Scene::new(description).expect("the checkpoint scene builds"))
 }
 
 /// Bytes of a checkpoint before the fuzzed body: magic, format version, scene fingerprint.
@@ -269,8 +269,8 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 pub fn checkpoint_params(method: ppm::Method) -> ppm::RenderParams {
     let mut params = ppm::RenderParams::preview();
     params.method = method;
-    params.photons_per_pass = 64;
-    params.max_depth = 8;
+    params.budget.photons_per_pass = 64;
+    params.budget.max_depth = 8;
     params
 }
 
@@ -283,10 +283,12 @@ pub fn checkpoint_params(method: ppm::Method) -> ppm::RenderParams {
 ///
 /// If a checkpoint just saved does not split (a bug of the harness or of the library).
 #[must_use]
-pub fn column_checkpoints(scene: &scene::Scene) -> Vec<(String, Vec<u8>, Vec<u8>)> {
+pub fn column_checkpoints(scene: &std::sync::Arc<scene::Scene>) -> Vec<(String, Vec<u8>, Vec<u8>)> {
     let mut out = Vec::new();
     for method in ppm::Method::ALL {
-        let Ok(mut renderer) = ppm::Renderer::new(scene, checkpoint_params(method)) else {
+        let Ok(mut renderer) =
+            ppm::Renderer::new(std::sync::Arc::clone(scene), checkpoint_params(method))
+        else {
             continue;
         };
         for pass in 1..=2 {

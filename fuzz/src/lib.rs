@@ -8,8 +8,8 @@ mod harness;
 
 use std::path::Path;
 
-use scene::{Scene, SceneDescription};
 use import::LoadOptions;
+use scene::{Scene, SceneDescription};
 
 pub use harness::*;
 

@@ -10,6 +10,7 @@
 mod architecture;
 mod mitsuba_roundtrip;
 mod pbrt_by_hand;
+mod rays;
 mod shared_scenes;
 
 /// `passes` path-traced passes (max depth 5, `seed`) of `scene` on a `width × height` film:
@@ -21,12 +22,12 @@ fn path_image(
     passes: u32,
 ) -> Vec<[f32; 3]> {
     scene.film = scene::Film { width, height };
-    let scene = scene::Scene::new(scene).unwrap();
+    let scene = std::sync::Arc::new(scene::Scene::new(scene).unwrap());
     let mut params = ppm::RenderParams::preview();
     params.method = ppm::Method::Path;
-    params.max_depth = 5;
+    params.budget.max_depth = 5;
     params.seed = seed;
-    let mut renderer = ppm::Renderer::new(&scene, params).unwrap();
+    let mut renderer = ppm::Renderer::new(std::sync::Arc::clone(&scene), params).unwrap();
     for _ in 0..passes {
         renderer.iterate();
     }

@@ -41,12 +41,12 @@ fn every_lit_shared_scene_renders_with_every_method() {
             width: 12,
             height: 12,
         };
-        let scene = Scene::new(description).unwrap();
+        let scene = std::sync::Arc::new(Scene::new(description).unwrap());
         for method in Method::ALL {
             let mut params = RenderParams::preview();
             params.method = method;
-            params.photons_per_pass = 3_000;
-            let mut renderer = Renderer::new(&scene, params).unwrap();
+            params.budget.photons_per_pass = 3_000;
+            let mut renderer = Renderer::new(std::sync::Arc::clone(&scene), params).unwrap();
             renderer.iterate();
             let image = renderer.image();
             assert!(

@@ -538,9 +538,9 @@ mod seeds {
         let scene = harness::checkpoint_scene();
         let mut params = ppm::RenderParams::preview();
         params.method = ppm::Method::Appm;
-        params.photons_per_pass = 64;
-        params.max_depth = 8;
-        let mut renderer = ppm::Renderer::new(&scene, params)?;
+        params.budget.photons_per_pass = 64;
+        params.budget.max_depth = 8;
+        let mut renderer = ppm::Renderer::new(std::sync::Arc::clone(&scene), params)?;
         renderer.iterate();
         renderer.iterate();
         let rendered = renderer
@@ -721,7 +721,10 @@ mod seeds {
         let scene = harness::checkpoint_scene();
         let mut out = Vec::new();
         for method in ppm::Method::ALL {
-            let mut renderer = ppm::Renderer::new(&scene, harness::checkpoint_params(method))?;
+            let mut renderer = ppm::Renderer::new(
+                std::sync::Arc::clone(&scene),
+                harness::checkpoint_params(method),
+            )?;
             for pass in 1..=2 {
                 renderer.iterate();
                 let saved = renderer.save_state("seed");
@@ -783,7 +786,7 @@ mod tests {
         assert_eq!(seeds.len(), 2 * ppm::Method::ALL.len());
         for (name, body) in &seeds {
             let bytes = harness::checkpoint_bytes(&scene, body);
-            let restored = ppm::Renderer::restore(&scene, &bytes);
+            let restored = ppm::Renderer::restore(std::sync::Arc::clone(&scene), &bytes);
             assert!(restored.is_ok(), "{name}: {:?}", restored.err());
         }
     }
@@ -855,7 +858,7 @@ mod tests {
         assert_eq!(split.len(), 2 * ppm::Method::ALL.len());
         for (name, head, columns) in &split {
             let bytes = ppm::checkpoint_surgery::join(head, columns);
-            let restored = ppm::Renderer::restore(&scene, &bytes);
+            let restored = ppm::Renderer::restore(std::sync::Arc::clone(&scene), &bytes);
             assert!(restored.is_ok(), "{name}: {:?}", restored.err());
         }
     }

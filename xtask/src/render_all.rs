@@ -191,7 +191,7 @@ fn golden_path(root: &Path, name: &str) -> PathBuf {
 fn bless(root: &Path, entry: &SuiteScene, golden: &Path) -> Result<()> {
     let scene = suite::load_scene(root, entry)?;
     let mut params = suite::params(entry, &scene, ppm::Method::Path, REFERENCE_SEED)?;
-    params.samples_per_pixel = entry.reference_spp;
+    params.film.samples_per_pixel = entry.reference_spp;
     let rendered = suite::render(&scene, params, entry.reference_passes)?;
     std::fs::create_dir_all(golden.parent().context("golden path has a parent")?)?;
     film::write_exr(golden, &film::Frame::new(rendered.image.clone()))?;

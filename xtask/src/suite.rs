@@ -2,6 +2,7 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
@@ -67,7 +68,7 @@ fn one() -> u32 {
 }
 
 fn default_depth() -> u32 {
-    ppm::RenderParams::preview().max_depth
+    ppm::RenderParams::preview().budget.max_depth
 }
 
 /// Reads `tests/scenes.toml`.
@@ -81,7 +82,7 @@ pub(crate) fn load_suite(root: &Path) -> Result<Suite> {
 }
 
 /// Loads the scene file with the suite's film size.
-pub(crate) fn load_scene(root: &Path, entry: &SuiteScene) -> Result<scene::Scene> {
+pub(crate) fn load_scene(root: &Path, entry: &SuiteScene) -> Result<Arc<scene::Scene>> {
     load_scene_sized(root, &entry.path, entry.width, entry.height)
 }
 
@@ -91,13 +92,15 @@ pub(crate) fn load_scene_sized(
     path: &Path,
     width: u32,
     height: u32,
-) -> Result<scene::Scene> {
+) -> Result<Arc<scene::Scene>> {
     let path = root.join(path);
     let mut description =
         import::load(&path).with_context(|| format!("loading {}", path.display()))?;
     description.film.width = width;
     description.film.height = height;
-    scene::Scene::new(description).with_context(|| format!("building {}", path.display()))
+    let scene =
+        scene::Scene::new(description).with_context(|| format!("building {}", path.display()))?;
+    Ok(Arc::new(scene))
 }
 
 /// The parameters of `method` on `entry` at the check budget: the scene's `[render]` table,
@@ -113,9 +116,9 @@ pub(crate) fn params(
         .with_context(|| format!("[render] table of {}", entry.path.display()))?;
     params.method = method;
     params.seed = seed;
-    params.max_depth = entry.max_depth;
-    params.photons_per_pass = entry.photons;
-    params.samples_per_pixel = if method == ppm::Method::Path {
+    params.budget.max_depth = entry.max_depth;
+    params.budget.photons_per_pass = entry.photons;
+    params.film.samples_per_pixel = if method == ppm::Method::Path {
         1
     } else {
         entry.spp
@@ -131,12 +134,13 @@ pub(crate) struct Rendered {
 
 /// Renders `passes` passes of `params` and returns the image.
 pub(crate) fn render(
-    scene: &scene::Scene,
+    scene: &Arc<scene::Scene>,
     params: ppm::RenderParams,
     passes: u32,
 ) -> Result<Rendered> {
     let start = Instant::now();
-    let mut renderer = ppm::Renderer::new(scene, params).context("render parameters")?;
+    let mut renderer =
+        ppm::Renderer::new(Arc::clone(scene), params).context("render parameters")?;
     for _ in 0..passes {
         renderer.iterate();
     }

@@ -22,9 +22,9 @@ static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 pub(crate) fn render(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Result<Outcome> {
     let job = settings::render_job(scene, args)?;
     check_memory(&job)?;
-    let scene = scene::Scene::new(job.description.clone())?;
+    let scene = std::sync::Arc::new(scene::Scene::new(job.description.clone())?);
     in_pool(job.run.threads, || {
-        let renderer = Renderer::new(&scene, job.params)
+        let renderer = Renderer::new(std::sync::Arc::clone(&scene), job.params)
             .map_err(|e| anyhow::anyhow!("{}: {e}", job.description.source.display()))?;
         drive(&job, renderer)
     })
@@ -69,9 +69,9 @@ pub(crate) fn resume(args: &ResumeArgs) -> anyhow::Result<Outcome> {
         earlier_seconds: note.render_seconds,
     };
     check_memory(&job)?;
-    let scene = scene::Scene::new(job.description.clone())?;
+    let scene = std::sync::Arc::new(scene::Scene::new(job.description.clone())?);
     in_pool(job.run.threads, || {
-        let renderer = Renderer::restore(&scene, &bytes)
+        let renderer = Renderer::restore(std::sync::Arc::clone(&scene), &bytes)
             .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
         if let Some(n) = job.budget.passes
             && n < renderer.passes()
@@ -113,7 +113,7 @@ pub(crate) fn in_pool<R: Send>(
 }
 
 /// Passes until the budget is spent or Ctrl-C, then the outputs.
-fn drive(job: &Job, mut renderer: Renderer<'_>) -> anyhow::Result<Outcome> {
+fn drive(job: &Job, mut renderer: Renderer) -> anyhow::Result<Outcome> {
     install_ctrlc_handler();
     let start = Instant::now();
     let first_pass = renderer.passes();
@@ -245,7 +245,7 @@ fn install_ctrlc_handler() {
 }
 
 /// The EXR (with AOVs and metadata) and the PNG.
-fn write_images(job: &Job, renderer: &Renderer<'_>, elapsed: Duration) -> anyhow::Result<()> {
+fn write_images(job: &Job, renderer: &Renderer, elapsed: Duration) -> anyhow::Result<()> {
     let (width, height) = renderer.resolution();
     let params = renderer.params();
     let scene_name = job.scene_path.as_ref().map_or_else(
@@ -299,7 +299,7 @@ fn write_images(job: &Job, renderer: &Renderer<'_>, elapsed: Duration) -> anyhow
 /// The renderer's state with a note that lets `fppm resume` find the scene and the outputs.
 fn write_checkpoint(
     job: &Job,
-    renderer: &Renderer<'_>,
+    renderer: &Renderer,
     path: &Path,
     elapsed: Duration,
 ) -> anyhow::Result<()> {
@@ -361,7 +361,7 @@ impl Progress {
         }
     }
 
-    fn pass(&mut self, renderer: &Renderer<'_>, stats: &PassStats, elapsed: Duration) {
+    fn pass(&mut self, renderer: &Renderer, stats: &PassStats, elapsed: Duration) {
         let passes = renderer.passes();
         self.non_finite += stats.non_finite;
         if self.json {

@@ -91,13 +91,14 @@ pub(crate) fn plan(args: PlanArgs) -> anyhow::Result<Outcome> {
         .check(film.width, film.height, &job.params, true)?;
     std::fs::create_dir_all(&args.job)
         .with_context(|| format!("{}: cannot create the job folder", args.job.display()))?;
-    let scene = scene::Scene::new(job.description.clone())?;
+    let scene = std::sync::Arc::new(scene::Scene::new(job.description.clone())?);
     let clock = Instant::now();
     let bytes = in_pool(job.run.threads, || {
-        let kernels = Renderer::pass_independent_kernels(&scene, job.params)
+        let kernels = Renderer::pass_independent_kernels(std::sync::Arc::clone(&scene), job.params)
             .map_err(|e| anyhow::anyhow!("{}: {e}", job.description.source.display()))?;
-        let renderer = Renderer::with_kernels(&scene, job.params, kernels, 0)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", job.description.source.display()))?;
+        let renderer =
+            Renderer::with_kernels(std::sync::Arc::clone(&scene), job.params, kernels, 0)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", job.description.source.display()))?;
         let note = PlanNote {
             render: settings::note_for(&job, 0.0),
             passes,
@@ -182,14 +183,14 @@ fn read_plan(job: &Path) -> anyhow::Result<(Vec<u8>, StateHeader, PlanNote)> {
 }
 
 /// The scene of a plan, with the plan's film.
-fn plan_scene(note: &PlanNote) -> anyhow::Result<scene::Scene> {
+fn plan_scene(note: &PlanNote) -> anyhow::Result<std::sync::Arc<scene::Scene>> {
     let mut description =
         settings::load_scene(note.render.scene.as_deref(), note.render.env.as_deref())?;
     settings::apply_film(
         &mut description,
         (Some(note.render.width), Some(note.render.height)),
     );
-    Ok(scene::Scene::new(description)?)
+    Ok(std::sync::Arc::new(scene::Scene::new(description)?))
 }
 
 /// The unit index: `--index`, else Slurm's `SLURM_ARRAY_TASK_ID`, else Kubernetes'
@@ -228,14 +229,15 @@ pub(crate) fn unit(args: &UnitArgs) -> anyhow::Result<Outcome> {
     let plan_path = args.job.join(PLAN);
     let clock = Instant::now();
     let part = in_pool(run.threads, || {
-        let planned = Renderer::restore(&scene, &plan_bytes)
+        let planned = Renderer::restore(std::sync::Arc::clone(&scene), &plan_bytes)
             .map_err(|e| anyhow::anyhow!("{}: {e}", plan_path.display()))?;
         let kernels = planned
             .kernels()
             .ok_or_else(|| anyhow::anyhow!("{}: the plan holds no kernels", plan_path.display()))?
             .to_vec();
-        let mut renderer = Renderer::with_kernels(&scene, header.params, kernels, first)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", plan_path.display()))?;
+        let mut renderer =
+            Renderer::with_kernels(std::sync::Arc::clone(&scene), header.params, kernels, first)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", plan_path.display()))?;
         for _ in 0..count {
             renderer.iterate();
         }
@@ -325,7 +327,7 @@ pub(crate) fn merge(args: &MergeArgs) -> anyhow::Result<Outcome> {
         ("passes".to_owned(), total.passes.to_string()),
         (
             "photons".to_owned(),
-            (total.passes * u64::from(header.params.photons_per_pass)).to_string(),
+            (total.passes * u64::from(header.params.budget.photons_per_pass)).to_string(),
         ),
     ];
     metadata.extend(

@@ -1,6 +1,6 @@
 //! The one error type of the scene loaders.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Why a scene could not be loaded.
 ///
@@ -346,5 +346,13 @@ impl LoadError {
             | Self::EnvironmentMap { path, .. }
             | Self::NoSupportedEmitter { path, .. } => path,
         }
+    }
+}
+
+/// The glTF importer's error naming `path`, its message on one line in lower case.
+pub(crate) fn gltf_error(path: &Path, message: impl std::fmt::Display) -> LoadError {
+    LoadError::Gltf {
+        path: path.to_path_buf(),
+        message: lower_first(&message.to_string()),
     }
 }

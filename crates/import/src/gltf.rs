@@ -32,6 +32,7 @@ use gltf::mesh::Mode;
 
 use super::{MeshData, read_bytes};
 use crate::error::LoadError;
+use crate::error::gltf_error;
 use crate::image_file::TextureCache;
 use scene::texture::{
     Alpha, AlphaMode, MaterialTextures, MetallicRoughness, NormalMap, TextureRef, Wrap,
@@ -40,13 +41,6 @@ use scene::{Camera, Light, Material, MaterialKind};
 
 /// Deepest node hierarchy accepted (guards against cyclic node graphs).
 const MAX_DEPTH: usize = 1024;
-
-pub(super) fn gltf_error(path: &Path, message: impl std::fmt::Display) -> LoadError {
-    LoadError::Gltf {
-        path: path.to_path_buf(),
-        message: crate::error::lower_first(&message.to_string()),
-    }
-}
 
 /// Loads a glTF or GLB file.
 pub(crate) fn load_gltf(path: &Path) -> Result<MeshData, LoadError> {

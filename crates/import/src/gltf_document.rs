@@ -5,8 +5,8 @@
 
 use std::path::{Path, PathBuf};
 
-use super::gltf::gltf_error;
 use crate::error::LoadError;
+use crate::error::gltf_error;
 
 /// Parses and validates a glTF or GLB file's JSON.
 ///

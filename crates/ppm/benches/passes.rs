@@ -78,11 +78,11 @@ fn process_cpu_seconds() -> f64 {
 
 /// One configuration under test: a renderer of one method in a pool of some threads, and what
 /// its timed passes gave.
-struct Run<'s> {
+struct Run {
     method: Method,
     threads: usize,
     pool: rayon::ThreadPool,
-    renderer: Renderer<'s>,
+    renderer: Renderer,
     stats: Vec<PassStats>,
     cpu: Vec<f64>,
 }
@@ -91,13 +91,13 @@ struct Run<'s> {
 /// configuration in turn, so that every configuration sees the same machine. The speed of the
 /// shared machine drifts by ±20 % over minutes; measured one after the other, the ratios of the
 /// summary (frequency overhead, parallel speed-up) drifted with it.
-fn run<'s>(
-    scene: &'s scene::Scene,
+fn run(
+    scene: &std::sync::Arc<scene::Scene>,
     configs: &[(Method, usize)],
     photons_per_pass: u32,
     passes: usize,
-) -> Vec<Run<'s>> {
-    let mut runs: Vec<Run<'s>> = configs
+) -> Vec<Run> {
+    let mut runs: Vec<Run> = configs
         .iter()
         .map(|&(method, threads)| {
             let pool = rayon::ThreadPoolBuilder::new()
@@ -106,9 +106,9 @@ fn run<'s>(
                 .unwrap();
             let mut params = RenderParams::preview();
             params.method = method;
-            params.photons_per_pass = photons_per_pass;
-            params.light_tracing = env_or("FPPM_BENCH_LIGHT_TRACING", 1u8) != 0;
-            let mut renderer = Renderer::new(scene, params).unwrap();
+            params.budget.photons_per_pass = photons_per_pass;
+            params.connections.light_tracing = env_or("FPPM_BENCH_LIGHT_TRACING", 1u8) != 0;
+            let mut renderer = Renderer::new(std::sync::Arc::clone(scene), params).unwrap();
             // The first pass traces the hitpoints and builds the grid: not the steady state.
             pool.install(|| renderer.iterate());
             Run {
@@ -146,7 +146,7 @@ fn main() {
         width: 512,
         height: 512,
     };
-    let scene = scene::Scene::new(description).unwrap();
+    let scene = std::sync::Arc::new(scene::Scene::new(description).unwrap());
     let photons_per_pass: u32 = env_or("FPPM_BENCH_PHOTONS", 1_000_000);
     let passes: usize = env_or("FPPM_BENCH_PASSES", 15);
     println!(
@@ -303,7 +303,7 @@ fn main() {
                  classical PPM; bookkeeping (trace {:+.3} s, deposits and probes {:.3} s) {:.1} % of \
                  the freq pass (medians of paired passes); held kernels reach {:.2} hitpoints per \
                  photon against {:.2}",
-                RenderParams::preview().freq_fraction,
+                RenderParams::preview().frequency.fraction,
                 (paired(ppm, freq, &|p, f| f.timings.total() / p.timings.total()) - 1.0) * 100.0,
                 paired(ppm, freq, &extra_trace),
                 median(freq.iter().map(|f| f.timings.frequency).collect()),
@@ -313,10 +313,10 @@ fn main() {
             );
         }
     }
-    let n_slots = 512 * 512 * RenderParams::preview().samples_per_pixel as usize;
+    let n_slots = 512 * 512 * RenderParams::preview().film.samples_per_pixel as usize;
     println!(
         "hitpoints per pixel: {} ({} slots); fixed columns: {} bytes per hitpoint",
-        RenderParams::preview().samples_per_pixel,
+        RenderParams::preview().film.samples_per_pixel,
         n_slots,
         ppm::bytes_per_hitpoint()
     );

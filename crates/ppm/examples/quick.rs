@@ -24,25 +24,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             height: size,
         };
     }
-    let scene = scene::Scene::new(description)?;
+    let scene = std::sync::Arc::new(scene::Scene::new(description)?);
     let mut params = ppm::RenderParams::preview();
     params.method = ppm::Method::from_name(method).ok_or("unknown method")?;
     if let Ok(depth) = std::env::var("QUICK_MAX_DEPTH") {
-        params.max_depth = depth.parse()?;
+        params.budget.max_depth = depth.parse()?;
     }
     if let Ok(spp) = std::env::var("QUICK_SPP") {
-        params.samples_per_pixel = spp.parse()?;
+        params.film.samples_per_pixel = spp.parse()?;
     }
     if let Ok(radius) = std::env::var("QUICK_RADIUS") {
-        params.initial_radius = Some(radius.parse()?);
+        params.kernel.initial_radius = Some(radius.parse()?);
     }
     if let Ok(photons) = std::env::var("QUICK_PHOTONS") {
-        params.photons_per_pass = photons.parse()?;
+        params.budget.photons_per_pass = photons.parse()?;
     }
     if let Ok(seed) = std::env::var("QUICK_SEED") {
         params.seed = seed.parse()?;
     }
-    let mut renderer = ppm::Renderer::new(&scene, params)?;
+    let mut renderer = ppm::Renderer::new(std::sync::Arc::clone(&scene), params)?;
     let start = std::time::Instant::now();
     for _ in 0..passes {
         renderer.iterate();

@@ -23,10 +23,10 @@
 //! ```no_run
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! let description = import::load(std::path::Path::new("scene.toml"))?;
-//! let scene = scene::Scene::new(description)?;
+//! let scene = std::sync::Arc::new(scene::Scene::new(description)?);
 //! let mut params = ppm::RenderParams::preview();
 //! params.method = ppm::Method::FreqPpm;
-//! let mut renderer = ppm::Renderer::new(&scene, params)?;
+//! let mut renderer = ppm::Renderer::new(std::sync::Arc::clone(&scene), params)?;
 //! for _ in 0..10 {
 //!     let stats = renderer.iterate();
 //!     assert_eq!(stats.photons_traced, 100_000);
@@ -37,26 +37,34 @@
 //! # }
 //! ```
 
+mod aov;
+mod checkpoint;
 mod disc;
+mod independent;
+mod integrator;
+mod methods;
 mod params;
 mod path;
 mod photon_mapper;
 mod pointwise;
 mod renderer;
 mod rng;
-mod state;
+mod stats;
 mod update;
 
-pub use crate::params::{Method, PARAMS, Param, ParamError, ParamKind, RenderParams, param};
-pub use crate::photon_mapper::{
-    MemoryEstimate, MemoryUse, Part, PartError, PassStats, PassSums, PassTimings,
-    auto_initial_radius, bytes_per_hitpoint,
-};
-pub use crate::pointwise::{pointwise_reference, pointwise_reference_paths};
-pub use crate::renderer::{Aov, Renderer};
-pub use crate::rng::Sampler;
+pub use crate::aov::Aov;
 #[doc(hidden)]
-pub use crate::state::surgery as checkpoint_surgery;
-pub use crate::state::{STATE_VERSION, StateError, StateHeader};
+pub use crate::checkpoint::surgery as checkpoint_surgery;
+pub use crate::checkpoint::{STATE_VERSION, StateError, StateHeader};
+pub use crate::independent::{Part, PartError, PassSums};
+pub use crate::params::{
+    Budget, Connections, FilmSampling, FrequencyParams, Kernel, Method, PARAMS, Param, ParamError,
+    ParamKind, RenderParams, param,
+};
+pub use crate::photon_mapper::{auto_initial_radius, bytes_per_hitpoint};
+pub use crate::pointwise::{pointwise_reference, pointwise_reference_paths};
+pub use crate::renderer::Renderer;
+pub use crate::rng::Sampler;
+pub use crate::stats::{MemoryEstimate, MemoryUse, PassStats, PassTimings};
 pub use crate::update::{FrequencyFloor, FrequencyRadius, GatherStats};
 pub use spectrum::{K_POSTER, K_STRICT, MergePolicy};

@@ -3,29 +3,46 @@
 //! the photon mappers. It is deliberately simple: it is the independent ground truth the photon
 //! mappers are checked against, not a competitor.
 
+use std::sync::Arc;
+
 use glam::Vec2;
 use rayon::prelude::*;
 use scene::{Bsdf, Hit, Rgb, Scene, TransportMode};
 
+use crate::checkpoint::codec::{Reader, StateError, Writer};
+use crate::integrator::Integrator;
 use crate::params::RenderParams;
 use crate::rng::Sampler;
+use crate::stats::{MemoryEstimate, PassStats};
 
 /// Pixels per parallel work item; fixed so the work split does not depend on the thread count.
 const PIXEL_CHUNK: usize = 256;
 
 /// Progressive path tracing: every pass adds `samples_per_pixel` paths to every pixel.
-pub(crate) struct PathTracer<'s> {
-    scene: &'s Scene,
-    pub(crate) params: RenderParams,
+pub(crate) struct PathTracer {
+    scene: Arc<Scene>,
+    params: RenderParams,
     width: u32,
     /// Sum of the radiance samples per pixel.
-    pub(crate) sum: Vec<[f64; 3]>,
+    sum: Vec<[f64; 3]>,
     /// Passes accumulated in `sum`.
-    pub(crate) passes: u32,
+    passes: u32,
 }
 
-impl<'s> PathTracer<'s> {
-    pub(crate) fn new(scene: &'s Scene, params: RenderParams) -> Self {
+/// What a render will hold (the film aside): one `[f64; 3]` sum per pixel, and as much again
+/// while a checkpoint is written.
+pub(crate) fn estimate(pixels: u64, _params: &RenderParams) -> MemoryEstimate {
+    let sums = pixels.saturating_mul(24);
+    MemoryEstimate {
+        hitpoints: sums,
+        photons: 0,
+        film: 0,
+        checkpoint: sums,
+    }
+}
+
+impl PathTracer {
+    pub(crate) fn new(scene: Arc<Scene>, params: RenderParams) -> Self {
         let film = scene.description().film;
         Self {
             scene,
@@ -36,10 +53,11 @@ impl<'s> PathTracer<'s> {
         }
     }
 
-    /// Adds one pass of `samples_per_pixel` paths per pixel; returns the number of paths.
-    pub(crate) fn iterate(&mut self) -> (u64, u64) {
+    /// Adds one pass of `samples_per_pixel` paths per pixel; returns the number of paths and of
+    /// the samples dropped for being NaN or infinite.
+    fn add_pass(&mut self) -> (u64, u64) {
         let pass = self.passes;
-        let spp = self.params.samples_per_pixel;
+        let spp = self.params.film.samples_per_pixel;
         let this = &*self;
         let samples: Vec<([f64; 3], u64)> = (0..this.sum.len())
             .into_par_iter()
@@ -73,12 +91,6 @@ impl<'s> PathTracer<'s> {
         (self.sum.len() as u64 * u64::from(spp), non_finite)
     }
 
-    /// The mean radiance per pixel.
-    pub(crate) fn image(&self) -> Vec<[f32; 3]> {
-        let n = f64::from(self.passes.max(1)) * f64::from(self.params.samples_per_pixel);
-        self.sum.iter().map(|s| s.map(|v| (v / n) as f32)).collect()
-    }
-
     /// One camera path through `pixel`: its radiance estimate.
     fn trace(&self, pixel: u32, mut sampler: Sampler) -> Rgb {
         let (x, y) = (pixel % self.width, pixel / self.width);
@@ -106,7 +118,7 @@ impl<'s> PathTracer<'s> {
         // Each iteration scatters at `hit` (the vertex after `depth` bounces), then finds the
         // next vertex and its emission: emission found there ends a path with depth + 1 bounces,
         // light sampled at `hit` one with depth + 1, both at most max_depth.
-        while depth < self.params.max_depth {
+        while depth < self.params.budget.max_depth {
             let Some(bsdf) = self.scene.bsdf(&hit) else {
                 break;
             };
@@ -122,7 +134,7 @@ impl<'s> PathTracer<'s> {
                 break;
             };
             beta *= sample.weight;
-            if depth + 1 >= self.params.rr_depth {
+            if depth + 1 >= self.params.budget.rr_depth {
                 let survive = beta.max_element().min(1.0);
                 if survive <= 0.0 || u_roulette >= survive {
                     break;
@@ -197,4 +209,54 @@ impl<'s> PathTracer<'s> {
 fn power_heuristic(f: f32, g: f32) -> f32 {
     let (f2, g2) = (f * f, g * g);
     if f2 + g2 > 0.0 { f2 / (f2 + g2) } else { 0.0 }
+}
+
+impl Integrator for PathTracer {
+    fn params(&self) -> &RenderParams {
+        &self.params
+    }
+
+    fn passes(&self) -> u32 {
+        self.passes
+    }
+
+    fn iterate(&mut self) -> PassStats {
+        let pass = self.passes;
+        let clock = std::time::Instant::now();
+        let (paths, non_finite) = self.add_pass();
+        let mut stats = PassStats::empty(pass);
+        stats.camera_paths = paths;
+        stats.non_finite = non_finite;
+        stats.timings.camera = clock.elapsed().as_secs_f64();
+        stats
+    }
+
+    /// The mean radiance per pixel.
+    fn image(&self) -> Vec<[f32; 3]> {
+        let n = f64::from(self.passes.max(1)) * f64::from(self.params.film.samples_per_pixel);
+        self.sum.iter().map(|s| s.map(|v| (v / n) as f32)).collect()
+    }
+
+    /// The per-pixel sums.
+    fn save(&self, w: &mut Writer) {
+        w.u64(self.sum.len() as u64);
+        for s in &self.sum {
+            s.iter().for_each(|&v| w.f64(v));
+        }
+    }
+
+    fn saved_bound(&self) -> usize {
+        8 + self.sum.len().saturating_mul(24)
+    }
+
+    fn restore(&mut self, r: &mut Reader<'_>, passes: u32) -> Result<(), StateError> {
+        if r.len()? != self.sum.len() {
+            return Err(StateError::Corrupt);
+        }
+        for s in &mut self.sum {
+            *s = [r.f64()?, r.f64()?, r.f64()?];
+        }
+        self.passes = passes;
+        Ok(())
+    }
 }

@@ -8,8 +8,9 @@
 //! exactly the slot's hitpoint, plus the emission its camera paths see directly, which PPM
 //! re-jitters every pass and so averages over the pixel.
 
-use rayon::prelude::*;
+use std::sync::Arc;
 
+use rayon::prelude::*;
 use scene::{Rgb, Scene};
 
 use crate::params::{ParamError, RenderParams};
@@ -37,7 +38,7 @@ const SLOT_CHUNK: usize = 64;
 /// [`ParamError`] if `params` are invalid, or their method re-traces its hitpoints (SPPM, the
 /// path tracer) or direct lighting is on: those converge to the pixel average already.
 pub fn pointwise_reference(
-    scene: &Scene,
+    scene: &Arc<Scene>,
     params: RenderParams,
     paths_per_point: u32,
     emission_passes: u32,
@@ -54,21 +55,23 @@ pub fn pointwise_reference(
 ///
 /// As [`pointwise_reference`].
 pub fn pointwise_reference_paths(
-    scene: &Scene,
+    scene: &Arc<Scene>,
     params: RenderParams,
     paths: std::ops::Range<u32>,
     emission_passes: u32,
 ) -> Result<Vec<[f32; 3]>, ParamError> {
-    if params.method.is_stochastic() || !params.method.is_photon_mapper() || params.direct_lighting
+    if params.method.is_stochastic()
+        || !params.method.is_photon_mapper()
+        || params.connections.direct_lighting
     {
         return Err(ParamError::NoFixedHitpoints {
             method: params.method.name(),
         });
     }
-    let mapper = PhotonMapper::new(scene, params)?;
-    let tracer = PathTracer::new(scene, params);
+    let mapper = PhotonMapper::new(Arc::clone(scene), params)?;
+    let tracer = PathTracer::new(Arc::clone(scene), params);
     let film = scene.description().film;
-    let spp = params.samples_per_pixel as usize;
+    let spp = params.film.samples_per_pixel as usize;
     let n_slots = film.width as usize * film.height as usize * spp;
     let slot_radiance = |slot: usize| -> [f64; 3] {
         let slot = slot as u32;

@@ -2,8 +2,8 @@
 //! finishes (which reports the [`Invalid`] as an error naming the file) and by `Scene::new` for
 //! descriptions built in code (a [`SceneError`]). What follows from these
 //! checks (finite positions, unit directions, non-negative colours, material indices in range)
-//! is what the rest of the crate relies on: the BVH build cannot fail, and `LightSampler::new`
-//! takes the `Powered` emitters that only `emitters` makes, so it cannot fail either.
+//! is what the rest of the crate relies on: the BVH build cannot fail. That some emitter
+//! carries power is the light sampler's check (`light/emitters.rs`, an [`Invalid`] too).
 
 use std::f32::consts::PI;
 use std::fmt;
@@ -14,8 +14,6 @@ use glam::Vec3;
 use crate::MaterialParam;
 use crate::SceneError;
 use crate::description::{Cylinder, Light, Material, SceneDescription};
-use crate::light::Emitters;
-use crate::sampling::Distribution1D;
 use crate::{Environment, EnvironmentRadiance};
 
 /// One problem of a scene description; the importers turn it into an error naming the file,
@@ -84,37 +82,6 @@ impl Invalid {
             Self::NoPower => SceneError::NoLight { path },
         }
     }
-}
-
-/// Emitters of which at least one carries power, with the distribution that picks them by
-/// power; only [`emitters`] makes one.
-#[derive(Clone, Debug)]
-pub(crate) struct Powered {
-    emitters: Emitters,
-    distribution: Distribution1D,
-}
-
-impl Powered {
-    /// The emitters and the distribution over them.
-    pub(crate) fn into_parts(self) -> (Emitters, Distribution1D) {
-        (self.emitters, self.distribution)
-    }
-}
-
-/// The emitters, if some light or emitter has positive (finite) power and none has a power
-/// beyond what 32-bit floats hold (its photons would carry infinite flux).
-pub(crate) fn emitters(emitters: Emitters) -> Result<Powered, Invalid> {
-    if let Some(i) = emitters.weights().iter().position(|w| w.is_infinite()) {
-        return Err(Invalid::value(
-            format!("emitter {i}"),
-            "has a power beyond the range of 32-bit floats (emission × area too large)",
-        ));
-    }
-    let distribution = Distribution1D::new(&emitters.weights()).ok_or(Invalid::NoPower)?;
-    Ok(Powered {
-        emitters,
-        distribution,
-    })
 }
 
 /// Formats a vector as `[x, y, z]`.

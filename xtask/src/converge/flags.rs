@@ -122,9 +122,9 @@ impl Overrides {
         self.apply(&mut p)?;
         Ok(format!(
             "alpha={:.3} ff={} k={} merge={} geometry={}",
-            p.alpha,
-            p.freq_fraction,
-            k_name(p.kernel_k),
+            p.kernel.alpha,
+            p.frequency.fraction,
+            k_name(p.frequency.kernel_k),
             value_of("freq_merge", &p),
             value_of("freq_geometry", &p),
         ))

@@ -94,7 +94,7 @@ pub(super) fn write_masks(path: &Path, masks: &Masks, width: usize) -> Result<()
 
 /// Radius map (all photon mappers), frequency radius and held-by-floor maps (frequency methods).
 pub(super) fn write_maps(
-    renderer: &ppm::Renderer<'_>,
+    renderer: &ppm::Renderer,
     out: &Path,
     stem: &str,
     width: usize,

@@ -160,7 +160,8 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
             method,
             flags.overrides.label(&params)?
         );
-        let mut renderer = ppm::Renderer::new(&scene, params).context("render parameters")?;
+        let mut renderer = ppm::Renderer::new(std::sync::Arc::clone(&scene), params)
+            .context("render parameters")?;
         let mut elapsed = Duration::ZERO;
         for &budget in &flags.budgets {
             while elapsed.as_secs_f64() < budget {
@@ -262,11 +263,11 @@ fn base_params(
     flags: &Flags,
 ) -> Result<ppm::RenderParams> {
     let mut params = suite::params(entry, scene, method, flags.seed)?;
-    params.photons_per_pass = flags.photons;
+    params.budget.photons_per_pass = flags.photons;
     // Against the pointwise reference (the radiance at PPM's fixed hitpoints) the renders
     // gather only: light-traced connections converge to the pixel's average instead.
     if flags.pointwise.is_some() {
-        params.light_tracing = false;
+        params.connections.light_tracing = false;
     }
     flags.overrides.apply(&mut params)?;
     Ok(params)

@@ -4,7 +4,7 @@ use super::*;
 
 /// One-at-a-time parameter sweep at one budget.
 pub(super) fn sweep(
-    scene: &scene::Scene,
+    scene: &std::sync::Arc<scene::Scene>,
     entry: &SuiteScene,
     reference: &Image,
     masks: &Masks,
@@ -39,7 +39,8 @@ pub(super) fn sweep(
             }
             let mut params = base_params(entry, scene, method, flags)?;
             v.apply(&mut params)?;
-            let mut renderer = ppm::Renderer::new(scene, params).context("render parameters")?;
+            let mut renderer = ppm::Renderer::new(std::sync::Arc::clone(scene), params)
+                .context("render parameters")?;
             let mut elapsed = Duration::ZERO;
             while elapsed.as_secs_f64() < flags.budget {
                 let start = flags.clock.now();
@@ -69,9 +70,9 @@ pub(super) fn sweep(
                 entry.name,
                 method.name(),
                 flags.budget,
-                params.alpha,
-                params.freq_fraction,
-                k_name(params.kernel_k),
+                params.kernel.alpha,
+                params.frequency.fraction,
+                k_name(params.frequency.kernel_k),
                 value_of("freq_merge", &params),
                 value_of("freq_geometry", &params),
                 elapsed.as_secs_f64(),

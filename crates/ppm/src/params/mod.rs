@@ -92,20 +92,32 @@ impl fmt::Display for Method {
     }
 }
 
-/// Everything an integrator needs besides the scene. Plain data, no `Default`: start from a
-/// preset ([`RenderParams::preview`]) and change fields.
+/// Everything an integrator needs besides the scene, grouped by what it controls. Plain data,
+/// no `Default`: start from a preset ([`RenderParams::preview`]) and change fields. Each field
+/// is named once, in [`PARAMS`], as flags, `[render]` tables and image metadata spell it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderParams {
     /// Which integrator.
     pub method: Method,
+    /// Seed of every random number.
+    pub seed: u64,
+    /// What a pass spends: photons and path length.
+    pub budget: Budget,
+    /// How the film is sampled.
+    pub film: FilmSampling,
+    /// The progressive gather radius of the photon mappers.
+    pub kernel: Kernel,
+    /// The estimators combined with merging: connections to the camera and to the lights.
+    pub connections: Connections,
+    /// The frequency analysis of the frequency-guided methods.
+    pub frequency: FrequencyParams,
+}
+
+/// What a pass spends.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Budget {
     /// Photons traced per pass (> 0).
     pub photons_per_pass: u32,
-    /// Radius reduction α ∈ (0, 1]: the fraction of new photons kept (0.7 in smallppm,
-    /// 2/3 in pbrt-v4).
-    pub alpha: f64,
-    /// Initial gather radius in scene units; `None` picks it from the scene (see
-    /// [`crate::auto_initial_radius`]).
-    pub initial_radius: Option<f64>,
     /// Maximum number of scattering events on a light path from the emitter to the camera
     /// (≥ 1), as pbrt's `maxdepth`: paths have at most `max_depth + 1` segments. Every method
     /// bounds the same paths: a photon mapper counts the photon's bounces, the hitpoint's
@@ -117,60 +129,85 @@ pub struct RenderParams {
     /// value; smaller values end dim paths sooner (faster passes, more noise per path). The
     /// Mitsuba importer carries the integrator's `rr_depth` here.
     pub rr_depth: u32,
+}
+
+/// How the film is sampled.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FilmSampling {
     /// Hitpoint slots per pixel (jittered; ≥ 1); for the path tracer, paths per pixel per pass.
     pub samples_per_pixel: u32,
-    /// Seed of every random number.
-    pub seed: u64,
-    /// Share of photons that are frequency photons, in [0, 1] (frequency methods only).
-    pub freq_fraction: f64,
-    /// How a hitpoint merges frequency deposits.
-    pub freq_merge: MergePolicy,
-    /// The kernel radius constant K: [`spectrum::K_STRICT`] (the 95 %-of-peak radius, the
-    /// default chosen by the convergence study) or the poster's [`spectrum::K_POSTER`].
-    pub kernel_k: f64,
-    /// What happens once the PPM radius reaches the frequency radius.
-    pub freq_floor: FrequencyFloor,
-    /// Whether frequency photons probe for partial occlusion near their hits (one extra
-    /// shadow ray per segment of a frequency photon), so that shadow edges raise the spatial
-    /// frequency and keep hitpoints there shrinking.
-    pub freq_occlusion: bool,
-    /// Whether a hitpoint may hold its radius only where its gather disc lies on its own
-    /// surface (probe rays when it first becomes a candidate, `crate::disc`), so that held
-    /// kernels do not hang over edges and corners where no photon is accepted.
-    pub freq_geometry: bool,
-    /// Add direct lighting by light sampling at hitpoints instead of gathering photons that
-    /// arrive straight from an emitter.
-    pub direct_lighting: bool,
-    /// The largest kernel a frequency method may give a hitpoint, as a multiple of the
-    /// initial radius R₀, in [1, 64]. After the pilot (`freq_pilot`) every hitpoint whose
-    /// frequency prediction and clear disc allow it starts over at min(r_freq, clear radius,
-    /// `freq_grow`·R₀); 1 never grows a kernel beyond R₀ (the poster's rule).
-    pub freq_grow: f64,
-    /// α while a frequency method holds a hitpoint (R ≤ its frequency radius), in (0, 1]:
-    /// 1 keeps the radius for ever (the poster's rule, biased in the limit); below 1 the held
-    /// radius keeps shrinking slowly, R² ∝ N^−(1−α_hold)/α_hold, so that the estimate converges
-    /// (for α_hold > 1/2, N·R² still grows).
-    pub freq_hold_alpha: f64,
-    /// Passes of a frequency method's pilot, in [0, 10⁶]: after them (and only if
-    /// `freq_grow` > 1) the kernels are sized from the frequency prediction and every
-    /// hitpoint's statistics restart; 0 skips the growth.
-    pub freq_pilot: u32,
-    /// Whether a frequency method caps *every* slot's radius at the clear radius of its
-    /// gather disc (probed at every visible point), not only the held ones: near corners and
-    /// edges the kernel then shrinks at once to the distance where the disc leaves the
-    /// surface, which removes most of photon mapping's corner bias.
-    pub freq_clear_cap: bool,
-    /// Whether the candidates of a 2 × 2 block of pixels (every slot of it under
-    /// `freq_clear_cap`) share one clear-disc probe for 16 passes where their visible points
-    /// lie in one plane well inside the probed disc (`PhotonMapper::probe_clear_radii`);
-    /// otherwise every candidate probes its own.
-    pub freq_probe_share: bool,
+}
+
+/// The progressive gather radius of the photon mappers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Kernel {
+    /// Radius reduction α ∈ (0, 1]: the fraction of new photons kept (0.7 in smallppm,
+    /// 2/3 in pbrt-v4).
+    pub alpha: f64,
+    /// Initial gather radius in scene units; `None` picks it from the scene (see
+    /// [`crate::auto_initial_radius`]).
+    pub initial_radius: Option<f64>,
+}
+
+/// The estimators the photon mappers combine with merging.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Connections {
     /// Whether the photon mappers also connect every stored photon to the camera (light
     /// tracing) and combine the two estimates of what the camera sees directly on a
     /// non-specular surface by multiple importance sampling, as vertex connection and merging
     /// does: a photon merged at a directly seen hitpoint of radius R counts with weight
     /// N/(1 + N) and its connection with 1/(1 + N), N = πR²·(camera samples per unit area).
     pub light_tracing: bool,
+    /// Add direct lighting by light sampling at hitpoints instead of gathering photons that
+    /// arrive straight from an emitter.
+    pub direct_lighting: bool,
+}
+
+/// The frequency analysis of the frequency-guided methods (`freq`, `freq-sppm`, and `appm`'s
+/// pilot).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrequencyParams {
+    /// Share of photons that are frequency photons, in [0, 1].
+    pub fraction: f64,
+    /// How a hitpoint merges frequency deposits.
+    pub merge: MergePolicy,
+    /// The kernel radius constant K: [`spectrum::K_STRICT`] (the 95 %-of-peak radius, the
+    /// default chosen by the convergence study) or the poster's [`spectrum::K_POSTER`].
+    pub kernel_k: f64,
+    /// What happens once the PPM radius reaches the frequency radius.
+    pub floor: FrequencyFloor,
+    /// Whether frequency photons probe for partial occlusion near their hits (one extra
+    /// shadow ray per segment of a frequency photon), so that shadow edges raise the spatial
+    /// frequency and keep hitpoints there shrinking.
+    pub occlusion: bool,
+    /// Whether a hitpoint may hold its radius only where its gather disc lies on its own
+    /// surface (probe rays when it first becomes a candidate, `crate::disc`), so that held
+    /// kernels do not hang over edges and corners where no photon is accepted.
+    pub geometry: bool,
+    /// The largest kernel a frequency method may give a hitpoint, as a multiple of the
+    /// initial radius R₀, in [1, 64]. After the pilot (`pilot`) every hitpoint whose
+    /// frequency prediction and clear disc allow it starts over at min(r_freq, clear radius,
+    /// `grow`·R₀); 1 never grows a kernel beyond R₀ (the poster's rule).
+    pub grow: f64,
+    /// α while a frequency method holds a hitpoint (R ≤ its frequency radius), in (0, 1]:
+    /// 1 keeps the radius for ever (the poster's rule, biased in the limit); below 1 the held
+    /// radius keeps shrinking slowly, R² ∝ N^−(1−α_hold)/α_hold, so that the estimate converges
+    /// (for α_hold > 1/2, N·R² still grows).
+    pub hold_alpha: f64,
+    /// Passes of the pilot, in [0, 10⁶]: after them (and only if `grow` > 1) the kernels are
+    /// sized from the frequency prediction and every hitpoint's statistics restart; 0 skips
+    /// the growth.
+    pub pilot: u32,
+    /// Whether *every* slot's radius is capped at the clear radius of its gather disc (probed
+    /// at every visible point), not only the held ones: near corners and edges the kernel then
+    /// shrinks at once to the distance where the disc leaves the surface, which removes most of
+    /// photon mapping's corner bias.
+    pub clear_cap: bool,
+    /// Whether the candidates of a 2 × 2 block of pixels (every slot of it under `clear_cap`)
+    /// share one clear-disc probe for 16 passes where their visible points lie in one plane
+    /// well inside the probed disc (`PhotonMapper::probe_clear_radii`); otherwise every
+    /// candidate probes its own.
+    pub probe_share: bool,
 }
 
 /// A parameter outside its domain.
@@ -243,8 +280,8 @@ impl RenderParams {
     /// frequency prediction and restarts the statistics, if it grows kernels at all.
     #[must_use]
     pub fn growth_pass(&self) -> Option<u32> {
-        (self.method.uses_frequency() && self.freq_grow > 1.0 && self.freq_pilot > 0)
-            .then_some(self.freq_pilot)
+        let f = &self.frequency;
+        (self.method.uses_frequency() && f.grow > 1.0 && f.pilot > 0).then_some(f.pilot)
     }
 
     /// The defaults: freq-sppm, 100 000 photons per pass, α = 0.7, one hitpoint per
@@ -254,26 +291,36 @@ impl RenderParams {
     pub fn preview() -> Self {
         Self {
             method: Method::FreqSppm,
-            photons_per_pass: 100_000,
-            alpha: 0.7,
-            initial_radius: None,
-            max_depth: 1024,
-            rr_depth: 3,
-            samples_per_pixel: 1,
             seed: 0,
-            freq_fraction: 0.1,
-            freq_merge: MergePolicy::MinRadius,
-            kernel_k: K_STRICT,
-            freq_floor: FrequencyFloor::Keep,
-            freq_occlusion: true,
-            freq_geometry: true,
-            direct_lighting: false,
-            freq_grow: 1.0,
-            freq_hold_alpha: 0.9,
-            freq_pilot: 4,
-            freq_clear_cap: true,
-            freq_probe_share: true,
-            light_tracing: true,
+            budget: Budget {
+                photons_per_pass: 100_000,
+                max_depth: 1024,
+                rr_depth: 3,
+            },
+            film: FilmSampling {
+                samples_per_pixel: 1,
+            },
+            kernel: Kernel {
+                alpha: 0.7,
+                initial_radius: None,
+            },
+            connections: Connections {
+                light_tracing: true,
+                direct_lighting: false,
+            },
+            frequency: FrequencyParams {
+                fraction: 0.1,
+                merge: MergePolicy::MinRadius,
+                kernel_k: K_STRICT,
+                floor: FrequencyFloor::Keep,
+                occlusion: true,
+                geometry: true,
+                grow: 1.0,
+                hold_alpha: 0.9,
+                pilot: 4,
+                clear_cap: true,
+                probe_share: true,
+            },
         }
     }
 
@@ -290,40 +337,44 @@ impl RenderParams {
                 range,
             }
         }
-        if self.photons_per_pass == 0 {
-            return Err(out("photons_per_pass", self.photons_per_pass, "[1, 2^32)"));
+        if self.budget.photons_per_pass == 0 {
+            return Err(out(
+                "photons_per_pass",
+                self.budget.photons_per_pass,
+                "[1, 2^32)",
+            ));
         }
-        if !(self.alpha > 0.0 && self.alpha <= 1.0) {
-            return Err(out("alpha", self.alpha, "(0, 1]"));
+        if !(self.kernel.alpha > 0.0 && self.kernel.alpha <= 1.0) {
+            return Err(out("alpha", self.kernel.alpha, "(0, 1]"));
         }
-        if let Some(r) = self.initial_radius
+        if let Some(r) = self.kernel.initial_radius
             && !(r > 0.0 && r.is_finite())
         {
             return Err(out("initial_radius", r, "(0, inf)"));
         }
-        if self.max_depth == 0 || self.max_depth > 1024 {
-            return Err(out("max_depth", self.max_depth, "[1, 1024]"));
+        if self.budget.max_depth == 0 || self.budget.max_depth > 1024 {
+            return Err(out("max_depth", self.budget.max_depth, "[1, 1024]"));
         }
-        if self.rr_depth == 0 || self.rr_depth > 1024 {
-            return Err(out("rr_depth", self.rr_depth, "[1, 1024]"));
+        if self.budget.rr_depth == 0 || self.budget.rr_depth > 1024 {
+            return Err(out("rr_depth", self.budget.rr_depth, "[1, 1024]"));
         }
-        if self.samples_per_pixel == 0 || self.samples_per_pixel > 1024 {
-            return Err(out("spp", self.samples_per_pixel, "[1, 1024]"));
+        if self.film.samples_per_pixel == 0 || self.film.samples_per_pixel > 1024 {
+            return Err(out("spp", self.film.samples_per_pixel, "[1, 1024]"));
         }
-        if !(0.0..=1.0).contains(&self.freq_fraction) {
-            return Err(out("freq_fraction", self.freq_fraction, "[0, 1]"));
+        if !(0.0..=1.0).contains(&self.frequency.fraction) {
+            return Err(out("freq_fraction", self.frequency.fraction, "[0, 1]"));
         }
-        if !(self.kernel_k > 0.0 && self.kernel_k.is_finite()) {
-            return Err(out("kernel_k", self.kernel_k, "(0, inf)"));
+        if !(self.frequency.kernel_k > 0.0 && self.frequency.kernel_k.is_finite()) {
+            return Err(out("kernel_k", self.frequency.kernel_k, "(0, inf)"));
         }
-        if !(1.0..=64.0).contains(&self.freq_grow) {
-            return Err(out("freq_grow", self.freq_grow, "[1, 64]"));
+        if !(1.0..=64.0).contains(&self.frequency.grow) {
+            return Err(out("freq_grow", self.frequency.grow, "[1, 64]"));
         }
-        if !(self.freq_hold_alpha > 0.0 && self.freq_hold_alpha <= 1.0) {
-            return Err(out("freq_hold_alpha", self.freq_hold_alpha, "(0, 1]"));
+        if !(self.frequency.hold_alpha > 0.0 && self.frequency.hold_alpha <= 1.0) {
+            return Err(out("freq_hold_alpha", self.frequency.hold_alpha, "(0, 1]"));
         }
-        if self.freq_pilot > 1_000_000 {
-            return Err(out("freq_pilot", self.freq_pilot, "[0, 1000000]"));
+        if self.frequency.pilot > 1_000_000 {
+            return Err(out("freq_pilot", self.frequency.pilot, "[0, 1000000]"));
         }
         Ok(())
     }

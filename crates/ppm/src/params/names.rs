@@ -100,13 +100,13 @@ pub const PARAMS: &[Param] = &[
             value_name: "N",
             choices: &[],
         },
-        get: |p| p.photons_per_pass.to_string(),
+        get: |p| p.budget.photons_per_pass.to_string(),
         set: |p, v| {
             let n = parse_count(v)?;
             if n <= 0 {
                 return Err("must be positive".to_owned());
             }
-            p.photons_per_pass = u32::try_from(n).map_err(|_| {
+            p.budget.photons_per_pass = u32::try_from(n).map_err(|_| {
                 format!(
                     "is too large: a pass of {n} photons would need about {:.1} TiB of photon buffers (at most {} photons per pass)",
                     crate::MemoryEstimate::photon_bytes(u64::try_from(n).unwrap_or(0)) as f64
@@ -125,9 +125,9 @@ pub const PARAMS: &[Param] = &[
             value_name: "ALPHA",
             choices: &[],
         },
-        get: |p| p.alpha.to_string(),
+        get: |p| p.kernel.alpha.to_string(),
         set: |p, v| {
-            p.alpha = parse_number(v)?;
+            p.kernel.alpha = parse_number(v)?;
             Ok(())
         },
     },
@@ -140,11 +140,12 @@ pub const PARAMS: &[Param] = &[
             choices: &[],
         },
         get: |p| {
-            p.initial_radius
+            p.kernel
+                .initial_radius
                 .map_or_else(|| "auto".to_owned(), |r| r.to_string())
         },
         set: |p, v| {
-            p.initial_radius = if v == "auto" {
+            p.kernel.initial_radius = if v == "auto" {
                 None
             } else {
                 Some(parse_number(v)?)
@@ -160,9 +161,9 @@ pub const PARAMS: &[Param] = &[
             value_name: "SHARE",
             choices: &[],
         },
-        get: |p| p.freq_fraction.to_string(),
+        get: |p| p.frequency.fraction.to_string(),
         set: |p, v| {
-            p.freq_fraction = parse_number(v)?;
+            p.frequency.fraction = parse_number(v)?;
             Ok(())
         },
     },
@@ -184,14 +185,14 @@ pub const PARAMS: &[Param] = &[
             ],
         },
         get: |p| {
-            match p.freq_merge {
+            match p.frequency.merge {
                 MergePolicy::MinRadius => "min",
                 MergePolicy::PosterMax => "poster-max",
             }
             .to_owned()
         },
         set: |p, v| {
-            p.freq_merge = match v {
+            p.frequency.merge = match v {
                 "min" => MergePolicy::MinRadius,
                 "poster-max" => MergePolicy::PosterMax,
                 _ => return Err("is not one of min, poster-max".to_owned()),
@@ -217,14 +218,14 @@ pub const PARAMS: &[Param] = &[
             ],
         },
         get: |p| {
-            match p.freq_floor {
+            match p.frequency.floor {
                 FrequencyFloor::Keep => "keep",
                 FrequencyFloor::Clamp => "clamp",
             }
             .to_owned()
         },
         set: |p, v| {
-            p.freq_floor = match v {
+            p.frequency.floor = match v {
                 "keep" => FrequencyFloor::Keep,
                 "clamp" => FrequencyFloor::Clamp,
                 _ => return Err("is not one of keep, clamp".to_owned()),
@@ -240,9 +241,9 @@ pub const PARAMS: &[Param] = &[
             value_name: "K",
             choices: &[],
         },
-        get: |p| p.kernel_k.to_string(),
+        get: |p| p.frequency.kernel_k.to_string(),
         set: |p, v| {
-            p.kernel_k = match v {
+            p.frequency.kernel_k = match v {
                 "strict" => K_STRICT,
                 "poster" => K_POSTER,
                 _ => parse_number(v)?,
@@ -258,9 +259,9 @@ pub const PARAMS: &[Param] = &[
             value_name: "G",
             choices: &[],
         },
-        get: |p| p.freq_grow.to_string(),
+        get: |p| p.frequency.grow.to_string(),
         set: |p, v| {
-            p.freq_grow = parse_number(v)?;
+            p.frequency.grow = parse_number(v)?;
             Ok(())
         },
     },
@@ -272,9 +273,9 @@ pub const PARAMS: &[Param] = &[
             value_name: "A",
             choices: &[],
         },
-        get: |p| p.freq_hold_alpha.to_string(),
+        get: |p| p.frequency.hold_alpha.to_string(),
         set: |p, v| {
-            p.freq_hold_alpha = parse_number(v)?;
+            p.frequency.hold_alpha = parse_number(v)?;
             Ok(())
         },
     },
@@ -286,10 +287,11 @@ pub const PARAMS: &[Param] = &[
             value_name: "N",
             choices: &[],
         },
-        get: |p| p.freq_pilot.to_string(),
+        get: |p| p.frequency.pilot.to_string(),
         set: |p, v| {
             let n: i64 = v.parse().map_err(|_| "is not a whole number".to_owned())?;
-            p.freq_pilot = u32::try_from(n).map_err(|_| "is outside [0, 1000000]".to_owned())?;
+            p.frequency.pilot =
+                u32::try_from(n).map_err(|_| "is outside [0, 1000000]".to_owned())?;
             Ok(())
         },
     },
@@ -298,9 +300,9 @@ pub const PARAMS: &[Param] = &[
         flag: "no-freq-clear-cap",
         help: "Cap only the held slots of a frequency method at the clear radius of their gather disc (by default every slot's radius is capped there, which removes most of the bias at corners and edges)",
         kind: ParamKind::Switch { sets: false },
-        get: |p| on_off(p.freq_clear_cap),
+        get: |p| on_off(p.frequency.clear_cap),
         set: |p, v| {
-            p.freq_clear_cap = parse_switch(v)?;
+            p.frequency.clear_cap = parse_switch(v)?;
             Ok(())
         },
     },
@@ -309,9 +311,9 @@ pub const PARAMS: &[Param] = &[
         flag: "no-freq-probe-share",
         help: "Let every candidate of a frequency method probe its own clear disc (by default the candidates of a 2x2 block of pixels share one probe for 16 passes where their points lie in one plane inside it)",
         kind: ParamKind::Switch { sets: false },
-        get: |p| on_off(p.freq_probe_share),
+        get: |p| on_off(p.frequency.probe_share),
         set: |p, v| {
-            p.freq_probe_share = parse_switch(v)?;
+            p.frequency.probe_share = parse_switch(v)?;
             Ok(())
         },
     },
@@ -320,9 +322,9 @@ pub const PARAMS: &[Param] = &[
         flag: "no-light-tracing",
         help: "Photon mappers: do not connect stored photons to the camera (by default they are, where kernels cover at most two camera samples, and weighted against merging by multiple importance sampling)",
         kind: ParamKind::Switch { sets: false },
-        get: |p| on_off(p.light_tracing),
+        get: |p| on_off(p.connections.light_tracing),
         set: |p, v| {
-            p.light_tracing = parse_switch(v)?;
+            p.connections.light_tracing = parse_switch(v)?;
             Ok(())
         },
     },
@@ -334,9 +336,9 @@ pub const PARAMS: &[Param] = &[
             value_name: "N",
             choices: &[],
         },
-        get: |p| p.max_depth.to_string(),
+        get: |p| p.budget.max_depth.to_string(),
         set: |p, v| {
-            p.max_depth = parse_small(v)?;
+            p.budget.max_depth = parse_small(v)?;
             Ok(())
         },
     },
@@ -348,9 +350,9 @@ pub const PARAMS: &[Param] = &[
             value_name: "N",
             choices: &[],
         },
-        get: |p| p.rr_depth.to_string(),
+        get: |p| p.budget.rr_depth.to_string(),
         set: |p, v| {
-            p.rr_depth = parse_small(v)?;
+            p.budget.rr_depth = parse_small(v)?;
             Ok(())
         },
     },
@@ -362,9 +364,9 @@ pub const PARAMS: &[Param] = &[
             value_name: "N",
             choices: &[],
         },
-        get: |p| p.samples_per_pixel.to_string(),
+        get: |p| p.film.samples_per_pixel.to_string(),
         set: |p, v| {
-            p.samples_per_pixel = parse_small(v)?;
+            p.film.samples_per_pixel = parse_small(v)?;
             Ok(())
         },
     },
@@ -389,9 +391,9 @@ pub const PARAMS: &[Param] = &[
         flag: "direct-lighting",
         help: "Add direct lighting by light sampling at hitpoints instead of gathering photons that arrive straight from an emitter",
         kind: ParamKind::Switch { sets: true },
-        get: |p| on_off(p.direct_lighting),
+        get: |p| on_off(p.connections.direct_lighting),
         set: |p, v| {
-            p.direct_lighting = parse_switch(v)?;
+            p.connections.direct_lighting = parse_switch(v)?;
             Ok(())
         },
     },
@@ -400,9 +402,9 @@ pub const PARAMS: &[Param] = &[
         flag: "no-freq-geometry",
         help: "Let frequency methods hold a radius even where the gather disc hangs over an edge or a corner of the surface (no geometric bound on held kernels)",
         kind: ParamKind::Switch { sets: false },
-        get: |p| on_off(p.freq_geometry),
+        get: |p| on_off(p.frequency.geometry),
         set: |p, v| {
-            p.freq_geometry = parse_switch(v)?;
+            p.frequency.geometry = parse_switch(v)?;
             Ok(())
         },
     },
@@ -411,9 +413,9 @@ pub const PARAMS: &[Param] = &[
         flag: "no-freq-occlusion",
         help: "Let frequency photons travel without probing for partial occlusion near their hits (no shadow edges in their spectra)",
         kind: ParamKind::Switch { sets: false },
-        get: |p| on_off(p.freq_occlusion),
+        get: |p| on_off(p.frequency.occlusion),
         set: |p, v| {
-            p.freq_occlusion = parse_switch(v)?;
+            p.frequency.occlusion = parse_switch(v)?;
             Ok(())
         },
     },
@@ -522,18 +524,18 @@ mod tests {
     fn every_value_reads_back_as_itself() {
         let mut params = RenderParams::preview();
         params.method = Method::FreqSppm;
-        params.initial_radius = Some(0.125);
-        params.freq_merge = MergePolicy::PosterMax;
-        params.freq_floor = FrequencyFloor::Clamp;
-        params.freq_geometry = false;
-        params.direct_lighting = true;
-        params.alpha = 2.0 / 3.0;
-        params.freq_grow = 2.5;
-        params.freq_hold_alpha = 1.0;
-        params.freq_pilot = 0;
-        params.freq_clear_cap = false;
-        params.light_tracing = false;
-        params.freq_probe_share = false;
+        params.kernel.initial_radius = Some(0.125);
+        params.frequency.merge = MergePolicy::PosterMax;
+        params.frequency.floor = FrequencyFloor::Clamp;
+        params.frequency.geometry = false;
+        params.connections.direct_lighting = true;
+        params.kernel.alpha = 2.0 / 3.0;
+        params.frequency.grow = 2.5;
+        params.frequency.hold_alpha = 1.0;
+        params.frequency.pilot = 0;
+        params.frequency.clear_cap = false;
+        params.connections.light_tracing = false;
+        params.frequency.probe_share = false;
         for base in [RenderParams::preview(), params] {
             let mut copy = RenderParams::preview();
             copy.method = Method::Path;
@@ -587,6 +589,6 @@ mod tests {
             Err(ParamError::Unknown { .. })
         ));
         p.set("kernel-k", "poster").unwrap();
-        assert_eq!(p.kernel_k, K_POSTER);
+        assert_eq!(p.frequency.kernel_k, K_POSTER);
     }
 }

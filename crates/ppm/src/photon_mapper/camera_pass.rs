@@ -60,7 +60,7 @@ struct VisiblePoint {
     bounces: u32,
 }
 
-impl PhotonMapper<'_> {
+impl PhotonMapper {
     /// Traces one camera path per slot with this pass's jitter. The emission they see
     /// directly (and the direct lighting, if enabled) is always accumulated, so that emitters
     /// seen through a pixel are antialiased progressively even by PPM; the visible points
@@ -69,7 +69,7 @@ impl PhotonMapper<'_> {
     /// dropped for being NaN or infinite.
     pub(super) fn camera_pass(&mut self, update_hitpoints: bool) -> u64 {
         let setup = &self.setup;
-        let spp = setup.params.samples_per_pixel;
+        let spp = setup.params.film.samples_per_pixel;
         let n_slots = setup.width as usize * setup.height as usize * spp as usize;
         let initial_radius = setup.kernel_scale;
         let first = self.slots.is_empty();
@@ -120,7 +120,7 @@ impl PhotonMapper<'_> {
                 bounces: 0,
             });
             // Visible points have bounces < max_depth ≤ 1024 (`trace_camera_path`).
-            let budget = (setup.params.max_depth - 1).saturating_sub(point.bounces);
+            let budget = (setup.params.budget.max_depth - 1).saturating_sub(point.bounces);
             self.photon_bounces[slot] = match sample.visible {
                 Some(_) => u16::try_from(budget).unwrap_or(NO_VISIBLE_POINT - 1),
                 None => NO_VISIBLE_POINT,
@@ -153,15 +153,15 @@ impl PhotonMapper<'_> {
     }
 }
 
-impl Setup<'_> {
+impl Setup {
     fn trace_camera_path(&self, slot: u32, pass: u32) -> CameraSample {
-        let weight_scale = 1.0 / self.params.samples_per_pixel as f32;
+        let weight_scale = 1.0 / self.params.film.samples_per_pixel as f32;
         let chain = self.camera_chain(slot, pass);
         let mut direct = chain.direct;
         let mut non_finite = 0;
         let visible = chain.end.and_then(|mut end| {
             let hit = &end.hit;
-            if self.params.direct_lighting
+            if self.params.connections.direct_lighting
                 && let Some(bsdf) = self.scene.bsdf(hit)
             {
                 direct += end.throughput
@@ -211,7 +211,7 @@ impl Setup<'_> {
     }
 
     fn camera_chain(&self, slot: u32, pass: u32) -> CameraChain {
-        let spp = self.params.samples_per_pixel;
+        let spp = self.params.film.samples_per_pixel;
         let pixel = slot / spp;
         let (x, y) = (pixel % self.width, pixel / self.width);
         let mut sampler = Sampler::new(self.params.seed, pass, CAMERA_STREAM | u64::from(slot));
@@ -222,14 +222,14 @@ impl Setup<'_> {
         // `bounces`: scattering events of the camera path before this hit. Emission seen here
         // ends a light path with that many; a hitpoint adds one (its own scattering) to the
         // photon's, so it needs bounces < max_depth.
-        for bounces in 0..=self.params.max_depth {
+        for bounces in 0..=self.params.budget.max_depth {
             let Some(hit) = self.scene.intersect(&ray) else {
                 // An escaped camera path sees the environment (zero without one).
                 direct += throughput * self.scene.lights().environment_radiance(ray.direction);
                 break;
             };
             direct += throughput * self.scene.emitted(&hit);
-            if bounces == self.params.max_depth {
+            if bounces == self.params.budget.max_depth {
                 break;
             }
             let Some(material) = self.scene.material(hit.material) else {

@@ -7,6 +7,9 @@ use photon::{GridParams, HitPointGrid, HitPoints};
 
 use super::frequency::SlotFrequency;
 
+/// The grid entry of a slot the grid does not index (no visible point this pass).
+pub(super) const NOT_IN_GRID: u32 = u32::MAX;
+
 /// The hash grid over the valid slots and the slot of each of its entries.
 #[derive(Default)]
 pub(super) struct Index {

@@ -1,4 +1,4 @@
-//! The progressive loop shared by PPM, SPPM and their frequency-guided variants.
+//! The progressive photon mappers: PPM, SPPM and their frequency-guided variants.
 //!
 //! One pass is four phases, one file each:
 //!
@@ -8,20 +8,24 @@
 //!    them into the hitpoints;
 //! 4. `update.rs`: fold the pass into R, N, τ, shrinking held slots by α_hold instead of α.
 //!
-//! `frequency.rs` holds the whole frequency extension, which those phases call into.
-//! `stats.rs` holds what a pass reports. This file holds the state they share and the image.
+//! `frequency/` holds the frequency extension, which those phases call into; `memory.rs` what
+//! a render holds; `state.rs` what a checkpoint keeps of it. This file holds the state the
+//! phases share, the pass that runs them ([`PhotonMapper::run_pass`], which the
+//! pass-independent estimator of `crate::independent` runs with its own radii and image), and
+//! the image.
 
 mod camera_pass;
 mod frequency;
-mod independent;
 mod index;
+mod memory;
 mod photon_pass;
-mod stats;
+mod state;
 #[cfg(test)]
 mod tests;
 mod trace;
 mod update;
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use photon::HitPoints;
@@ -29,13 +33,15 @@ use rayon::prelude::*;
 use scene::Scene;
 use spectrum::Caps;
 
-pub(crate) use self::frequency::SlotFrequency;
-pub(crate) use self::independent::pilot_kernels;
-pub use self::independent::{Part, PartError, PassSums};
-pub use self::stats::{MemoryEstimate, MemoryUse, PassStats, PassTimings};
-use self::{frequency::FrequencyDeposits, index::Index, photon_pass::PhotonPass};
+pub use self::memory::bytes_per_hitpoint;
+pub(crate) use self::memory::estimate;
+use self::photon_pass::PhotonPass;
+use self::{frequency::FrequencyDeposits, frequency::SlotFrequency, index::Index};
+use crate::aov::Aov;
+use crate::checkpoint::codec::{Reader, StateError, Writer};
+use crate::integrator::Integrator;
 use crate::params::{ParamError, RenderParams};
-use crate::renderer::Aov;
+use crate::stats::{MemoryUse, PassStats};
 use crate::update::GatherStats;
 
 /// Photons per parallel work item. Fixed (not derived from the thread count) so that the
@@ -46,8 +52,8 @@ const SLOT_CHUNK: usize = 1024;
 
 /// What every phase reads and none changes: the scene, the parameters and what follows from
 /// them.
-struct Setup<'s> {
-    scene: &'s Scene,
+struct Setup {
+    scene: Arc<Scene>,
     params: RenderParams,
     caps: Caps,
     /// The initial gather radius R₀ (the largest kernel is [`Setup::kernel_max`]).
@@ -58,8 +64,8 @@ struct Setup<'s> {
 
 /// The photon mappers' state: hitpoint slots with their statistics, the grid, the direct
 /// emission seen by camera paths, and each phase's buffers.
-pub(crate) struct PhotonMapper<'s> {
-    setup: Setup<'s>,
+pub(crate) struct PhotonMapper {
+    setup: Setup,
     pass: u32,
     n_emitted: u64,
     slots: HitPoints<SlotFrequency>,
@@ -77,9 +83,6 @@ pub(crate) struct PhotonMapper<'s> {
     photons: PhotonPass,
     /// The frequency deposits' buffers.
     frequency: FrequencyDeposits,
-    /// The pass-independent estimator's kernels and sums (`appm` only; set before its first
-    /// pass).
-    independent: Option<independent::Independent>,
     /// Per 2 × 2 block of pixels, the clear disc its slots share ([`frequency::BlockDisc`]): a
     /// function of the scene, the parameters and the pass, recomputed where missing (after a
     /// restore), so that it is not part of a checkpoint.
@@ -87,36 +90,10 @@ pub(crate) struct PhotonMapper<'s> {
 }
 
 /// `photon_bounces` of a slot without a visible point (budgets are below `max_depth` ≤ 1024).
-const NO_VISIBLE_POINT: u16 = u16::MAX;
-
-/// The state of a photon mapper between passes, as a checkpoint restores it
-/// ([`PhotonMapper::restore`]).
-pub(crate) struct SavedState {
-    /// Photons emitted so far.
-    pub(crate) n_emitted: u64,
-    /// Camera passes so far.
-    pub(crate) camera_passes: u32,
-    /// The hitpoint records.
-    pub(crate) slots: HitPoints<SlotFrequency>,
-    /// Per slot: the photon-bounce budget of its visible point, `None` without one.
-    pub(crate) photon_budget: Vec<Option<u16>>,
-    /// Per slot: the directly seen emission summed over camera passes.
-    pub(crate) direct: Vec<[f64; 3]>,
-}
+pub(crate) const NO_VISIBLE_POINT: u16 = u16::MAX;
 
 /// The largest photon-bounce budget a slot can have.
-pub(crate) const MAX_PHOTON_BUDGET: u16 = NO_VISIBLE_POINT - 1;
-
-/// Memory per hitpoint slot of the photon mappers' fixed columns: the hitpoint record
-/// (`photon::HitPoints` with the frequency state) plus the renderer's per-slot photon-bounce
-/// budget (which also says whether the slot is valid) and direct-emission sum. The hash grid
-/// and its slot map come on top; [`crate::Renderer::memory`] measures everything.
-#[must_use]
-pub fn bytes_per_hitpoint() -> usize {
-    HitPoints::<SlotFrequency>::bytes_per_hitpoint()
-        + std::mem::size_of::<u16>()
-        + std::mem::size_of::<[f64; 3]>()
-}
+const MAX_PHOTON_BUDGET: u16 = NO_VISIBLE_POINT - 1;
 
 /// The smallppm choice of initial radius: twice the mean extent of the scene's bounding box
 /// divided by the mean film size in pixels, about a two-pixel footprint.
@@ -131,35 +108,37 @@ pub fn auto_initial_radius(scene: &Scene) -> f64 {
     if r > 0.0 && r.is_finite() { r } else { 1e-3 }
 }
 
-impl<'s> PhotonMapper<'s> {
-    /// A renderer for `scene` with `params`; nothing is traced until the first
-    /// [`crate::Renderer::iterate`].
+impl PhotonMapper {
+    /// A renderer for `scene` with `params`; nothing is traced until the first pass.
     ///
     /// # Errors
     ///
     /// [`ParamError`] if a parameter is outside its domain or the film is too large.
-    pub(crate) fn new(scene: &'s Scene, params: RenderParams) -> Result<Self, ParamError> {
+    pub(crate) fn new(scene: Arc<Scene>, params: RenderParams) -> Result<Self, ParamError> {
         params.validate()?;
         let film = scene.description().film;
-        let n_slots =
-            u64::from(film.width) * u64::from(film.height) * u64::from(params.samples_per_pixel);
+        let n_slots = u64::from(film.width)
+            * u64::from(film.height)
+            * u64::from(params.film.samples_per_pixel);
         if n_slots == 0 || n_slots > u64::from(u32::MAX) {
             return Err(ParamError::TooManyHitpoints {
                 width: film.width,
                 height: film.height,
-                samples_per_pixel: params.samples_per_pixel,
+                samples_per_pixel: params.film.samples_per_pixel,
             });
         }
         let bounds = scene.bounds();
         let scene_size = f64::from((bounds.max - bounds.min).length()).max(1e-6);
+        let kernel_scale = params
+            .kernel
+            .initial_radius
+            .unwrap_or_else(|| auto_initial_radius(&scene));
         Ok(Self {
             setup: Setup {
                 scene,
                 params,
                 caps: Caps::for_scene_size(scene_size),
-                kernel_scale: params
-                    .initial_radius
-                    .unwrap_or_else(|| auto_initial_radius(scene)),
+                kernel_scale,
                 width: film.width,
                 height: film.height,
             },
@@ -172,25 +151,26 @@ impl<'s> PhotonMapper<'s> {
             index: Index::default(),
             photons: PhotonPass::default(),
             frequency: FrequencyDeposits::default(),
-            independent: None,
             block_discs: Vec::new(),
         })
     }
 
+    /// The scene being rendered.
+    pub(crate) fn scene(&self) -> &Arc<Scene> {
+        &self.setup.scene
+    }
+
     /// The parameters this renderer runs with.
-    #[must_use]
     pub(crate) fn params(&self) -> &RenderParams {
         &self.setup.params
     }
 
     /// Passes completed so far.
-    #[must_use]
     pub(crate) fn passes(&self) -> u32 {
         self.pass
     }
 
     /// Photons emitted over all passes so far.
-    #[must_use]
     pub(crate) fn photons_emitted(&self) -> u64 {
         self.n_emitted
     }
@@ -200,113 +180,86 @@ impl<'s> PhotonMapper<'s> {
     fn photons_counted(&self) -> u64 {
         match self.setup.params.growth_pass() {
             Some(p) if self.pass > p => {
-                self.n_emitted - u64::from(p) * u64::from(self.setup.params.photons_per_pass)
+                self.n_emitted - u64::from(p) * u64::from(self.setup.params.budget.photons_per_pass)
             }
             _ => self.n_emitted,
         }
     }
 
     /// Whether `slot` holds a visible point in the current pass.
-    #[must_use]
     fn is_valid(&self, slot: usize) -> bool {
         self.photon_bounces[slot] != NO_VISIBLE_POINT
-    }
-
-    /// The hitpoint records, for the checkpoint codec.
-    pub(crate) fn slots(&self) -> &HitPoints<SlotFrequency> {
-        &self.slots
-    }
-
-    /// The photon-bounce budget of `slot`'s visible point, `None` without one.
-    pub(crate) fn photon_budget(&self, slot: usize) -> Option<u16> {
-        let budget = self.photon_bounces[slot];
-        (budget != NO_VISIBLE_POINT).then_some(budget)
-    }
-
-    /// The directly seen emission of `slot`, summed over camera passes.
-    pub(crate) fn direct(&self, slot: usize) -> [f64; 3] {
-        self.direct[slot]
-    }
-
-    /// Camera passes so far.
-    pub(crate) fn camera_passes(&self) -> u32 {
-        self.camera_passes
-    }
-
-    /// Takes back the state of a checkpoint after `passes` passes. The caller checked that
-    /// the columns have one entry per slot (or none, before the first pass) and that every
-    /// budget is at most [`MAX_PHOTON_BUDGET`].
-    pub(crate) fn restore(&mut self, passes: u32, state: SavedState) {
-        self.pass = passes;
-        self.n_emitted = state.n_emitted;
-        self.camera_passes = state.camera_passes;
-        self.slots = state.slots;
-        self.photon_bounces = state
-            .photon_budget
-            .into_iter()
-            .map(|b| b.unwrap_or(NO_VISIBLE_POINT))
-            .collect();
-        self.direct = state.direct;
     }
 
     /// The number of hitpoint slots of a full film.
     pub(crate) fn n_slots(&self) -> usize {
         self.setup.width as usize
             * self.setup.height as usize
-            * self.setup.params.samples_per_pixel as usize
+            * self.setup.params.film.samples_per_pixel as usize
     }
 
-    /// Heap memory by part (capacities of the buffers).
-    #[must_use]
-    pub(crate) fn memory(&self) -> MemoryUse {
-        use std::mem::size_of;
-        let (photon_buffers, hitpoint_buffers) = self.photons.heap_bytes();
-        let (frequency_records, frequency_per_entry) = self.frequency.heap_bytes();
-        MemoryUse {
-            hitpoints: self.slots.len(),
-            records: self.slots.heap_bytes(),
-            slot_columns: self.photon_bounces.capacity() * size_of::<u16>()
-                + self.direct.capacity() * size_of::<[f64; 3]>(),
-            grid: self.index.heap_bytes(),
-            pass_hitpoint_buffers: hitpoint_buffers + frequency_per_entry,
-            pass_photon_buffers: photon_buffers + frequency_records,
+    /// Continues at pass `passes`, as if that many passes of `photons_per_pass` photons had
+    /// run (a pass-independent render's next pass; its slots carry nothing between passes).
+    pub(crate) fn start_at(&mut self, passes: u32) {
+        self.pass = passes;
+        self.n_emitted = u64::from(passes) * u64::from(self.setup.params.budget.photons_per_pass);
+    }
+
+    /// The initial gather radius R₀.
+    pub(crate) fn initial_radius(&self) -> f64 {
+        self.setup.kernel_scale
+    }
+
+    /// The slots' radii, to be set before the grid is built.
+    pub(crate) fn radii_mut(&mut self) -> &mut [f64] {
+        self.slots.columns_mut().radius
+    }
+
+    /// After a photon pass: each slot's radius, directly seen emission, photon-bounce budget
+    /// ([`NO_VISIBLE_POINT`] without a visible point), and the pass's photon deposits.
+    pub(crate) fn pass_columns(&self) -> (&[f64], &[[f64; 3]], &[u16], &PhotonPass) {
+        (
+            self.slots.radius(),
+            &self.direct,
+            &self.photon_bounces,
+            &self.photons,
+        )
+    }
+
+    /// Forgets the directly seen emission summed so far.
+    pub(crate) fn clear_direct(&mut self) {
+        for d in &mut self.direct {
+            *d = [0.0; 3];
         }
     }
 
-    /// Runs one pass: camera pass (the first time, or every time for SPPM), hash grid,
-    /// photon pass, hitpoint update.
-    pub(crate) fn iterate(&mut self) -> PassStats {
+    /// Runs one pass: the camera pass (the first time, or every time for SPPM), then
+    /// `before_grid` (which sets the radii a pass gathers with, and says whether it changed
+    /// them), the hash grid, the photon pass, and `after_photons` (which folds the pass into
+    /// the estimate).
+    pub(crate) fn run_pass(
+        &mut self,
+        before_grid: impl FnOnce(&mut Self) -> bool,
+        after_photons: impl FnOnce(&mut Self, &mut PassStats),
+    ) -> PassStats {
         let mut stats = PassStats::empty(self.pass);
         let clock = Instant::now();
         let stochastic = self.setup.params.method.is_stochastic();
         let retrace = self.slots.is_empty() || stochastic;
-        if self.setup.params.method.is_pass_independent() && self.independent.is_none() {
-            let kernels = independent::pilot_kernels(self.setup.scene, self.setup.params);
-            let pixels = self.setup.width as usize * self.setup.height as usize;
-            self.set_independent(kernels, PassSums::new(pixels), self.pass);
-        }
         stats.non_finite += self.camera_pass(retrace);
-        self.schedule_radii();
-        let grow = self.setup.params.growth_pass() == Some(self.pass);
-        if grow {
-            self.grow_kernels();
-        }
+        let radii_changed = before_grid(self);
         stats.camera_paths = self.slots.len() as u64;
         let camera = clock.elapsed().as_secs_f64();
         let photon_bounces = &self.photon_bounces;
         self.index.update(
             &self.slots,
             |slot| photon_bounces[slot] != NO_VISIBLE_POINT,
-            !stochastic && !grow,
+            !stochastic && !radii_changed,
         );
         let index = clock.elapsed().as_secs_f64() - camera;
         self.photon_pass(&mut stats);
         let photons_done = clock.elapsed().as_secs_f64();
-        if self.independent.is_some() {
-            self.add_pass_image(&mut stats);
-        } else {
-            self.update_hitpoints(&mut stats);
-        }
+        after_photons(self, &mut stats);
         let timings = &mut stats.timings;
         timings.camera = camera;
         timings.index = index;
@@ -314,42 +267,6 @@ impl<'s> PhotonMapper<'s> {
         timings.update = clock.elapsed().as_secs_f64() - photons_done;
         self.pass += 1;
         stats
-    }
-
-    /// The current estimate: linear RGB radiance per pixel, row-major from the top-left,
-    /// `width × height` entries.
-    #[must_use]
-    pub(crate) fn image(&self) -> Vec<[f32; 3]> {
-        let spp = self.setup.params.samples_per_pixel as usize;
-        let n_pixels = self.setup.width as usize * self.setup.height as usize;
-        if let Some(sums) = self.pass_sums() {
-            return sums.image();
-        }
-        let mut image = vec![[0.0f32; 3]; n_pixels];
-        if self.slots.is_empty() {
-            return image;
-        }
-        let radius = self.slots.radius();
-        let count = self.slots.photon_count();
-        let flux = self.slots.flux();
-        let n_emitted = self.photons_counted() as f64;
-        let camera_passes = f64::from(self.camera_passes.max(1));
-        image.par_iter_mut().enumerate().for_each(|(pixel, out)| {
-            let mut sum = [0.0f64; 3];
-            for slot in pixel * spp..(pixel + 1) * spp {
-                let stats = GatherStats {
-                    radius: radius[slot],
-                    photon_count: count[slot],
-                    flux: flux[slot],
-                };
-                let photons = stats.radiance(n_emitted).unwrap_or([0.0; 3]);
-                for c in 0..3 {
-                    sum[c] += photons[c] + self.direct[slot][c] / camera_passes;
-                }
-            }
-            *out = sum.map(|v| v as f32);
-        });
-        image
     }
 
     /// A per-slot quantity averaged over each pixel's valid slots: radius, photon count,
@@ -360,13 +277,13 @@ impl<'s> PhotonMapper<'s> {
         if matches!(aov, Aov::FreqRadius | Aov::FreqHeld) && !params.method.uses_frequency() {
             return None;
         }
-        let spp = params.samples_per_pixel as usize;
+        let spp = params.film.samples_per_pixel as usize;
         let n_pixels = self.setup.width as usize * self.setup.height as usize;
         let slots = &self.slots;
         if slots.is_empty() {
             return Some(vec![0.0; n_pixels]);
         }
-        let k = params.kernel_k;
+        let k = params.frequency.kernel_k;
         let aov = (0..n_pixels)
             .into_par_iter()
             .map(|pixel| {
@@ -398,5 +315,86 @@ impl<'s> PhotonMapper<'s> {
             })
             .collect();
         Some(aov)
+    }
+}
+
+impl Integrator for PhotonMapper {
+    fn params(&self) -> &RenderParams {
+        &self.setup.params
+    }
+
+    fn passes(&self) -> u32 {
+        self.pass
+    }
+
+    fn photons_emitted(&self) -> u64 {
+        self.n_emitted
+    }
+
+    /// A progressive pass: after the camera pass a frequency method may grow its kernels
+    /// (once, after its pilot), and after the photons every slot folds the pass into R, N, τ.
+    fn iterate(&mut self) -> PassStats {
+        self.run_pass(
+            |m| {
+                let grow = m.setup.params.growth_pass() == Some(m.pass);
+                if grow {
+                    m.grow_kernels();
+                }
+                grow
+            },
+            Self::update_hitpoints,
+        )
+    }
+
+    /// The current estimate: linear RGB radiance per pixel, row-major from the top-left,
+    /// `width × height` entries.
+    fn image(&self) -> Vec<[f32; 3]> {
+        let spp = self.setup.params.film.samples_per_pixel as usize;
+        let n_pixels = self.setup.width as usize * self.setup.height as usize;
+        let mut image = vec![[0.0f32; 3]; n_pixels];
+        if self.slots.is_empty() {
+            return image;
+        }
+        let radius = self.slots.radius();
+        let count = self.slots.photon_count();
+        let flux = self.slots.flux();
+        let n_emitted = self.photons_counted() as f64;
+        let camera_passes = f64::from(self.camera_passes.max(1));
+        image.par_iter_mut().enumerate().for_each(|(pixel, out)| {
+            let mut sum = [0.0f64; 3];
+            for slot in pixel * spp..(pixel + 1) * spp {
+                let stats = GatherStats {
+                    radius: radius[slot],
+                    photon_count: count[slot],
+                    flux: flux[slot],
+                };
+                let photons = stats.radiance(n_emitted).unwrap_or([0.0; 3]);
+                for c in 0..3 {
+                    sum[c] += photons[c] + self.direct[slot][c] / camera_passes;
+                }
+            }
+            *out = sum.map(|v| v as f32);
+        });
+        image
+    }
+
+    fn aov(&self, aov: Aov) -> Option<Vec<f32>> {
+        self.slot_aov(aov)
+    }
+
+    fn memory(&self) -> Option<MemoryUse> {
+        Some(PhotonMapper::memory(self))
+    }
+
+    fn save(&self, w: &mut Writer) {
+        self.write_state(w);
+    }
+
+    fn saved_bound(&self) -> usize {
+        state::bound(self.n_slots())
+    }
+
+    fn restore(&mut self, r: &mut Reader<'_>, passes: u32) -> Result<(), StateError> {
+        self.read_state(r, passes)
     }
 }

@@ -10,11 +10,9 @@ use rayon::prelude::*;
 use scene::{Bsdf, Rgb};
 
 use super::frequency::FrequencyPhoton;
+use super::index::NOT_IN_GRID;
 use super::trace::{LightTracing, TracedPhotons};
 use super::{NO_VISIBLE_POINT, PHOTON_CHUNK, PassStats, PhotonMapper};
-
-/// `PhotonPass::slot_entry` of a slot the grid does not index.
-pub(super) const NOT_IN_GRID: u32 = u32::MAX;
 
 /// The photon pass's buffers and what it leaves for the update: M and Φ per grid entry.
 ///
@@ -22,7 +20,7 @@ pub(super) const NOT_IN_GRID: u32 = u32::MAX;
 /// hundred megabytes of them, which freshly allocated would cost page faults and serial copies.
 /// None of it carries state between passes.
 #[derive(Default)]
-pub(super) struct PhotonPass {
+pub(crate) struct PhotonPass {
     /// Per chunk of [`PHOTON_CHUNK`] photon paths, what they stored.
     pub(super) traced: Vec<TracedPhotons>,
     /// Morton keys of the stored photons.
@@ -46,7 +44,7 @@ pub(super) struct PhotonPass {
 
 impl PhotonPass {
     /// M and Φ of `slot` in the last pass.
-    pub(super) fn deposit_of(&self, slot: usize) -> (u32, [f64; 3]) {
+    pub(crate) fn deposit_of(&self, slot: usize) -> (u32, [f64; 3]) {
         match self.slot_entry[slot] {
             NOT_IN_GRID => (0, [0.0; 3]),
             entry => self.per_entry[entry as usize],
@@ -54,7 +52,7 @@ impl PhotonPass {
     }
 
     /// The light-traced radiance of `slot` in the last pass, times the photons emitted.
-    pub(super) fn light_of(&self, slot: usize) -> [f64; 3] {
+    pub(crate) fn light_of(&self, slot: usize) -> [f64; 3] {
         self.light.get(slot).copied().unwrap_or([0.0; 3])
     }
 
@@ -85,25 +83,31 @@ impl PhotonPass {
     }
 }
 
-impl PhotonMapper<'_> {
+impl PhotonMapper {
     /// Traces this pass's photons (in parallel, fixed chunks), then gathers them into the
     /// hitpoints in Morton order, and the frequency photons' deposits with them; reports the
     /// photon counts and the tracing and frequency times in `stats`.
     pub(super) fn photon_pass(&mut self, stats: &mut PassStats) {
         let setup = &self.setup;
-        let n = u64::from(setup.params.photons_per_pass);
+        let n = u64::from(setup.params.budget.photons_per_pass);
         let first_index = self.n_emitted;
         let pass = self.pass;
         let clock = Instant::now();
         let buffers = &mut self.photons;
         let n_chunks = usize::try_from(n.div_ceil(PHOTON_CHUNK)).unwrap_or(usize::MAX);
         buffers.traced.resize_with(n_chunks, TracedPhotons::default);
-        let layout = self.frequency.layout(n_chunks, setup.params.max_depth);
+        let layout = self
+            .frequency
+            .layout(n_chunks, setup.params.budget.max_depth);
         let textured_hits = setup.scene.textured_hits();
-        let light = setup.params.light_tracing.then(|| LightTracing {
-            radii: self.slots.radius(),
-            samples_per_pixel: setup.params.samples_per_pixel,
-        });
+        let light = setup
+            .params
+            .connections
+            .light_tracing
+            .then(|| LightTracing {
+                radii: self.slots.radius(),
+                samples_per_pixel: setup.params.film.samples_per_pixel,
+            });
         buffers
             .traced
             .par_iter_mut()
@@ -142,10 +146,11 @@ impl PhotonMapper<'_> {
             // visible point; 1 where the camera sees it only through specular bounces (a
             // connection cannot reach it).
             let camera = setup.scene.camera();
-            let direct_budget = u16::try_from(setup.params.max_depth - 1).unwrap_or(u16::MAX);
+            let direct_budget =
+                u16::try_from(setup.params.budget.max_depth - 1).unwrap_or(u16::MAX);
             let (positions, normals) = (self.slots.position(), self.slots.geometric_normal());
             let (budgets, radii) = (&self.photon_bounces, self.slots.radius());
-            let spp = setup.params.samples_per_pixel as usize;
+            let spp = setup.params.film.samples_per_pixel as usize;
             buffers.merge_weight.clear();
             buffers.merge_weight.extend((0..n_slots).map(|slot| {
                 let budget = budgets[slot];

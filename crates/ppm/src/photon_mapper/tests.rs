@@ -1,9 +1,13 @@
 //! Tests of the photon mappers' internals.
 
+use std::sync::Arc;
+
+use scene::Scene;
+
 use super::frequency::{TagLayout, UNTAGGED};
 use super::{PassStats, PhotonMapper};
+use crate::integrator::Integrator;
 use crate::{Method, RenderParams};
-use scene::Scene;
 
 #[test]
 fn tags_pack_chunk_and_record_indices_when_they_fit() {
@@ -25,7 +29,7 @@ fn tags_pack_chunk_and_record_indices_when_they_fit() {
 }
 
 /// The shared CornellBox-Sphere at 24 × 24.
-fn cornell_sphere_24() -> Scene {
+fn cornell_sphere_24() -> Arc<Scene> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/scenes/cornell_box/CornellBox-Sphere.obj");
     let mut description = import::load(&path).unwrap();
@@ -33,7 +37,7 @@ fn cornell_sphere_24() -> Scene {
         width: 24,
         height: 24,
     };
-    Scene::new(description).unwrap()
+    Arc::new(Scene::new(description).unwrap())
 }
 
 #[test]
@@ -41,9 +45,9 @@ fn global_tags_deposit_exactly_what_packed_tags_do() {
     let scene = cornell_sphere_24();
     let mut params = RenderParams::preview();
     params.method = Method::FreqPpm;
-    params.photons_per_pass = 5_000;
+    params.budget.photons_per_pass = 5_000;
     let render = |force_global_tags| {
-        let mut mapper = PhotonMapper::new(&scene, params).unwrap();
+        let mut mapper = PhotonMapper::new(Arc::clone(&scene), params).unwrap();
         mapper.frequency.force_global_tags = force_global_tags;
         let stats: Vec<PassStats> = (0..3).map(|_| mapper.iterate()).collect();
         (mapper.image(), mapper.slots.freq().to_vec(), stats)
@@ -73,9 +77,9 @@ fn block_discs_recomputed_mid_epoch_are_those_of_the_epoch_start() {
     let scene = cornell_sphere_24();
     let mut params = RenderParams::preview();
     params.method = Method::FreqSppm;
-    params.photons_per_pass = 5_000;
-    let mut kept = PhotonMapper::new(&scene, params).unwrap();
-    let mut forgot = PhotonMapper::new(&scene, params).unwrap();
+    params.budget.photons_per_pass = 5_000;
+    let mut kept = PhotonMapper::new(Arc::clone(&scene), params).unwrap();
+    let mut forgot = PhotonMapper::new(Arc::clone(&scene), params).unwrap();
     for _ in 0..19 {
         kept.iterate();
         forgot.iterate();

@@ -90,7 +90,7 @@ impl AsRef<[Photon]> for TracedPhotons {
     }
 }
 
-impl Setup<'_> {
+impl Setup {
     /// Traces photon path `index` of pass `pass` and stores its non-specular hits in `out`.
     /// `TEXTURED_HITS` must be the scene's `Scene::textured_hits`.
     ///
@@ -127,9 +127,9 @@ impl Setup<'_> {
         }
         // Read once: the stores into `out` in the loop would otherwise make the compiler
         // reload them through `self.params` at every bounce.
-        let max_depth = self.params.max_depth;
-        let rr_depth = self.params.rr_depth;
-        let direct_lighting = self.params.direct_lighting;
+        let max_depth = self.params.budget.max_depth;
+        let rr_depth = self.params.budget.rr_depth;
+        let direct_lighting = self.params.connections.direct_lighting;
         // `depth`: the photon's bounces before this hit. A hitpoint adds one more, so hits at
         // depth max_depth − 1 are the last that can count.
         for depth in 0..max_depth {
@@ -156,7 +156,8 @@ impl Setup<'_> {
                     incoming,
                     material.kind.lobe(),
                     tag_base,
-                    out,
+                    out.photons.len() as u32,
+                    &mut out.frequency,
                 );
                 out.photons.push(Photon {
                     position: hit.position,
@@ -236,7 +237,7 @@ impl Setup<'_> {
     }
 }
 
-impl Setup<'_> {
+impl Setup {
     /// Light tracing: the photon stored at `hit` (power `power`, arriving along −`incoming`)
     /// reflected toward the lens, added to the slots of the pixel it lands on.
     ///

@@ -8,23 +8,23 @@ use rayon::prelude::*;
 use super::{PassStats, PhotonMapper, frequency};
 use crate::update::GatherStats;
 
-impl PhotonMapper<'_> {
+impl PhotonMapper {
     /// Folds the last photon pass into every slot, and reports the radii and the share of
     /// slots that hold theirs in `stats`.
     pub(super) fn update_hitpoints(&mut self, stats: &mut PassStats) {
         let params = self.setup.params;
-        let alpha = params.alpha;
-        let k = params.kernel_k;
-        let floor = params.freq_floor;
+        let alpha = params.kernel.alpha;
+        let k = params.frequency.kernel_k;
+        let floor = params.frequency.floor;
         let uses_frequency = params.method.uses_frequency();
         let probe_clock = Instant::now();
-        if uses_frequency && params.freq_geometry {
-            self.probe_clear_radii(params.freq_clear_cap, params.freq_probe_share);
+        if uses_frequency && params.frequency.geometry {
+            self.probe_clear_radii(params.frequency.clear_cap, params.frequency.probe_share);
         }
         let probe_seconds = probe_clock.elapsed().as_secs_f64();
         let r_top = self.setup.kernel_max();
-        let hold_alpha = params.freq_hold_alpha;
-        let clear_cap = uses_frequency && params.freq_geometry && params.freq_clear_cap;
+        let hold_alpha = params.frequency.hold_alpha;
+        let clear_cap = uses_frequency && params.frequency.geometry && params.frequency.clear_cap;
         // The cap never goes below a quarter of the initial radius: a smaller disc collects
         // too few photons per pass for its bias gain to pay (measured, docs/integrators.md).
         let r_min = 0.25 * self.setup.kernel_scale;

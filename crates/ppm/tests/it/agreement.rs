@@ -18,19 +18,19 @@ fn photon_mappers_converge_to_the_path_traced_reference_on_cornell_original() {
 fn converge_to_the_path_tracer(name: &str) {
     let scene = cornell(name, 24, 24);
     let mut reference_params = params(Method::Path, 1);
-    reference_params.samples_per_pixel = 128;
-    reference_params.max_depth = 16;
+    reference_params.film.samples_per_pixel = 128;
+    reference_params.budget.max_depth = 16;
     let reference = render(&scene, reference_params, 4);
     let reference_mean = mean(&reference);
 
     for method in PHOTON_METHODS {
         let mut p = params(method, 20_000);
-        p.max_depth = 16;
+        p.budget.max_depth = 16;
         // Fixed hitpoints (PPM) antialias only through several slots per pixel.
-        p.samples_per_pixel = 4;
+        p.film.samples_per_pixel = 4;
         // About a pixel's footprint, rather than the automatic two-pixel radius of this tiny
         // film, whose blur would dominate the comparison.
-        p.initial_radius = Some(0.04);
+        p.kernel.initial_radius = Some(0.04);
         let errors: Vec<(u32, f64, f64)> = [4, 16, 64]
             .into_iter()
             .map(|passes| {
@@ -65,11 +65,11 @@ fn converge_to_the_path_tracer(name: &str) {
 fn the_roulette_depth_changes_noise_not_the_mean() {
     let scene = cornell("CornellBox-Original.obj", 24, 24);
     let mut reference = params(Method::Path, 1);
-    reference.samples_per_pixel = 128;
+    reference.film.samples_per_pixel = 128;
     let reference_mean = mean(&render(&scene, reference, 4));
     for rr_depth in [1, 8] {
         let mut path = reference;
-        path.rr_depth = rr_depth;
+        path.budget.rr_depth = rr_depth;
         let ratio = mean(&render(&scene, path, 4)) / reference_mean;
         assert!(
             (ratio - 1.0).abs() < 0.01,
@@ -78,10 +78,10 @@ fn the_roulette_depth_changes_noise_not_the_mean() {
     }
     let stored = |rr_depth: u32| {
         let mut p = params(Method::Sppm, 20_000);
-        p.rr_depth = rr_depth;
-        p.samples_per_pixel = 4;
-        p.initial_radius = Some(0.04);
-        let mut renderer = ppm::Renderer::new(&scene, p).unwrap();
+        p.budget.rr_depth = rr_depth;
+        p.film.samples_per_pixel = 4;
+        p.kernel.initial_radius = Some(0.04);
+        let mut renderer = ppm::Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
         let stored: u64 = (0..32).map(|_| renderer.iterate().photons_stored).sum();
         (mean(&renderer.image()), stored)
     };

@@ -38,7 +38,7 @@ fn furnace_sphere_gives_the_analytic_radiance_for_every_method() {
     let scene = scene(FURNACE);
     for method in PHOTON_METHODS {
         let mut p = params(method, 20_000);
-        p.max_depth = 64;
+        p.budget.max_depth = 64;
         let image = render(&scene, p, 8);
         let m = mean(&image);
         assert!(
@@ -47,8 +47,8 @@ fn furnace_sphere_gives_the_analytic_radiance_for_every_method() {
         );
     }
     let mut p = params(Method::Path, 1);
-    p.samples_per_pixel = 16;
-    p.max_depth = 64;
+    p.film.samples_per_pixel = 16;
+    p.budget.max_depth = 64;
     let m = mean(&render(&scene, p, 4));
     assert!(
         (m - 1.0).abs() < 0.02,
@@ -106,7 +106,7 @@ fn max_depth_bounds_the_bounces_of_the_whole_light_path() {
         ] {
             for method in PHOTON_METHODS {
                 let mut p = params(method, 20_000);
-                p.max_depth = k;
+                p.budget.max_depth = k;
                 let m = mean(&render(scene, p, 8));
                 assert!(
                     (m / expected - 1.0).abs() < 0.02,
@@ -114,8 +114,8 @@ fn max_depth_bounds_the_bounces_of_the_whole_light_path() {
                 );
             }
             let mut p = params(Method::Path, 1);
-            p.samples_per_pixel = 16;
-            p.max_depth = k;
+            p.film.samples_per_pixel = 16;
+            p.budget.max_depth = k;
             let m = mean(&render(scene, p, 4));
             assert!(
                 (m / expected - 1.0).abs() < 0.02,
@@ -190,11 +190,11 @@ fn point_light_over_a_plane_matches_the_inverse_square_law_pixel_by_pixel() {
     let mut cases: Vec<(Method, Vec<[f32; 3]>)> = Vec::new();
     for method in [Method::Ppm, Method::FreqPpm] {
         let mut p = params(method, 400_000);
-        p.initial_radius = Some(0.03);
+        p.kernel.initial_radius = Some(0.03);
         cases.push((method, render(&scene, p, 16)));
     }
     let mut p = params(Method::Path, 1);
-    p.samples_per_pixel = 64;
+    p.film.samples_per_pixel = 64;
     cases.push((Method::Path, render(&scene, p, 1)));
     for (method, image) in cases {
         // The low-noise region: pixels whose reference radiance is at least half the peak.
@@ -300,7 +300,7 @@ fn pointwise_reference_is_the_radiance_at_the_hitpoints() {
     let mut sppm = params(Method::Sppm, 1);
     assert!(ppm::pointwise_reference(&scene, sppm, 1, 1).is_err());
     sppm.method = Method::Ppm;
-    sppm.direct_lighting = true;
+    sppm.connections.direct_lighting = true;
     assert!(ppm::pointwise_reference(&scene, sppm, 1, 1).is_err());
 }
 
@@ -314,11 +314,11 @@ fn ppm_converges_to_the_pointwise_reference() {
         .map(|v| [v as f32; 3])
         .collect();
     let mut p = params(Method::Ppm, 100_000);
-    p.initial_radius = Some(0.05);
+    p.kernel.initial_radius = Some(0.05);
     // Connections to the camera converge to the pixel average, not to the hitpoints'.
-    p.light_tracing = false;
+    p.connections.light_tracing = false;
     let pointwise = ppm::pointwise_reference(&scene, p, 2, 1).unwrap();
-    let mut renderer = ppm::Renderer::new(&scene, p).unwrap();
+    let mut renderer = ppm::Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
     let mut errors = Vec::new();
     for passes in [4, 16, 64] {
         while renderer.passes() < passes {

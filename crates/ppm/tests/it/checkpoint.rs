@@ -14,13 +14,13 @@ fn resumed_render_is_bit_identical_to_an_uninterrupted_one() {
     ]);
     for (method, light_tracing) in cases {
         let mut p = params(method, 5_000);
-        p.light_tracing = light_tracing;
-        let mut straight = Renderer::new(&scene, p).unwrap();
+        p.connections.light_tracing = light_tracing;
+        let mut straight = Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
         for _ in 0..4 {
             straight.iterate();
         }
 
-        let mut first = Renderer::new(&scene, p).unwrap();
+        let mut first = Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
         first.iterate();
         first.iterate();
         let bytes = first.save_state("scene: cornell sphere");
@@ -29,7 +29,7 @@ fn resumed_render_is_bit_identical_to_an_uninterrupted_one() {
         assert_eq!(header.passes, 2);
         assert_eq!(header.note, "scene: cornell sphere");
         assert_eq!(header.params, p);
-        let mut resumed = Renderer::restore(&scene, &bytes).unwrap();
+        let mut resumed = Renderer::restore(std::sync::Arc::clone(&scene), &bytes).unwrap();
         assert_eq!(resumed.passes(), 2);
         resumed.iterate();
         resumed.iterate();
@@ -52,34 +52,35 @@ fn resumed_render_is_bit_identical_to_an_uninterrupted_one() {
 fn checkpoints_of_another_scene_version_or_corrupt_bytes_are_refused() {
     let scene = cornell("CornellBox-Sphere.obj", 8, 8);
     let other = cornell("CornellBox-Original.obj", 8, 8);
-    let mut renderer = Renderer::new(&scene, params(Method::Ppm, 1_000)).unwrap();
+    let mut renderer =
+        Renderer::new(std::sync::Arc::clone(&scene), params(Method::Ppm, 1_000)).unwrap();
     renderer.iterate();
     let bytes = renderer.save_state("");
 
     assert!(matches!(
-        Renderer::restore(&other, &bytes),
+        Renderer::restore(std::sync::Arc::clone(&other), &bytes),
         Err(StateError::SceneMismatch { .. })
     ));
     assert!(matches!(
-        Renderer::restore(&scene, b"not a checkpoint"),
+        Renderer::restore(std::sync::Arc::clone(&scene), b"not a checkpoint"),
         Err(StateError::NotACheckpoint)
     ));
     let truncated = &bytes[..bytes.len() - 100];
     assert!(matches!(
-        Renderer::restore(&scene, truncated),
+        Renderer::restore(std::sync::Arc::clone(&scene), truncated),
         Err(StateError::Corrupt)
     ));
     let mut flipped = bytes.clone();
     let middle = flipped.len() / 2;
     flipped[middle] ^= 1;
     assert!(matches!(
-        Renderer::restore(&scene, &flipped),
+        Renderer::restore(std::sync::Arc::clone(&scene), &flipped),
         Err(StateError::Corrupt)
     ));
     let mut newer = bytes;
     newer[8] = newer[8].wrapping_add(1);
     assert!(matches!(
-        Renderer::restore(&scene, &newer),
+        Renderer::restore(std::sync::Arc::clone(&scene), &newer),
         Err(StateError::Version { .. })
     ));
 }
@@ -149,8 +150,8 @@ fn checkpoint_with_a_zero_radius_is_refused() {
     // A radius no computation produces, to find a slot's radius in the columns: every slot
     // that no photon reached still has it.
     let radius = 0.012_345_678_9_f64;
-    p.initial_radius = Some(radius);
-    let mut renderer = Renderer::new(&scene, p).unwrap();
+    p.kernel.initial_radius = Some(radius);
+    let mut renderer = Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
     renderer.iterate();
     let bytes = edited(&renderer.save_state(""), |_, body| {
         let pattern = radius.to_le_bytes();
@@ -160,7 +161,7 @@ fn checkpoint_with_a_zero_radius_is_refused() {
             .expect("a slot keeps the initial radius");
         body[at..at + 8].copy_from_slice(&0.0f64.to_le_bytes());
     });
-    match Renderer::restore(&scene, &bytes) {
+    match Renderer::restore(std::sync::Arc::clone(&scene), &bytes) {
         Err(e) => assert_eq!(e, StateError::Corrupt),
         Ok(mut restored) => {
             restored.iterate();
@@ -176,14 +177,15 @@ fn checkpoint_with_a_zero_radius_is_refused() {
 fn checkpoint_with_an_impossible_photon_count_is_refused() {
     let scene = cornell("CornellBox-Sphere.obj", 4, 4);
     let photons = 777;
-    let mut renderer = Renderer::new(&scene, params(Method::Ppm, photons)).unwrap();
+    let mut renderer =
+        Renderer::new(std::sync::Arc::clone(&scene), params(Method::Ppm, photons)).unwrap();
     renderer.iterate();
     let bytes = edited(&renderer.save_state(""), |_, body| {
         // The columns start with the photons emitted.
         assert_eq!(body[..8], u64::from(photons).to_le_bytes());
         body[..8].copy_from_slice(&(u64::MAX - 5).to_le_bytes());
     });
-    match Renderer::restore(&scene, &bytes) {
+    match Renderer::restore(std::sync::Arc::clone(&scene), &bytes) {
         Err(e) => assert_eq!(e, StateError::Corrupt),
         Ok(mut restored) => {
             restored.iterate();
@@ -197,7 +199,8 @@ fn checkpoint_with_an_impossible_photon_count_is_refused() {
 #[test]
 fn checkpoint_with_no_pass_left_is_refused() {
     let scene = cornell("CornellBox-Sphere.obj", 4, 4);
-    let mut renderer = Renderer::new(&scene, params(Method::Path, 1)).unwrap();
+    let mut renderer =
+        Renderer::new(std::sync::Arc::clone(&scene), params(Method::Path, 1)).unwrap();
     renderer.iterate();
     let bytes = edited(&renderer.save_state(""), |head, _| {
         // The head ends with the pass count.
@@ -205,7 +208,7 @@ fn checkpoint_with_no_pass_left_is_refused() {
         assert_eq!(head[at..], 1u32.to_le_bytes());
         head[at..].copy_from_slice(&u32::MAX.to_le_bytes());
     });
-    match Renderer::restore(&scene, &bytes) {
+    match Renderer::restore(std::sync::Arc::clone(&scene), &bytes) {
         Err(e) => assert_eq!(e, StateError::Corrupt),
         Ok(mut restored) => {
             restored.iterate();

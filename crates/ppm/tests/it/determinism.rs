@@ -16,9 +16,9 @@ fn render_with_threads(
         .unwrap();
     pool.install(|| {
         let mut p = params(method, 6_000);
-        p.samples_per_pixel = 2;
-        p.light_tracing = light_tracing;
-        let mut renderer = Renderer::new(&scene, p).unwrap();
+        p.film.samples_per_pixel = 2;
+        p.connections.light_tracing = light_tracing;
+        let mut renderer = Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
         for _ in 0..3 {
             renderer.iterate();
         }

@@ -73,7 +73,7 @@ fn white_furnace_is_one_everywhere_for_every_method() {
     let (on, off) = masks(&scene);
     assert!(on.iter().filter(|&&m| m).count() > 100);
     let mut p = params(Method::Path, 1);
-    p.samples_per_pixel = 16;
+    p.film.samples_per_pixel = 16;
     let mut runs = vec![(Method::Path, render(&scene, p, 4))];
     for method in PHOTON_METHODS {
         runs.push((method, render(&scene, params(method, 50_000), 8)));
@@ -82,8 +82,8 @@ fn white_furnace_is_one_everywhere_for_every_method() {
     // estimation (photons leave a convex body after their first bounce): many camera samples,
     // few photons.
     let mut p = params(Method::Sppm, 1_000);
-    p.direct_lighting = true;
-    p.samples_per_pixel = 16;
+    p.connections.direct_lighting = true;
+    p.film.samples_per_pixel = 16;
     runs.push((Method::Sppm, render(&scene, p, 64)));
     for (method, image) in runs {
         let sphere = mean_where(&image, &on);
@@ -99,7 +99,7 @@ fn white_furnace_is_one_everywhere_for_every_method() {
 
 /// The shared Cornell box with the sphere (open at the front), lit by the shared `museum.exr`
 /// besides its own lamp, at 24 × 24.
-fn museum_cornell() -> scene::Scene {
+fn museum_cornell() -> std::sync::Arc<scene::Scene> {
     let shared = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
     let options = import::LoadOptions {
         environment: Some(shared.join("mitsuba3/common/textures/museum.exr")),
@@ -111,7 +111,7 @@ fn museum_cornell() -> scene::Scene {
         width: 24,
         height: 24,
     };
-    scene::Scene::new(description).unwrap()
+    std::sync::Arc::new(scene::Scene::new(description).unwrap())
 }
 
 #[test]
@@ -223,7 +223,7 @@ radiance = [1.0, 1.0, 1.0]
         scale: 1.0,
         to_world: glam::Mat3::IDENTITY,
     });
-    let scene = scene::Scene::new(description).unwrap();
+    let scene = std::sync::Arc::new(scene::Scene::new(description).unwrap());
     let channel_means = |image: &[[f32; 3]]| {
         let mut m = [0.0f64; 3];
         for p in image {
@@ -234,7 +234,7 @@ radiance = [1.0, 1.0, 1.0]
         m
     };
     let mut p = params(Method::Path, 1);
-    p.samples_per_pixel = 64;
+    p.film.samples_per_pixel = 64;
     let mut runs = vec![(Method::Path, render(&scene, p, 4))];
     for method in PHOTON_METHODS {
         runs.push((method, render(&scene, params(method, 100_000), 8)));

@@ -46,9 +46,9 @@ intensity = [5.0, 5.0, 5.0]
 fn shadow_edges_predict_smaller_kernels_than_smooth_light() {
     let scene = scene(SHADOW_EDGE);
     let mut p = params(Method::FreqPpm, 40_000);
-    p.freq_fraction = 1.0;
-    p.initial_radius = Some(0.02);
-    let mut renderer = Renderer::new(&scene, p).unwrap();
+    p.frequency.fraction = 1.0;
+    p.kernel.initial_radius = Some(0.02);
+    let mut renderer = Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
     for _ in 0..4 {
         renderer.iterate();
     }
@@ -84,8 +84,8 @@ fn shadow_edges_predict_smaller_kernels_than_smooth_light() {
     assert!(far < 0.02, "smooth floor: {far}");
 
     // Without the occlusion probe the edge is invisible to the frequency analysis.
-    p.freq_occlusion = false;
-    let mut blind = Renderer::new(&scene, p).unwrap();
+    p.frequency.occlusion = false;
+    let mut blind = Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
     for _ in 0..4 {
         blind.iterate();
     }
@@ -97,9 +97,9 @@ fn shadow_edges_predict_smaller_kernels_than_smooth_light() {
 fn smooth_direct_light_holds_most_kernels() {
     let scene = scene(SHADOW_EDGE);
     let mut p = params(Method::FreqPpm, 40_000);
-    p.initial_radius = Some(0.02);
-    p.freq_fraction = 0.5;
-    let mut renderer = Renderer::new(&scene, p).unwrap();
+    p.kernel.initial_radius = Some(0.02);
+    p.frequency.fraction = 0.5;
+    let mut renderer = Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
     let mut held = 0.0;
     for _ in 0..4 {
         held = renderer.iterate().frequency_held;
@@ -107,7 +107,7 @@ fn smooth_direct_light_holds_most_kernels() {
     // Everything the camera sees is directly lit and smooth except next to the shadow edge:
     // every hitpoint that has received a frequency photon holds its radius.
     assert!(held > 0.5, "share held by the frequency floor: {held}");
-    let classical = Renderer::new(&scene, params(Method::Ppm, 20_000))
+    let classical = Renderer::new(std::sync::Arc::clone(&scene), params(Method::Ppm, 20_000))
         .unwrap()
         .iterate()
         .frequency_held;

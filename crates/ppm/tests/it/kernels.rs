@@ -15,10 +15,10 @@ fn grown_kernels_keep_the_furnace_radiance() {
     for method in [Method::FreqPpm, Method::FreqSppm] {
         for cap in [false, true] {
             let mut p = params(method, 20_000);
-            p.max_depth = 64;
-            p.freq_grow = 4.0;
-            p.freq_pilot = 2;
-            p.freq_clear_cap = cap;
+            p.budget.max_depth = 64;
+            p.frequency.grow = 4.0;
+            p.frequency.pilot = 2;
+            p.frequency.clear_cap = cap;
             let m = mean(&render(&scene, p, 8));
             assert!(
                 (m - 1.0).abs() < 0.02,
@@ -34,10 +34,10 @@ fn grown_kernels_are_larger_than_the_start_where_the_light_is_smooth() {
     // so after the pilot most kernels grow, and the image stays on the inverse-square law.
     let scene = scene(PLANE);
     let mut p = params(Method::FreqPpm, 100_000);
-    p.initial_radius = Some(0.03);
-    p.freq_grow = 4.0;
-    p.freq_pilot = 2;
-    let mut renderer = Renderer::new(&scene, p).unwrap();
+    p.kernel.initial_radius = Some(0.03);
+    p.frequency.grow = 4.0;
+    p.frequency.pilot = 2;
+    let mut renderer = Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
     let pilot: Vec<_> = (0..2).map(|_| renderer.iterate()).collect();
     assert!(pilot.iter().all(|s| s.max_radius <= 0.03 + 1e-12));
     let after = renderer.iterate();
@@ -63,12 +63,12 @@ fn a_pilot_without_frequency_photons_keeps_the_start_radius() {
     // No frequency photon, no prediction: nothing grows and the render is plain SPPM.
     let scene = scene(FURNACE);
     let mut p = params(Method::FreqSppm, 20_000);
-    p.max_depth = 64;
-    p.freq_fraction = 0.0;
-    p.freq_grow = 4.0;
-    p.freq_pilot = 1;
-    p.initial_radius = Some(0.05);
-    let mut renderer = Renderer::new(&scene, p).unwrap();
+    p.budget.max_depth = 64;
+    p.frequency.fraction = 0.0;
+    p.frequency.grow = 4.0;
+    p.frequency.pilot = 1;
+    p.kernel.initial_radius = Some(0.05);
+    let mut renderer = Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
     for _ in 0..4 {
         let stats = renderer.iterate();
         assert!(stats.max_radius <= 0.05 + 1e-12, "{}", stats.max_radius);

@@ -34,8 +34,8 @@ fn merging_and_connections_sum_to_the_analytic_pixel_averages_at_any_radius() {
     for radius in [0.005, 0.05, 0.15] {
         for method in [Method::Sppm, Method::FreqSppm] {
             let mut p = params(method, 100_000);
-            p.initial_radius = Some(radius);
-            p.light_tracing = true;
+            p.kernel.initial_radius = Some(radius);
+            p.connections.light_tracing = true;
             let image = render(&scene, p, 8);
             let (ratio, rel, n) = bright_region_errors(&image, &reference);
             println!("{method} radius {radius}: ratio {ratio:.4}, mean relative error {rel:.4}");
@@ -62,8 +62,8 @@ fn connections_lower_the_noise_where_kernels_are_below_a_pixel() {
     let mut errors = Vec::new();
     for light_tracing in [false, true] {
         let mut p = params(Method::Sppm, 100_000);
-        p.initial_radius = Some(0.002);
-        p.light_tracing = light_tracing;
+        p.kernel.initial_radius = Some(0.002);
+        p.connections.light_tracing = light_tracing;
         let image = render(&scene, p, 8);
         errors.push(bright_region_errors(&image, &reference).1);
         println!(
@@ -85,8 +85,8 @@ fn furnace_keeps_its_radiance_with_light_tracing() {
     let scene = scene(FURNACE);
     for method in crate::support::PHOTON_METHODS {
         let mut p = params(method, 20_000);
-        p.max_depth = 64;
-        p.light_tracing = true;
+        p.budget.max_depth = 64;
+        p.connections.light_tracing = true;
         let m = mean(&render(&scene, p, 8));
         println!("furnace {method}: {m:.4}");
         assert!(
@@ -136,12 +136,12 @@ intensity = [10.0, 10.0, 10.0]
 fn thin_lens_connections_render_the_path_tracer_s_defocus() {
     let scene = scene(DEFOCUSED_EDGE);
     let mut p: RenderParams = params(Method::Path, 1);
-    p.samples_per_pixel = 256;
+    p.film.samples_per_pixel = 256;
     let reference = render(&scene, p, 1);
     let mut p = params(Method::Sppm, 200_000);
     // Kernels far below a pixel: the image is the connections'.
-    p.initial_radius = Some(0.001);
-    p.light_tracing = true;
+    p.kernel.initial_radius = Some(0.001);
+    p.connections.light_tracing = true;
     let image = render(&scene, p, 8);
     // The columns across the blurred edge, in the middle rows: the profile must match the
     // path tracer's, whose own noise at 256 paths per pixel is about 1 %.

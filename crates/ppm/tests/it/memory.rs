@@ -6,13 +6,13 @@ use ppm::{MemoryEstimate, Method, Renderer};
 
 use crate::support::params;
 
-fn repo_scene(name: &str, width: u32, height: u32) -> scene::Scene {
+fn repo_scene(name: &str, width: u32, height: u32) -> std::sync::Arc<scene::Scene> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../scenes")
         .join(name);
     let mut description = import::load(&path).unwrap();
     description.film = scene::Film { width, height };
-    scene::Scene::new(description).unwrap()
+    std::sync::Arc::new(scene::Scene::new(description).unwrap())
 }
 
 /// On a caustic, a box and an indirectly lit room, for the classical and the frequency-guided
@@ -32,12 +32,12 @@ fn the_estimate_covers_what_a_render_holds() {
             .chain([(Method::Sppm, true), (Method::FreqSppm, true)]);
         for (method, light_tracing) in cases {
             let mut params = params(method, 20_000);
-            params.light_tracing = light_tracing;
+            params.connections.light_tracing = light_tracing;
             // Kernels a tenth of the automatic one: every stored photon is connected.
             if light_tracing {
-                params.initial_radius = Some(1e-3);
+                params.kernel.initial_radius = Some(1e-3);
             }
-            let mut renderer = Renderer::new(&scene, params).unwrap();
+            let mut renderer = Renderer::new(std::sync::Arc::clone(&scene), params).unwrap();
             for _ in 0..3 {
                 renderer.iterate();
             }
@@ -72,30 +72,30 @@ fn the_estimate_covers_what_a_render_holds() {
 fn the_estimate_follows_the_flags() {
     let mut p = params(Method::FreqSppm, 100_000);
     // Light tracing's buffers grow with the slots per pixel too (below).
-    p.light_tracing = false;
+    p.connections.light_tracing = false;
     let base = MemoryEstimate::of(100, 100, &p);
-    p.samples_per_pixel = 4;
+    p.film.samples_per_pixel = 4;
     let spp = MemoryEstimate::of(100, 100, &p);
     assert_eq!(spp.hitpoints, 4 * base.hitpoints);
     assert_eq!(spp.photons, base.photons);
-    p.light_tracing = true;
+    p.connections.light_tracing = true;
     let light = MemoryEstimate::of(100, 100, &p);
     assert!(light.hitpoints > spp.hitpoints);
-    p.samples_per_pixel = 1;
+    p.film.samples_per_pixel = 1;
     let light_one = MemoryEstimate::of(100, 100, &p);
     assert_eq!(
         light.photons - base.photons,
         4 * (light_one.photons - base.photons)
     );
-    p.samples_per_pixel = 4;
-    p.light_tracing = false;
-    p.photons_per_pass = 1_000_000;
+    p.film.samples_per_pixel = 4;
+    p.connections.light_tracing = false;
+    p.budget.photons_per_pass = 1_000_000;
     assert_eq!(MemoryEstimate::of(100, 100, &p).photons, 10 * base.photons);
     let path = params(Method::Path, 100_000);
     let path = MemoryEstimate::of(100, 100, &path);
     assert_eq!((path.photons, path.hitpoints), (0, 100 * 100 * 24));
     // No overflow on the largest films and photon counts.
-    p.samples_per_pixel = 1024;
-    p.photons_per_pass = u32::MAX;
+    p.film.samples_per_pixel = 1024;
+    p.budget.photons_per_pass = u32::MAX;
     assert!(MemoryEstimate::of(u32::MAX, u32::MAX, &p).total(true) == u64::MAX);
 }

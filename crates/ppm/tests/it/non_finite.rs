@@ -77,8 +77,8 @@ fn dropped(toml: &str) -> Vec<(Method, u64)> {
                 continue;
             }
             let mut p = params(method, 5_000);
-            p.direct_lighting = direct_lighting;
-            let mut renderer = Renderer::new(&scene, p).unwrap();
+            p.connections.direct_lighting = direct_lighting;
+            let mut renderer = Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
             let mut count = 0;
             for _ in 0..3 {
                 count += renderer.iterate().non_finite;

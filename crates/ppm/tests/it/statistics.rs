@@ -33,7 +33,8 @@ fn describe(stats: &PassStats) -> String {
 fn per_pass_statistics_of_each_method() {
     let scene = cornell("CornellBox-Sphere.obj", 16, 16);
     for method in Method::ALL {
-        let mut renderer = Renderer::new(&scene, params(method, 4_000)).unwrap();
+        let mut renderer =
+            Renderer::new(std::sync::Arc::clone(&scene), params(method, 4_000)).unwrap();
         let lines: Vec<String> = (0..3).map(|_| describe(&renderer.iterate())).collect();
         insta::assert_snapshot!(format!("stats_{}", method.name()), lines.join("\n"));
     }

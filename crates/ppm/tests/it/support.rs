@@ -1,38 +1,39 @@
 //! Scene fixtures and render helpers shared by the tests.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use ppm::{Method, RenderParams, Renderer};
 use scene::Scene;
 
 /// A scene from TOML text (paths relative to this directory).
-pub(crate) fn scene(toml: &str) -> Scene {
+pub(crate) fn scene(toml: &str) -> Arc<Scene> {
     let description = import::load_toml_str(toml, Path::new("test-scene.toml")).unwrap();
-    Scene::new(description).unwrap()
+    Arc::new(Scene::new(description).unwrap())
 }
 
 /// A shared Cornell box (read in place from `../shared/scenes`), at a small film size.
-pub(crate) fn cornell(name: &str, width: u32, height: u32) -> Scene {
+pub(crate) fn cornell(name: &str, width: u32, height: u32) -> Arc<Scene> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/scenes/cornell_box")
         .join(name);
     let mut description = import::load(&path).unwrap();
     description.film = scene::Film { width, height };
-    Scene::new(description).unwrap()
+    Arc::new(Scene::new(description).unwrap())
 }
 
 /// Parameters for a small test render.
 pub(crate) fn params(method: Method, photons_per_pass: u32) -> RenderParams {
     let mut params = RenderParams::preview();
     params.method = method;
-    params.photons_per_pass = photons_per_pass;
+    params.budget.photons_per_pass = photons_per_pass;
     params.seed = 7;
     params
 }
 
 /// Renders `passes` passes and returns the image.
-pub(crate) fn render(scene: &Scene, params: RenderParams, passes: u32) -> Vec<[f32; 3]> {
-    let mut renderer = Renderer::new(scene, params).unwrap();
+pub(crate) fn render(scene: &Arc<Scene>, params: RenderParams, passes: u32) -> Vec<[f32; 3]> {
+    let mut renderer = Renderer::new(Arc::clone(scene), params).unwrap();
     for _ in 0..passes {
         renderer.iterate();
     }

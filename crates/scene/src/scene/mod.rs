@@ -159,9 +159,8 @@ impl Scene {
             }
         }
         let extra = description.triangles.iter().map(triangle_extra).collect();
-        let emitters =
-            crate::validate::emitters(crate::light::Emitters::collect(&description, bounds))
-                .map_err(|e| e.in_scene(&description.source))?;
+        let emitters = crate::light::powered(crate::light::Emitters::collect(&description, bounds))
+            .map_err(|e| e.in_scene(&description.source))?;
         let lights = LightSampler::new(emitters);
         let primitives =
             description.triangles.len() + description.spheres.len() + description.cylinders.len();

@@ -1,5 +1,5 @@
-//! Ray-query robustness on real data: McGuire's Cornell box (OBJ).
-#![allow(clippy::unwrap_used, missing_docs)]
+//! Ray-query robustness of the scene runtime on real data: McGuire's Cornell box (OBJ), read
+//! by the importers.
 
 use glam::{Vec2, Vec3};
 use scene::{Film, Frame, Ray, Scene};
@@ -7,7 +7,7 @@ use scene::{Film, Frame, Ray, Scene};
 /// McGuire's Cornell box, read in place from the shared scenes beside the checkout.
 fn cornell() -> Scene {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/scenes/cornell_box/CornellBox-Original.obj");
+        .join("../../shared/scenes/cornell_box/CornellBox-Original.obj");
     let mut description = import::load(&path).unwrap();
     description.film = Film {
         width: 64,

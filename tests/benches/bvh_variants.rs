@@ -1,7 +1,7 @@
 //! Compares obvhs' own layouts and build presets (triangles only, RtTriangle) with ours
 //! (`Scene::intersect` / `Scene::occluded`, i.e. `src/bvh/`) on the same ray sets, single-threaded:
 //! the measurements behind the choice made in `src/bvh/mod.rs`.
-//! `cargo bench -p scene --bench bvh_variants`.
+//! `cargo bench -p tests --bench bvh_variants`.
 #![allow(clippy::unwrap_used, clippy::print_stdout, missing_docs)]
 
 mod common;
@@ -36,7 +36,7 @@ fn time<F: Fn(&BRay) -> bool>(rays: &[BRay], f: F) -> f64 {
 fn main() {
     let path = Path::new(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/scenes/stanford_bunny/stanford-bunny.obj"
+        "/../../shared/scenes/stanford_bunny/stanford-bunny.obj"
     ));
     let desc = common::load_triangles(path);
     let tris: Vec<Triangle> = desc
@@ -120,7 +120,7 @@ fn main() {
     // Build times alone on the 1M-triangle scene.
     let path = Path::new(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/scenes/gltf/MetalRoughSpheresNoTextures/glTF/MetalRoughSpheresNoTextures.gltf"
+        "/../../shared/scenes/gltf/MetalRoughSpheresNoTextures/glTF/MetalRoughSpheresNoTextures.gltf"
     ));
     if !path.exists() {
         return;

@@ -4,7 +4,7 @@
 //! threads, from `/proc`): on a shared machine the latter stays close to the idle per-core rate when the
 //! former does not. On an idle machine the two agree for one thread.
 //!
-//! `cargo bench -p scene` (scenes from `../shared/scenes` beside the checkout, or the paths given as arguments).
+//! `cargo bench -p tests --bench bvh` (scenes from `../shared/scenes` beside the checkout, or the paths given as arguments).
 #![allow(clippy::unwrap_used, clippy::print_stdout, missing_docs)]
 
 mod common;
@@ -63,8 +63,8 @@ fn main() {
         .collect();
     let paths: Vec<PathBuf> = if args.is_empty() {
         vec![
-            concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/scenes/stanford_bunny/stanford-bunny.obj").into(),
-            concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/scenes/gltf/MetalRoughSpheresNoTextures/glTF/MetalRoughSpheresNoTextures.gltf").into(),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/scenes/stanford_bunny/stanford-bunny.obj").into(),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/scenes/gltf/MetalRoughSpheresNoTextures/glTF/MetalRoughSpheresNoTextures.gltf").into(),
         ]
     } else {
         args.into_iter().map(PathBuf::from).collect()

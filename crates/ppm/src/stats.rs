@@ -1,5 +1,6 @@
-//! What a pass reports (`PassStats`, `PassTimings`) and what a render holds in memory
-//! (`MemoryUse`).
+//! What a pass reports (`PassStats`, `PassTimings`), what a render holds in memory
+//! (`MemoryUse`), and what it will hold, estimated before anything is allocated
+//! (`MemoryEstimate`; each integrator estimates its own and `methods.rs` picks the estimate).
 
 /// Per-pass statistics returned by [`crate::Renderer::iterate`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -149,81 +150,11 @@ pub struct MemoryEstimate {
 /// a Cornell box and an indirectly lit room (0.7–4.8 stored photons per emitted one; see
 /// docs/reliability.md); the estimate takes the upper end, as deep paths store more.
 const PHOTON_BYTES: u64 = 1536;
-/// Hash-grid bytes per hitpoint slot (cells and entries; measured 35–40).
-const GRID_BYTES_PER_SLOT: u64 = 48;
-/// Per-pass buffers per slot: M and Φ per grid entry and the slot's entry (36 bytes), plus a
-/// frequency estimate per entry for the frequency-guided methods (32 more).
-const PASS_BYTES_PER_SLOT: u64 = 36;
-/// Light tracing's buffers per slot: the pass's connected radiance (24 bytes) and the camera
-/// sample density at the visible point (4).
-const LIGHT_BYTES_PER_SLOT: u64 = 28;
-/// Light tracing's buffers per photon emitted and slot per pixel: one 16-byte contribution per
-/// slot of the pixel per connected photon, for up to the 4.8 stored photons per emitted one of
-/// [`PHOTON_BYTES`] (rounded up).
-const LIGHT_BYTES_PER_PHOTON: u64 = 80;
-const FREQUENCY_PASS_BYTES_PER_SLOT: u64 = 32;
 /// Output bytes per pixel: the image, its copy in the EXR writer, the PNG, and up to ten AOV
 /// channels.
-const FILM_BYTES_PER_PIXEL: u64 = 12 + 12 + 4 + 40;
-/// Checkpoint bytes per slot while writing: the encoded record (at most 188) and its
-/// compressed copy (about a third).
-const CHECKPOINT_BYTES_PER_SLOT: u64 = 256;
+pub(crate) const FILM_BYTES_PER_PIXEL: u64 = 12 + 12 + 4 + 40;
 
 impl MemoryEstimate {
-    /// The estimate for a `width × height` film rendered with `params`.
-    #[must_use]
-    pub fn of(width: u32, height: u32, params: &crate::RenderParams) -> Self {
-        let pixels = u64::from(width) * u64::from(height);
-        let film = pixels.saturating_mul(FILM_BYTES_PER_PIXEL);
-        if !params.method.is_photon_mapper() {
-            let sums = pixels.saturating_mul(24);
-            return Self {
-                hitpoints: sums,
-                photons: 0,
-                film,
-                checkpoint: sums,
-            };
-        }
-        let slots = pixels.saturating_mul(u64::from(params.samples_per_pixel));
-        let method = params.method;
-        let per_slot = super::bytes_per_hitpoint() as u64
-            + GRID_BYTES_PER_SLOT
-            + PASS_BYTES_PER_SLOT
-            + if method.uses_frequency() || method.is_pass_independent() {
-                // appm's pilot is a freq-sppm render.
-                FREQUENCY_PASS_BYTES_PER_SLOT
-            } else {
-                0
-            }
-            + if params.light_tracing {
-                LIGHT_BYTES_PER_SLOT
-            } else {
-                0
-            };
-        // appm: each slot's kernel, and each pixel's exact sums (3 × i128).
-        let independent = if method.is_pass_independent() {
-            slots
-                .saturating_mul(8)
-                .saturating_add(pixels.saturating_mul(48))
-        } else {
-            0
-        };
-        Self {
-            hitpoints: slots.saturating_mul(per_slot).saturating_add(independent),
-            photons: Self::photon_bytes(u64::from(params.photons_per_pass)).saturating_add(
-                if params.light_tracing {
-                    u64::from(params.photons_per_pass)
-                        .saturating_mul(LIGHT_BYTES_PER_PHOTON)
-                        .saturating_mul(u64::from(params.samples_per_pixel))
-                } else {
-                    0
-                },
-            ),
-            film,
-            checkpoint: slots.saturating_mul(CHECKPOINT_BYTES_PER_SLOT),
-        }
-    }
-
     /// Photon-buffer bytes of a pass of `photons` photons.
     #[must_use]
     pub fn photon_bytes(photons: u64) -> u64 {

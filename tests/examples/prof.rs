@@ -1,7 +1,7 @@
 //! Runs one kind of ray query many times on one scene, for profilers (callgrind, perf):
 //!
 //! ```text
-//! cargo build --release -p scene --example prof
+//! cargo build --release -p tests --example prof
 //! valgrind --tool=callgrind target/release/examples/prof <scene> <primary|bounce> <closest|occluded> [repeats]
 //! ```
 //!

@@ -2,8 +2,8 @@
 //! very same rays can be fed to another ray tracer (e.g. Embree).
 //!
 //! ```text
-//! cargo run --release -p scene --example rayset -- write <scene.obj|gltf> <primary|diffuse> <out.rays>
-//! cargo run --release -p scene --example rayset -- time  <scene.obj|gltf> <in.rays>
+//! cargo run --release -p tests --example rayset -- write <scene.obj|gltf> <primary|diffuse> <out.rays>
+//! cargo run --release -p tests --example rayset -- time  <scene.obj|gltf> <in.rays>
 //! ```
 //!
 //! File format (little-endian): the 8 bytes `FPPMRAYS`, a `u32` version (1), a `u32` ray count,

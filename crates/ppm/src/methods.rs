@@ -1,0 +1,68 @@
+//! The one list of integrators: which module renders each [`Method`], and what its render
+//! will hold in memory. A new integrator is a module implementing [`Integrator`], its variant
+//! of [`Method`] (with its name and help in `params/`), and its line in [`entry`].
+
+use std::sync::Arc;
+
+use scene::Scene;
+
+use crate::independent::{self, PassIndependent};
+use crate::integrator::Integrator;
+use crate::params::{Method, ParamError, RenderParams};
+use crate::path::{self, PathTracer};
+use crate::photon_mapper::{self, PhotonMapper};
+use crate::stats::{FILM_BYTES_PER_PIXEL, MemoryEstimate};
+
+/// Starts a render of a scene with parameters whose method is this one.
+type Build = fn(Arc<Scene>, RenderParams) -> Result<Box<dyn Integrator>, ParamError>;
+
+/// How to start one method's render, and estimate its memory before anything is allocated.
+struct Entry {
+    build: Build,
+    /// What the render holds for a film of this many pixels, the film itself aside.
+    estimate: fn(u64, &RenderParams) -> MemoryEstimate,
+}
+
+fn entry(method: Method) -> Entry {
+    match method {
+        Method::Ppm | Method::Sppm | Method::FreqPpm | Method::FreqSppm => Entry {
+            build: |scene, params| Ok(Box::new(PhotonMapper::new(scene, params)?)),
+            estimate: |pixels, params| {
+                photon_mapper::estimate(pixels, params, params.method.uses_frequency())
+            },
+        },
+        Method::Appm => Entry {
+            build: |scene, params| Ok(Box::new(PassIndependent::new(scene, params)?)),
+            estimate: independent::estimate,
+        },
+        Method::Path => Entry {
+            build: |scene, params| Ok(Box::new(PathTracer::new(scene, params))),
+            estimate: path::estimate,
+        },
+    }
+}
+
+/// The integrator of `params.method` for `scene`, before its first pass.
+///
+/// # Errors
+///
+/// [`ParamError`] if a parameter is outside its domain or the film is too large.
+pub(crate) fn integrator(
+    scene: Arc<Scene>,
+    params: RenderParams,
+) -> Result<Box<dyn Integrator>, ParamError> {
+    params.validate()?;
+    (entry(params.method).build)(scene, params)
+}
+
+impl MemoryEstimate {
+    /// The estimate for a `width × height` film rendered with `params`: the integrator's own
+    /// (`methods.rs` picks it by method) plus the output image with its AOVs.
+    #[must_use]
+    pub fn of(width: u32, height: u32, params: &RenderParams) -> Self {
+        let pixels = u64::from(width) * u64::from(height);
+        let mut estimate = (entry(params.method).estimate)(pixels, params);
+        estimate.film = pixels.saturating_mul(FILM_BYTES_PER_PIXEL);
+        estimate
+    }
+}
