@@ -6,7 +6,7 @@
 //!   metallic ≥ 0.5 ([`scene::texture::METALLIC_THRESHOLD`]) with roughness < 0.01 → mirror with the base
 //!   colour; metallic ≥ 0.5 otherwise → glossy with α = roughness² and no diffuse base;
 //!   else diffuse with the base colour ([`MetallicRoughness::kind`]), per texel under a metallic-roughness
-//!   texture; textures as [`material`] says.
+//!   texture; textures as `gltf_material.rs` says.
 //!   Emission = emissive factor × emissive strength. A primitive without a material gets
 //!   the glTF default material (white, metallic 1, roughness 1, so glossy with α = 1);
 //! - the camera is the perspective camera with the lowest index that a node of the scene
@@ -23,21 +23,20 @@
 //!   mirroring one; without it the normal map uses the triangle's own frame;
 //! - images are files beside the glTF file, base64 `data:` URIs or buffer views (GLB).
 
-use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::path::Path;
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use gltf::khr_lights_punctual::Kind;
 use gltf::mesh::Mode;
 
 use super::{MeshData, read_bytes};
-use crate::error::LoadError;
-use crate::error::gltf_error;
-use crate::image_file::TextureCache;
-use scene::texture::{
-    Alpha, AlphaMode, MaterialTextures, MetallicRoughness, NormalMap, TextureRef, Wrap,
+use crate::error::{LoadError, gltf_error};
+use crate::gltf_document::{
+    INDICES_RULE, NORMAL_RULE, POSITION_RULE, TANGENT_RULE, TEXCOORD_RULE, layout,
 };
-use scene::{Camera, Light, Material, MaterialKind};
+use crate::gltf_material::{Textures, default_material, material};
+use crate::image_file::TextureCache;
+use scene::{Camera, Light};
 
 /// Deepest node hierarchy accepted (guards against cyclic node graphs).
 const MAX_DEPTH: usize = 1024;
@@ -116,114 +115,6 @@ pub(crate) fn load_gltf(path: &Path) -> Result<MeshData, LoadError> {
     });
     Ok(data)
 }
-
-/// Whether `count` items of `size` bytes, `stride` bytes apart from `offset`, end at an
-/// address that fits in a `usize`.
-fn range_fits(offset: usize, stride: usize, count: usize, size: usize) -> bool {
-    count
-        .checked_sub(1)
-        .and_then(|c| stride.checked_mul(c))
-        .and_then(|x| x.checked_add(offset))
-        .and_then(|x| x.checked_add(size))
-        .is_some()
-}
-
-/// Checks what gltf 1.4.1's accessor reader computes without checking (`accessor/util.rs`,
-/// `Iter::new`): at least one item, a stride no smaller than an item, and byte ranges
-/// (`offset + stride · (count − 1) + size`, a view's `offset + length`) that do not overflow;
-/// the same for a sparse accessor's indices and values. A range past the end of its buffer is
-/// the reader's to report.
-fn layout(accessor: &gltf::Accessor<'_>) -> Result<(), String> {
-    let view_fits =
-        |view: &gltf::buffer::View<'_>| view.offset().checked_add(view.length()).is_some();
-    let strided = |view: &gltf::buffer::View<'_>, offset: usize, count: usize, size: usize| {
-        let stride = view.stride().unwrap_or(size);
-        if stride < size {
-            return Err(format!(
-                "buffer view {} has a stride of {stride} bytes, less than its {size}-byte items",
-                view.index()
-            ));
-        }
-        if !view_fits(view) || !range_fits(offset, stride, count, size) {
-            return Err(format!(
-                "its byte range in buffer view {} overflows",
-                view.index()
-            ));
-        }
-        Ok(())
-    };
-    let (count, size) = (accessor.count(), accessor.size());
-    if count == 0 {
-        return Err("it has no items (count 0)".to_owned());
-    }
-    if let Some(view) = accessor.view() {
-        strided(&view, accessor.offset(), count, size)?;
-    }
-    if let Some(sparse) = accessor.sparse() {
-        let n = sparse.count();
-        if n == 0 {
-            return Err("its sparse storage has no items (count 0)".to_owned());
-        }
-        let indices = sparse.indices();
-        strided(
-            &indices.view(),
-            indices.offset(),
-            n,
-            indices.index_type().size(),
-        )?;
-        let values = sparse.values();
-        strided(&values.view(), values.offset(), n, size)?;
-    }
-    Ok(())
-}
-
-/// What glTF 2.0 allows for an accessor the loader reads.
-struct AccessorRule {
-    what: &'static str,
-    dimensions: gltf::accessor::Dimensions,
-    types: &'static [gltf::accessor::DataType],
-    /// Whether integer components may be normalized (texture coordinates).
-    normalized: bool,
-}
-
-const POSITION_RULE: AccessorRule = AccessorRule {
-    what: "POSITION",
-    dimensions: gltf::accessor::Dimensions::Vec3,
-    types: &[gltf::accessor::DataType::F32],
-    normalized: false,
-};
-const NORMAL_RULE: AccessorRule = AccessorRule {
-    what: "NORMAL",
-    dimensions: gltf::accessor::Dimensions::Vec3,
-    types: &[gltf::accessor::DataType::F32],
-    normalized: false,
-};
-const TANGENT_RULE: AccessorRule = AccessorRule {
-    what: "TANGENT",
-    dimensions: gltf::accessor::Dimensions::Vec4,
-    types: &[gltf::accessor::DataType::F32],
-    normalized: false,
-};
-const INDICES_RULE: AccessorRule = AccessorRule {
-    what: "indices",
-    dimensions: gltf::accessor::Dimensions::Scalar,
-    types: &[
-        gltf::accessor::DataType::U8,
-        gltf::accessor::DataType::U16,
-        gltf::accessor::DataType::U32,
-    ],
-    normalized: false,
-};
-const TEXCOORD_RULE: AccessorRule = AccessorRule {
-    what: "TEXCOORD",
-    dimensions: gltf::accessor::Dimensions::Vec2,
-    types: &[
-        gltf::accessor::DataType::F32,
-        gltf::accessor::DataType::U8,
-        gltf::accessor::DataType::U16,
-    ],
-    normalized: true,
-};
 
 struct Walker<'a> {
     path: &'a Path,
@@ -590,210 +481,4 @@ fn mikktspace_tangents(
         return vec![[[0.0; 4]; 3]; triangles.len()];
     }
     mesh.out
-}
-
-/// The glTF default material: base colour 1, metallic 1, roughness 1.
-fn default_material() -> Material {
-    Material {
-        name: "default".to_owned(),
-        kind: MaterialKind::Glossy(scene::Glossy {
-            reflectance: Vec3::ONE,
-            roughness: 1.0,
-            diffuse: Vec3::ZERO,
-        }),
-        emission: Vec3::ZERO,
-        textures: None,
-    }
-}
-
-/// The images of a glTF file's textures, read once each.
-struct Textures<'a> {
-    path: &'a Path,
-    dir: Option<&'a Path>,
-    buffers: &'a [gltf::buffer::Data],
-    cache: TextureCache,
-    warnings: Vec<String>,
-}
-
-impl Textures<'_> {
-    /// The name under which an image held inside the file (a buffer view or a `data:` URI) is
-    /// cached and named in errors: `FILE#imageN`.
-    fn embedded_key(&self, index: usize) -> PathBuf {
-        PathBuf::from(format!("{}#image{index}", self.path.display()))
-    }
-
-    /// The texture `tex` as a colour (`srgb`) or data texture with its sampler's wrap modes and
-    /// the transform of `KHR_texture_transform`. The image is a file beside the glTF file, a
-    /// base64 `data:` URI or a buffer view (GLB).
-    fn get(
-        &mut self,
-        tex: &gltf::Texture<'_>,
-        srgb: bool,
-        transform: Option<gltf::texture::TextureTransform<'_>>,
-    ) -> Result<TextureRef, LoadError> {
-        let image = tex.source();
-        let image = match image.source() {
-            gltf::image::Source::Uri { uri, .. } => {
-                if let Some(rest) = uri.strip_prefix("data:") {
-                    let bytes =
-                        super::gltf_document::image_data_uri(self.path, image.index(), rest)?;
-                    self.cache
-                        .load_bytes(&self.embedded_key(image.index()), &bytes)?
-                } else {
-                    let file = self.dir.unwrap_or(Path::new("")).join(percent_decode(uri));
-                    self.cache.load(&file)?
-                }
-            }
-            gltf::image::Source::View { view, .. } => {
-                let key = self.embedded_key(image.index());
-                let bytes = self
-                    .buffers
-                    .get(view.buffer().index())
-                    .and_then(|b| b.0.get(view.offset()..view.offset() + view.length()))
-                    .ok_or_else(|| {
-                        gltf_error(
-                            self.path,
-                            format!("image {} lies outside its buffer", image.index()),
-                        )
-                    })?;
-                self.cache.load_bytes(&key, bytes)?
-            }
-        };
-        let wrap = |mode: gltf::texture::WrappingMode| match mode {
-            gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
-            gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
-            gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
-        };
-        let sampler = tex.sampler();
-        let mut texture = TextureRef::new(image, srgb);
-        texture.wrap = [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())];
-        if let Some(t) = transform {
-            // KHR_texture_transform: uv' = T·R·S·uv.
-            let ([ox, oy], r, [sx, sy]) = (t.offset(), t.rotation(), t.scale());
-            let (sin, cos) = r.sin_cos();
-            let m = [cos * sx, sin * sy, -sin * sx, cos * sy, ox, oy];
-            if m.iter().all(|v| v.is_finite()) {
-                texture.transform = m;
-            }
-        }
-        Ok(texture)
-    }
-}
-
-/// A URI's `%XX` escapes decoded (glTF URIs are percent-encoded: `a%20b.png`).
-fn percent_decode(uri: &str) -> String {
-    let bytes = uri.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        let hex = |b: u8| (b as char).to_digit(16);
-        if bytes[i] == b'%'
-            && let (Some(&h), Some(&l)) = (bytes.get(i + 1), bytes.get(i + 2))
-            && let (Some(h), Some(l)) = (hex(h), hex(l))
-        {
-            out.push((h * 16 + l) as u8);
-            i += 3;
-        } else {
-            out.push(bytes[i]);
-            i += 1;
-        }
-    }
-    String::from_utf8_lossy(&out).into_owned()
-}
-
-/// The material and the texture-coordinate set its textures read (the base colour's, else
-/// the first texture's).
-///
-/// Textures: the base colour texture multiplies the base colour (and its alpha the alpha);
-/// the emissive texture the emission; the normal texture perturbs the shading normal; the
-/// metallic-roughness texture decides the kind and the roughness per texel (metallic × blue,
-/// roughness × green, see [`MetallicRoughness`]), its mean the material's own kind (what
-/// reports show). `MASK` cuts the surface out below `alphaCutoff`, `BLEND` keeps it with
-/// probability alpha.
-fn material(
-    m: &gltf::Material<'_>,
-    index: usize,
-    textures: &mut Textures<'_>,
-) -> Result<(Material, u32), LoadError> {
-    let pbr = m.pbr_metallic_roughness();
-    let [r, g, b, alpha_factor] = pbr.base_color_factor();
-    let base = Vec3::new(r, g, b);
-    let (metallic_factor, roughness_factor) = (pbr.metallic_factor(), pbr.roughness_factor());
-    let (mut metallic, mut roughness) = (metallic_factor, roughness_factor);
-    let mut uv_sets = Vec::new();
-    let mut maps = MaterialTextures::default();
-    let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
-    if let Some(info) = pbr.metallic_roughness_texture() {
-        uv_sets.push(info.tex_coord());
-        let texture = textures.get(&info.texture(), false, info.texture_transform())?;
-        // The material's own kind (what reports show) follows the texture's mean; hits take
-        // their texel's (transmission wins over both).
-        let mean = texture.image.mean(false);
-        metallic *= mean.z;
-        roughness *= mean.y;
-        if transmission <= 0.0 {
-            maps.metallic_roughness = Some(MetallicRoughness {
-                texture,
-                base,
-                metallic: metallic_factor,
-                roughness: roughness_factor,
-            });
-        }
-    }
-    let kind = if transmission > 0.0 {
-        MaterialKind::Dielectric(scene::Dielectric {
-            ior: m.ior().unwrap_or(1.5),
-        })
-    } else {
-        MetallicRoughness::kind(base, metallic, roughness)
-    };
-    let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
-    let base_info = pbr.base_color_texture();
-    if let Some(info) = &base_info {
-        uv_sets.insert(0, info.tex_coord());
-        maps.color = Some(textures.get(&info.texture(), true, info.texture_transform())?);
-    }
-    if let Some(info) = m.emissive_texture()
-        && emission != Vec3::ZERO
-    {
-        uv_sets.push(info.tex_coord());
-        maps.emission = Some(textures.get(&info.texture(), true, info.texture_transform())?);
-    }
-    if let Some(normal) = m.normal_texture() {
-        uv_sets.push(normal.tex_coord());
-        maps.normal = Some(NormalMap {
-            texture: textures.get(&normal.texture(), false, None)?,
-            scale: normal.scale(),
-        });
-    }
-    let alpha_texture = maps.color.clone().filter(|t| t.image.has_alpha());
-    let mode = match m.alpha_mode() {
-        gltf::material::AlphaMode::Opaque => None,
-        gltf::material::AlphaMode::Mask => Some(AlphaMode::Mask {
-            cutoff: m.alpha_cutoff().unwrap_or(0.5),
-        }),
-        gltf::material::AlphaMode::Blend => {
-            (alpha_texture.is_some() || alpha_factor < 1.0).then_some(AlphaMode::Blend)
-        }
-    };
-    maps.alpha = mode.map(|mode| Alpha {
-        texture: alpha_texture,
-        factor: alpha_factor,
-        mode,
-    });
-    let uv_set = uv_sets.first().copied().unwrap_or(0);
-    if uv_sets.iter().any(|&s| s != uv_set) {
-        textures.warnings.push(format!(
-            "material {index} reads several texture-coordinate sets; all its textures use set {uv_set}"
-        ));
-    }
-    let material = Material {
-        name: m
-            .name()
-            .map_or_else(|| format!("material {index}"), str::to_owned),
-        kind,
-        emission,
-        textures: (!maps.is_empty()).then(|| Arc::new(maps)),
-    };
-    Ok((material, uv_set))
 }

@@ -1,7 +1,8 @@
 //! A glTF or GLB file's document and buffers, read defensively: gltf 1.4.1 panics on some
 //! malformed files in its validation and binary header parsing, and its buffer importer reads
 //! the file system directly, so the loader checks those inputs first and reads buffers itself
-//! (through [`super::files`]). The mesh walk is in `gltf.rs`.
+//! (through [`super::files`]), and checks each accessor's layout against its buffer before
+//! reading it. The mesh walk is in `gltf.rs`, the materials in `gltf_material.rs`.
 
 use std::path::{Path, PathBuf};
 
@@ -162,3 +163,111 @@ pub(super) fn image_data_uri(path: &Path, index: usize, rest: &str) -> Result<Ve
         )
     })
 }
+
+/// Whether `count` items of `size` bytes, `stride` bytes apart from `offset`, end at an
+/// address that fits in a `usize`.
+pub(crate) fn range_fits(offset: usize, stride: usize, count: usize, size: usize) -> bool {
+    count
+        .checked_sub(1)
+        .and_then(|c| stride.checked_mul(c))
+        .and_then(|x| x.checked_add(offset))
+        .and_then(|x| x.checked_add(size))
+        .is_some()
+}
+
+/// Checks what gltf 1.4.1's accessor reader computes without checking (`accessor/util.rs`,
+/// `Iter::new`): at least one item, a stride no smaller than an item, and byte ranges
+/// (`offset + stride · (count − 1) + size`, a view's `offset + length`) that do not overflow;
+/// the same for a sparse accessor's indices and values. A range past the end of its buffer is
+/// the reader's to report.
+pub(crate) fn layout(accessor: &gltf::Accessor<'_>) -> Result<(), String> {
+    let view_fits =
+        |view: &gltf::buffer::View<'_>| view.offset().checked_add(view.length()).is_some();
+    let strided = |view: &gltf::buffer::View<'_>, offset: usize, count: usize, size: usize| {
+        let stride = view.stride().unwrap_or(size);
+        if stride < size {
+            return Err(format!(
+                "buffer view {} has a stride of {stride} bytes, less than its {size}-byte items",
+                view.index()
+            ));
+        }
+        if !view_fits(view) || !range_fits(offset, stride, count, size) {
+            return Err(format!(
+                "its byte range in buffer view {} overflows",
+                view.index()
+            ));
+        }
+        Ok(())
+    };
+    let (count, size) = (accessor.count(), accessor.size());
+    if count == 0 {
+        return Err("it has no items (count 0)".to_owned());
+    }
+    if let Some(view) = accessor.view() {
+        strided(&view, accessor.offset(), count, size)?;
+    }
+    if let Some(sparse) = accessor.sparse() {
+        let n = sparse.count();
+        if n == 0 {
+            return Err("its sparse storage has no items (count 0)".to_owned());
+        }
+        let indices = sparse.indices();
+        strided(
+            &indices.view(),
+            indices.offset(),
+            n,
+            indices.index_type().size(),
+        )?;
+        let values = sparse.values();
+        strided(&values.view(), values.offset(), n, size)?;
+    }
+    Ok(())
+}
+
+/// What glTF 2.0 allows for an accessor the loader reads.
+pub(crate) struct AccessorRule {
+    pub(crate) what: &'static str,
+    pub(crate) dimensions: gltf::accessor::Dimensions,
+    pub(crate) types: &'static [gltf::accessor::DataType],
+    /// Whether integer components may be normalized (texture coordinates).
+    pub(crate) normalized: bool,
+}
+
+pub(crate) const POSITION_RULE: AccessorRule = AccessorRule {
+    what: "POSITION",
+    dimensions: gltf::accessor::Dimensions::Vec3,
+    types: &[gltf::accessor::DataType::F32],
+    normalized: false,
+};
+pub(crate) const NORMAL_RULE: AccessorRule = AccessorRule {
+    what: "NORMAL",
+    dimensions: gltf::accessor::Dimensions::Vec3,
+    types: &[gltf::accessor::DataType::F32],
+    normalized: false,
+};
+pub(crate) const TANGENT_RULE: AccessorRule = AccessorRule {
+    what: "TANGENT",
+    dimensions: gltf::accessor::Dimensions::Vec4,
+    types: &[gltf::accessor::DataType::F32],
+    normalized: false,
+};
+pub(crate) const INDICES_RULE: AccessorRule = AccessorRule {
+    what: "indices",
+    dimensions: gltf::accessor::Dimensions::Scalar,
+    types: &[
+        gltf::accessor::DataType::U8,
+        gltf::accessor::DataType::U16,
+        gltf::accessor::DataType::U32,
+    ],
+    normalized: false,
+};
+pub(crate) const TEXCOORD_RULE: AccessorRule = AccessorRule {
+    what: "TEXCOORD",
+    dimensions: gltf::accessor::Dimensions::Vec2,
+    types: &[
+        gltf::accessor::DataType::F32,
+        gltf::accessor::DataType::U8,
+        gltf::accessor::DataType::U16,
+    ],
+    normalized: true,
+};

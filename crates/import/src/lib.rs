@@ -44,6 +44,7 @@ pub(crate) mod files;
 mod frame;
 mod gltf;
 mod gltf_document;
+mod gltf_material;
 mod guard;
 mod image_file;
 mod mitsuba;

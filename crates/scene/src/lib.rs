@@ -64,4 +64,6 @@ pub use material::{
 };
 pub use ray::{Hit, Primitive, Ray};
 pub use scene::{Scene, SceneError};
-pub use summary::{Bounds, CameraSummary, LightCounts, MaterialSummary, SceneSummary};
+pub use summary::{
+    Bounds, CameraSummary, LightCounts, MaterialSummary, SceneSummary, TextureSummary,
+};

@@ -1,6 +1,7 @@
 //! A compact report of a loaded scene: what `fppm info` prints and what snapshot tests store.
 
 use std::fmt;
+use std::sync::Arc;
 
 use glam::Vec3;
 use serde::{Serialize, Serializer};
@@ -48,7 +49,7 @@ pub struct SceneSummary {
     pub warnings: Vec<String>,
     /// The texture images, once each (left out of snapshots when there are none).
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub textures: Vec<crate::texture::TextureSummary>,
+    pub textures: Vec<TextureSummary>,
 }
 
 /// Number of delta lights of each kind.
@@ -278,7 +279,7 @@ impl SceneDescription {
             degenerate_triangles: self.notes.degenerate_triangles,
             camera_framed: self.notes.camera_framed,
             warnings: self.notes.warnings.clone(),
-            textures: crate::texture::summarize(&self.materials),
+            textures: summarize_textures(&self.materials),
         }
     }
 }
@@ -391,4 +392,61 @@ impl fmt::Display for SceneSummary {
         }
         Ok(())
     }
+}
+
+/// One image in a [`crate::SceneSummary`]: its file name, resolution, memory and uses.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct TextureSummary {
+    /// The image's file name (without its directory, so that snapshots do not depend on where
+    /// the scene lies).
+    pub file: String,
+    /// Width and height in texels.
+    pub resolution: [u32; 2],
+    /// Bytes of the decoded texels.
+    pub bytes: usize,
+    /// How materials use it: `color`, `emission`, `normal`, `alpha`, `metallic-roughness`.
+    pub uses: Vec<&'static str>,
+}
+
+/// Every image the materials of `materials` use, once each, in order of first use.
+pub(crate) fn summarize_textures(materials: &[crate::Material]) -> Vec<TextureSummary> {
+    let mut out: Vec<(Arc<crate::texture::Image>, TextureSummary)> = Vec::new();
+    for t in materials.iter().filter_map(|m| m.textures.as_deref()) {
+        let uses = [
+            (t.color.as_ref(), "color"),
+            (t.emission.as_ref(), "emission"),
+            (t.normal.as_ref().map(|n| &n.texture), "normal"),
+            (t.alpha.as_ref().and_then(|a| a.texture.as_ref()), "alpha"),
+            (
+                t.metallic_roughness.as_ref().map(|m| &m.texture),
+                "metallic-roughness",
+            ),
+        ];
+        for (texture, what) in uses {
+            let Some(texture) = texture else { continue };
+            let entry = match out.iter().position(|(i, _)| Arc::ptr_eq(i, &texture.image)) {
+                Some(i) => &mut out[i].1,
+                None => {
+                    let image = &texture.image;
+                    out.push((
+                        Arc::clone(image),
+                        TextureSummary {
+                            file: image.path().file_name().map_or_else(
+                                || image.path().display().to_string(),
+                                |n| n.to_string_lossy().into_owned(),
+                            ),
+                            resolution: [image.resolution().0, image.resolution().1],
+                            bytes: image.memory(),
+                            uses: Vec::new(),
+                        },
+                    ));
+                    &mut out.last_mut().expect("just pushed").1
+                }
+            };
+            if !entry.uses.contains(&what) {
+                entry.uses.push(what);
+            }
+        }
+    }
+    out.into_iter().map(|(_, s)| s).collect()
 }

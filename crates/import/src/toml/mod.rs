@@ -23,6 +23,8 @@ use scene::SceneDescription;
 
 mod convert;
 mod errors;
+mod lights;
+mod materials;
 mod schema;
 
 use self::convert::Converter;

@@ -64,3 +64,45 @@ fn different_seeds_give_different_images() {
     let image_b = crate::support::render(&scene, b, 2);
     assert!(image_a != image_b);
 }
+
+/// A renderer owns its scene: it can be kept without the scene's binding, sent to another
+/// thread, rendered there and sent back, and renders there what it renders here, for every
+/// method.
+#[test]
+fn a_renderer_owns_its_scene_and_moves_between_threads() {
+    fn owned<T: Send + 'static>(value: T) -> T {
+        value
+    }
+    for method in Method::ALL {
+        let here = {
+            let scene = cornell("CornellBox-Sphere.obj", 16, 16);
+            let mut renderer = Renderer::new(scene, params(method, 3_000)).unwrap();
+            renderer.iterate();
+            renderer.image()
+        };
+        let renderer = owned(
+            Renderer::new(
+                cornell("CornellBox-Sphere.obj", 16, 16),
+                params(method, 3_000),
+            )
+            .unwrap(),
+        );
+        let (renderer, there) = std::thread::spawn(move || {
+            let mut renderer = renderer;
+            renderer.iterate();
+            let image = renderer.image();
+            (renderer, image)
+        })
+        .join()
+        .unwrap();
+        let bits = |image: &[[f32; 3]]| {
+            image
+                .iter()
+                .map(|p| p.map(f32::to_bits))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(bits(&here), bits(&there), "{method}");
+        assert_eq!(renderer.passes(), 1);
+        assert_eq!(renderer.scene().description().film.width, 16);
+    }
+}

@@ -5,14 +5,14 @@ use glam::Vec2;
 use super::*;
 
 fn image(width: u32, height: u32, texels: Vec<[u8; 4]>) -> Arc<Image> {
-    Arc::new(Image {
-        path: Path::new("test.png").to_path_buf(),
+    let image = Image::new(
+        Path::new("test.png").to_path_buf(),
         width,
         height,
-        texels: Texels::Bytes(texels),
-        has_alpha: true,
-        means: Default::default(),
-    })
+        Texels::Bytes(texels),
+        true,
+    );
+    Arc::new(image.unwrap())
 }
 
 #[test]
