@@ -35,16 +35,11 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ),
 ];
 
-/// Normal (non-dev, non-build) dependencies of every workspace package.
-fn dependencies() -> BTreeMap<String, Vec<String>> {
+/// What `cargo ARGS` prints, run in the workspace offline; it must succeed.
+fn cargo(args: &[&str]) -> Vec<u8> {
     let output = Command::new(env!("CARGO"))
-        .args([
-            "metadata",
-            "--format-version",
-            "1",
-            "--no-deps",
-            "--offline",
-        ])
+        .args(args)
+        .arg("--offline")
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
         .unwrap();
@@ -53,7 +48,13 @@ fn dependencies() -> BTreeMap<String, Vec<String>> {
         "{}",
         String::from_utf8_lossy(&output.stderr)
     );
-    let metadata: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    output.stdout
+}
+
+/// Normal (non-dev, non-build) dependencies of every workspace package.
+fn dependencies() -> BTreeMap<String, Vec<String>> {
+    let stdout = cargo(&["metadata", "--format-version", "1", "--no-deps"]);
+    let metadata: serde_json::Value = serde_json::from_slice(&stdout).unwrap();
     metadata["packages"]
         .as_array()
         .unwrap()
@@ -162,28 +163,10 @@ fn only_their_owner_knows_the_bvh_and_format_libraries() {
 /// Every package `root` compiles in a normal build (its normal dependencies, transitively, on
 /// this platform), as `cargo tree` lists them.
 fn normal_closure(root: &str) -> Vec<String> {
-    let output = Command::new(env!("CARGO"))
-        .args([
-            "tree",
-            "-p",
-            root,
-            "-e",
-            "normal",
-            "--prefix",
-            "none",
-            "-f",
-            "{p}",
-            "--offline",
-        ])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    String::from_utf8(output.stdout)
+    let stdout = cargo(&[
+        "tree", "-p", root, "-e", "normal", "--prefix", "none", "-f", "{p}",
+    ]);
+    String::from_utf8(stdout)
         .unwrap()
         .lines()
         .filter_map(|line| line.split_whitespace().next())

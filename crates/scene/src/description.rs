@@ -285,13 +285,7 @@ impl SceneDescription {
         h.list(&self.spheres);
         h.list(&self.cylinders);
         h.list(&self.lights);
-        match &self.environment {
-            None => h.u32(0),
-            Some(env) => {
-                h.u32(1);
-                h.add(env);
-            }
-        }
+        h.option(self.environment.as_ref(), |h, env| h.add(env));
         h.finish()
     }
 }
@@ -320,13 +314,7 @@ impl Fingerprint for Material {
     fn fingerprint(&self, h: &mut Fingerprinter) {
         h.vec3(self.emission);
         h.add(&self.kind);
-        match &self.textures {
-            None => h.u32(0),
-            Some(t) => {
-                h.u32(1);
-                h.add(&**t);
-            }
-        }
+        h.option(self.textures.as_deref(), |h, t| h.add(t));
     }
 }
 
@@ -352,27 +340,13 @@ impl Fingerprint for Triangle {
     fn fingerprint(&self, h: &mut Fingerprinter) {
         self.positions.iter().for_each(|&p| h.vec3(p));
         h.u32(self.material);
-        match self.normals {
-            None => h.u32(0),
-            Some(normals) => {
-                h.u32(1);
-                normals.iter().for_each(|&n| h.vec3(n));
-            }
-        }
-        match self.uv {
-            None => h.u32(0),
-            Some(uv) => {
-                h.u32(1);
-                uv.iter().for_each(|&v| h.vec2(v));
-            }
-        }
-        match self.tangents {
-            None => h.u32(0),
-            Some(tangents) => {
-                h.u32(1);
-                tangents.iter().flatten().for_each(|&c| h.f32(c));
-            }
-        }
+        h.option(self.normals, |h, normals| {
+            normals.iter().for_each(|&n| h.vec3(n))
+        });
+        h.option(self.uv, |h, uv| uv.iter().for_each(|&v| h.vec2(v)));
+        h.option(self.tangents, |h, tangents| {
+            tangents.iter().flatten().for_each(|&c| h.f32(c));
+        });
     }
 }
 

@@ -85,6 +85,17 @@ impl Fingerprinter {
         value.fingerprint(self);
     }
 
+    /// Feeds whether `value` is there, then what `add` feeds of it.
+    pub fn option<T>(&mut self, value: Option<T>, add: impl FnOnce(&mut Self, T)) {
+        match value {
+            None => self.u32(0),
+            Some(v) => {
+                self.u32(1);
+                add(self, v);
+            }
+        }
+    }
+
     /// Feeds a slice: its length, then each element.
     pub fn list<T: Fingerprint>(&mut self, values: &[T]) {
         self.u64(values.len() as u64);

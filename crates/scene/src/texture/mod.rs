@@ -297,13 +297,7 @@ impl Fingerprint for TextureRef {
 impl Fingerprint for MaterialTextures {
     /// Each use's texture (or its absence), with the use's own parameters.
     fn fingerprint(&self, h: &mut Fingerprinter) {
-        let mut texture = |r: Option<&TextureRef>| match r {
-            None => h.u32(0),
-            Some(r) => {
-                h.u32(1);
-                h.add(r);
-            }
-        };
+        let mut texture = |r: Option<&TextureRef>| h.option(r, |h, r| h.add(r));
         texture(self.color.as_ref());
         texture(self.emission.as_ref());
         texture(self.normal.as_ref().map(|n| &n.texture));
