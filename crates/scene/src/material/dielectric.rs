@@ -14,15 +14,18 @@ pub struct Dielectric {
 }
 
 impl Model for Dielectric {
+    #[inline]
     fn name(&self) -> &'static str {
         "dielectric"
     }
 
+    #[inline]
     fn lobe(&self) -> Lobe {
         Lobe::Specular
     }
 
     /// Seen at normal incidence a dielectric passes or reflects everything.
+    #[inline]
     fn albedo(&self) -> Rgb {
         Rgb::ONE
     }
@@ -32,6 +35,7 @@ impl Model for Dielectric {
     }
 
     /// A texture's colour does not tint a dielectric.
+    #[inline]
     fn tint(&mut self, _: Rgb) -> Rgb {
         Rgb::ONE
     }
@@ -41,6 +45,7 @@ impl Model for Dielectric {
         if front_face { self.ior } else { 1.0 / self.ior }
     }
 
+    #[inline]
     fn refractive_index(&self) -> Option<f32> {
         Some(self.ior)
     }

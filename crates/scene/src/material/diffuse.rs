@@ -27,18 +27,22 @@ pub(super) fn eval_world(albedo: Rgb, normal: Vec3, outgoing: Vec3, incoming: Ve
 }
 
 impl Model for Diffuse {
+    #[inline]
     fn name(&self) -> &'static str {
         "diffuse"
     }
 
+    #[inline]
     fn lobe(&self) -> Lobe {
         Lobe::Lambert
     }
 
+    #[inline]
     fn albedo(&self) -> Rgb {
         self.albedo
     }
 
+    #[inline]
     fn lambertian_albedo(&self) -> Option<Rgb> {
         Some(self.albedo)
     }
@@ -47,6 +51,7 @@ impl Model for Diffuse {
         vec![MaterialParam::Colour("albedo", self.albedo)]
     }
 
+    #[inline]
     fn tint(&mut self, tint: Rgb) -> Rgb {
         self.albedo *= tint;
         Rgb::ONE

@@ -32,17 +32,20 @@ pub struct Glossy {
 }
 
 impl Model for Glossy {
+    #[inline]
     fn name(&self) -> &'static str {
         "glossy"
     }
 
     /// Its GGX lobe, also over a diffuse base.
+    #[inline]
     fn lobe(&self) -> Lobe {
         Lobe::Ggx {
             alpha: self.roughness,
         }
     }
 
+    #[inline]
     fn albedo(&self) -> Rgb {
         self.reflectance + self.diffuse
     }
@@ -57,6 +60,7 @@ impl Model for Glossy {
 
     /// A texture's colour multiplies the whole BSDF, kept apart from the reflectance that
     /// Fresnel and the coupling read.
+    #[inline]
     fn tint(&mut self, tint: Rgb) -> Rgb {
         tint
     }

@@ -13,14 +13,17 @@ pub struct Mirror {
 }
 
 impl Model for Mirror {
+    #[inline]
     fn name(&self) -> &'static str {
         "mirror"
     }
 
+    #[inline]
     fn lobe(&self) -> Lobe {
         Lobe::Specular
     }
 
+    #[inline]
     fn albedo(&self) -> Rgb {
         self.reflectance
     }
@@ -29,6 +32,7 @@ impl Model for Mirror {
         vec![MaterialParam::Colour("reflectance", self.reflectance)]
     }
 
+    #[inline]
     fn tint(&mut self, tint: Rgb) -> Rgb {
         self.reflectance *= tint;
         Rgb::ONE

@@ -140,15 +140,18 @@ pub(crate) trait Model: Copy {
     fn tint(&mut self, tint: Rgb) -> Rgb;
     /// Its albedo if it is Lambertian: the photon loop then decides the roulette and evaluates
     /// gathered photons without the shading frame.
+    #[inline]
     fn lambertian_albedo(&self) -> Option<Rgb> {
         None
     }
     /// η on the far side of the shading normal over η on its side, where the normal faces the
     /// outside if `front_face`; one for models that do not refract.
+    #[inline]
     fn eta(&self, _front_face: bool) -> f32 {
         1.0
     }
     /// The index of refraction relative to the outside, for models that refract.
+    #[inline]
     fn refractive_index(&self) -> Option<f32> {
         None
     }
@@ -178,6 +181,7 @@ impl MaterialKind {
     /// The model's name in scene files and summaries: `diffuse`, `mirror`, `dielectric`,
     /// `glossy`.
     #[must_use]
+    #[inline]
     pub fn name(&self) -> &'static str {
         with_model!(self, m => m.name())
     }
@@ -185,12 +189,14 @@ impl MaterialKind {
     /// The lobe for the frequency operators. A glossy material with a diffuse base reports its
     /// GGX lobe.
     #[must_use]
+    #[inline]
     pub fn lobe(&self) -> Lobe {
         with_model!(self, m => m.lobe())
     }
 
     /// Whether every lobe is a delta (mirror, smooth dielectric).
     #[must_use]
+    #[inline]
     pub fn is_specular(&self) -> bool {
         self.lobe() == Lobe::Specular
     }
@@ -199,6 +205,7 @@ impl MaterialKind {
     /// albedo, a mirror's reflectance, one for a dielectric, specular plus diffuse for a glossy
     /// material.
     #[must_use]
+    #[inline]
     pub fn albedo(&self) -> Rgb {
         with_model!(self, m => m.albedo())
     }
@@ -218,6 +225,7 @@ impl MaterialKind {
 
     /// The index of refraction relative to the outside, for a model that refracts.
     #[must_use]
+    #[inline]
     pub fn refractive_index(&self) -> Option<f32> {
         with_model!(self, m => m.refractive_index())
     }
@@ -275,11 +283,13 @@ impl Bsdf {
     }
 
     /// Whether the BSDF is purely specular (mirror, smooth dielectric): [`Bsdf::eval`] is then always zero.
+    #[inline]
     pub fn is_specular(&self) -> bool {
         self.kind.is_specular()
     }
 
     /// The lobe width for the frequency operators; see [`MaterialKind::lobe`].
+    #[inline]
     pub fn lobe(&self) -> Lobe {
         self.kind.lobe()
     }
