@@ -5,7 +5,7 @@
 //! - materials: transmission > 0 → dielectric (ior from `KHR_materials_ior`, default 1.5);
 //!   metallic ≥ 0.5 ([`scene::texture::METALLIC_THRESHOLD`]) with roughness < 0.01 → mirror with the base
 //!   colour; metallic ≥ 0.5 otherwise → glossy with α = roughness² and no diffuse base;
-//!   else diffuse with the base colour ([`MetallicRoughness::kind`]), per texel under a metallic-roughness
+//!   else diffuse with the base colour ([`scene::texture::MetallicRoughness::kind`]), per texel under a metallic-roughness
 //!   texture; textures as `gltf_material.rs` says.
 //!   Emission = emissive factor × emissive strength. A primitive without a material gets
 //!   the glTF default material (white, metallic 1, roughness 1, so glossy with α = 1);

@@ -42,7 +42,7 @@ pub(super) enum Emitter {
         normal: Vec3,
         area: f32,
         radiance: Rgb,
-        /// What [`LightSampler::sample_emission`] needs, computed once here by the same
+        /// What [`super::LightSampler::sample_emission`] needs, computed once here by the same
         /// expressions as it would per photon (so hoisting them changes no photon):
         /// `p0 + e1`, `p0 + e2`, the frame about `normal`, √area and π·L·A.
         p1: Vec3,
@@ -59,7 +59,7 @@ pub(super) enum Emitter {
         radius: f32,
         radiance: Rgb,
     },
-    /// The scene's environment, held by [`LightSampler::environment`].
+    /// The scene's environment, held by [`super::LightSampler::environment`].
     Environment,
 }
 

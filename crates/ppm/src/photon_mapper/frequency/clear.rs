@@ -148,7 +148,7 @@ impl PhotonMapper {
 
     /// The end of the pilot (at the start of pass [`RenderParams::growth_pass`], once the
     /// visible points of the pass are traced): every valid slot with a frequency radius takes
-    /// the radius min(r_freq, clear radius, [`Setup::kernel_max`]) if that is larger than its
+    /// the radius min(r_freq, clear radius, [`super::super::Setup::kernel_max`]) if that is larger than its
     /// own, and every slot's statistics restart (N = 0, τ = 0; the image then counts the
     /// photons emitted from this pass on). Growing a radius after flux was gathered is not a
     /// rescale (the flux outside the old disc was never counted), hence the restart.
