@@ -63,9 +63,9 @@ impl Flags {
 pub(crate) const HELP: &str = "\
 cargo xtask render-all [--quick] [--full] [--bless NAME|all] [--filter NAME] [--calibrate]
 
-Renders every scene of tests/scenes.toml with ppm, sppm, freq, freq-sppm and path at the
-suite's small budgets, compares each with tests/golden/<name>.exr (path-traced) by relative MSE
-and mean, and writes target/render-all/report.html. Exits 1 if a scene regresses.
+Renders every scene of tests/scenes.toml with every method (ppm, sppm, appm, freq, freq-sppm,
+path) at the suite's small budgets, compares each with tests/golden/<name>.exr (path-traced) by
+relative MSE and mean, and writes target/render-all/report.html. Exits 1 if a scene regresses.
   --quick      the CI run (the suite budgets; this is also the default)
   --full       4x the passes of every method (errors only shrink, same tolerances)
   --bless NAME re-render the golden reference of NAME (or `all`) with the path tracer

@@ -14,10 +14,7 @@ pub struct Dielectric {
 }
 
 impl Model for Dielectric {
-    #[inline]
-    fn name(&self) -> &'static str {
-        "dielectric"
-    }
+    const NAME: &'static str = "dielectric";
 
     #[inline]
     fn lobe(&self) -> Lobe {
@@ -48,16 +45,6 @@ impl Model for Dielectric {
     #[inline]
     fn refractive_index(&self) -> Option<f32> {
         Some(self.ior)
-    }
-
-    #[inline]
-    fn eval_local(&self, _: &Shading, _: Vec3, _: Vec3) -> Rgb {
-        Rgb::ZERO
-    }
-
-    #[inline]
-    fn pdf_local(&self, _: Vec3, _: Vec3) -> f32 {
-        0.0
     }
 
     fn sample_local(

@@ -27,10 +27,7 @@ pub(super) fn eval_world(albedo: Rgb, normal: Vec3, outgoing: Vec3, incoming: Ve
 }
 
 impl Model for Diffuse {
-    #[inline]
-    fn name(&self) -> &'static str {
-        "diffuse"
-    }
+    const NAME: &'static str = "diffuse";
 
     #[inline]
     fn lobe(&self) -> Lobe {

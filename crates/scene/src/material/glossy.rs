@@ -32,10 +32,7 @@ pub struct Glossy {
 }
 
 impl Model for Glossy {
-    #[inline]
-    fn name(&self) -> &'static str {
-        "glossy"
-    }
+    const NAME: &'static str = "glossy";
 
     /// Its GGX lobe, also over a diffuse base.
     #[inline]

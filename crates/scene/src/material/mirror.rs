@@ -13,10 +13,7 @@ pub struct Mirror {
 }
 
 impl Model for Mirror {
-    #[inline]
-    fn name(&self) -> &'static str {
-        "mirror"
-    }
+    const NAME: &'static str = "mirror";
 
     #[inline]
     fn lobe(&self) -> Lobe {
@@ -36,16 +33,6 @@ impl Model for Mirror {
     fn tint(&mut self, tint: Rgb) -> Rgb {
         self.reflectance *= tint;
         Rgb::ONE
-    }
-
-    #[inline]
-    fn eval_local(&self, _: &Shading, _: Vec3, _: Vec3) -> Rgb {
-        Rgb::ZERO
-    }
-
-    #[inline]
-    fn pdf_local(&self, _: Vec3, _: Vec3) -> f32 {
-        0.0
     }
 
     #[inline]

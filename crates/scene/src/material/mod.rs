@@ -128,7 +128,7 @@ pub(crate) struct Shading {
 /// shading normal).
 pub(crate) trait Model: Copy {
     /// Its name in scene files and summaries.
-    fn name(&self) -> &'static str;
+    const NAME: &'static str;
     /// The lobe for the frequency operators.
     fn lobe(&self) -> Lobe;
     /// The reflectance it shows at normal incidence (the albedo AOV).
@@ -159,12 +159,29 @@ pub(crate) trait Model: Copy {
     fn eval_world(&self, _s: &Shading, _outgoing: Vec3, _incoming: Vec3) -> Option<Rgb> {
         None
     }
-    /// f for local directions on the same side, both mirrored into the upper hemisphere; zero
-    /// for delta lobes.
-    fn eval_local(&self, s: &Shading, wo: Vec3, wi: Vec3) -> Rgb;
+    /// f for local directions on the same side, both mirrored into the upper hemisphere. The
+    /// default is the delta lobes' zero: a model with a lobe of finite density overrides it.
+    #[inline]
+    fn eval_local(&self, _s: &Shading, _wo: Vec3, _wi: Vec3) -> Rgb {
+        debug_assert!(
+            self.lobe() == Lobe::Specular,
+            "{} needs eval_local",
+            Self::NAME
+        );
+        Rgb::ZERO
+    }
     /// The solid-angle density of [`Model::sample_local`] for local directions on the same
-    /// side, both in the upper hemisphere; zero for delta lobes.
-    fn pdf_local(&self, wo: Vec3, wi: Vec3) -> f32;
+    /// side, both in the upper hemisphere. The default is the delta lobes' zero, as for
+    /// [`Model::eval_local`].
+    #[inline]
+    fn pdf_local(&self, _wo: Vec3, _wi: Vec3) -> f32 {
+        debug_assert!(
+            self.lobe() == Lobe::Specular,
+            "{} needs pdf_local",
+            Self::NAME
+        );
+        0.0
+    }
     /// Draws `incoming` for the local `wo` (either side, finite, z ≠ 0).
     fn sample_local(
         &self,
@@ -177,13 +194,19 @@ pub(crate) trait Model: Copy {
     ) -> Option<BsdfSample>;
 }
 
+/// [`Model::NAME`] of the model behind a reference, for [`with_model!`].
+#[inline]
+fn model_name<M: Model>(_: &M) -> &'static str {
+    M::NAME
+}
+
 impl MaterialKind {
     /// The model's name in scene files and summaries: `diffuse`, `mirror`, `dielectric`,
     /// `glossy`.
     #[must_use]
     #[inline]
     pub fn name(&self) -> &'static str {
-        with_model!(self, m => m.name())
+        with_model!(self, m => model_name(m))
     }
 
     /// The lobe for the frequency operators. A glossy material with a diffuse base reports its
