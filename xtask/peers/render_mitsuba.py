@@ -1,9 +1,10 @@
 """Render a Mitsuba 3 scene for a wall-clock budget (used by `cargo xtask peers`).
 
-usage: render_mitsuba.py SCENE.xml INTEGRATOR SECONDS OUT.exr THREADS SEED [VARIANT]
+usage: render_mitsuba.py SCENE.xml INTEGRATOR BUDGET OUT.exr THREADS SEED [VARIANT]
 
-Renders in chunks of samples with distinct seeds, each chunk sized to take about a second,
-and stops before the next chunk would pass the budget; the image is the sample-weighted mean
+BUDGET is seconds, or spp=N for a fixed number of samples per pixel (for `ptracer`, N times the
+pixel count light paths). Renders in chunks of samples with distinct seeds, each chunk sized to
+take about a second, and stops before the next chunk would pass the budget (or at N samples); the image is the sample-weighted mean
 of the chunks (the same estimator as one render with all the samples). Prints one JSON line:
 seconds, samples per pixel, chunks, variant.
 """
@@ -17,9 +18,13 @@ import numpy as np
 
 
 def main() -> None:
-    scene_path, integrator, seconds, out, threads, seed = sys.argv[1:7]
+    scene_path, integrator, budget, out, threads, seed = sys.argv[1:7]
     variant = sys.argv[7] if len(sys.argv) > 7 else "llvm_ad_rgb"
-    seconds, threads, seed = float(seconds), int(threads), int(seed)
+    threads, seed = int(threads), int(seed)
+    if budget.startswith("spp="):
+        seconds, spp_budget = float("inf"), int(budget[4:])
+    else:
+        seconds, spp_budget = float(budget), None
     start = time.perf_counter()
     mi.set_variant(variant)
     dr.set_thread_count(threads)
@@ -37,6 +42,11 @@ def main() -> None:
         chunks += 1
         elapsed = time.perf_counter() - start
         rate = chunk / max(took, 1e-6)
+        if spp_budget is not None:
+            if spp_done >= spp_budget:
+                break
+            chunk = max(1, min(int(rate), 4096, spp_budget - spp_done))
+            continue
         remaining = seconds - elapsed
         if remaining <= 0:
             break

@@ -21,7 +21,7 @@ use film::Image;
 pub(crate) const HELP: &str = "\
 cargo xtask peers [--scenes a,b,...] [--seconds 60] [--film WxH] [--threads 2]
                   [--methods freq-sppm,sppm,freq,ppm] [--peers path,ptracer]
-                  [--reference-seconds 1200] [--out DIR] [--fppm-args \"...\"]
+                  [--reference-seconds 1200] [--out DIR] [--fppm-args \"...\"] [--paths N]
 
 Renders every scene of scenes/peers/ (or those named) with each fppm method and each Mitsuba 3
 integrator for the same wall-clock time, one renderer at a time, all with --threads threads,
@@ -32,7 +32,12 @@ the pixels whose first hit is diffuse, the reference's own noise in the same uni
 image mean over the reference's. A method may carry switches of its own after `+`:
 `sppm+no-light-tracing` renders `--method sppm --no-light-tracing`. Writes DIR/SCENE/*.exr and DIR/table.md; DIR defaults to
 target/peers. The Mitsuba venv is created in target/peers-venv on first use (pip install
-mitsuba drjit numpy; the llvm_ad_rgb variant needs Debian's libllvm19).";
+mitsuba drjit numpy; the llvm_ad_rgb variant needs Debian's libllvm19).
+
+--paths N (e.g. 117M) compares at an equal path count instead of equal time: each fppm method
+traces N light paths (--passes and --photons-per-pass, at most 10^6 per pass) and each Mitsuba
+integrator renders N / (width x height) samples per pixel (for `ptracer`, N light paths); use it
+with --methods light --peers ptracer to compare the two light tracers' variance.";
 
 /// The scenes of the comparison, in `scenes/peers/`.
 const SCENES: [&str; 4] = [
@@ -52,6 +57,8 @@ struct Flags {
     reference_seconds: f64,
     out: Option<PathBuf>,
     fppm_args: Vec<String>,
+    /// Light paths per renderer, instead of equal time.
+    paths: Option<u64>,
 }
 
 impl Flags {
@@ -68,6 +75,7 @@ impl Flags {
             reference_seconds: 1200.0,
             out: None,
             fppm_args: Vec::new(),
+            paths: None,
         };
         let mut it = args.iter();
         while let Some(flag) = it.next() {
@@ -98,6 +106,7 @@ impl Flags {
                 "--fppm-args" => {
                     flags.fppm_args = value()?.split_whitespace().map(str::to_owned).collect();
                 }
+                "--paths" => flags.paths = Some(parse_count(&value()?)?),
                 other => bail!("unknown flag {other} (see cargo xtask peers --help)"),
             }
         }
@@ -106,6 +115,31 @@ impl Flags {
         }
         Ok(flags)
     }
+}
+
+/// A count written as `117000000`, `117M` or `500k`.
+fn parse_count(text: &str) -> Result<u64> {
+    let (digits, scale) = match text.strip_suffix(['M', 'm']) {
+        Some(d) => (d, 1_000_000.0),
+        None => match text.strip_suffix(['k', 'K']) {
+            Some(d) => (d, 1_000.0),
+            None => (text, 1.0),
+        },
+    };
+    let value: f64 = digits.parse().with_context(|| format!("--paths {text}"))?;
+    let count = (value * scale).round();
+    if !(1.0..1e15).contains(&count) {
+        bail!("--paths {text} must be a positive count");
+    }
+    Ok(count as u64)
+}
+
+/// `--passes` and `--photons-per-pass` for `paths` light paths, at most 10⁶ per pass: the
+/// passes and the paths they really trace.
+fn passes_for(paths: u64) -> (u64, u64) {
+    let passes = paths.div_ceil(1_000_000);
+    let per_pass = paths.div_ceil(passes);
+    (passes, per_pass)
 }
 
 /// One scored render.
@@ -160,7 +194,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
                     &script,
                     &xml,
                     "path",
-                    flags.reference_seconds / 2.0,
+                    &(flags.reference_seconds / 2.0).to_string(),
                     half,
                     flags.threads,
                     1000 + seed as u32,
@@ -185,13 +219,28 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
             let mut parts = method.split('+');
             let method_name = parts.next().unwrap_or(method);
             let switches: Vec<String> = parts.map(|s| format!("--{s}")).collect();
+            let budget: Vec<String> = match flags.paths {
+                Some(paths) => {
+                    let (passes, per_pass) = passes_for(paths);
+                    vec![
+                        "--passes".into(),
+                        passes.to_string(),
+                        "--photons-per-pass".into(),
+                        per_pass.to_string(),
+                    ]
+                }
+                None => vec![
+                    "--time".into(),
+                    format!("{}ms", (flags.seconds * 1000.0) as u64),
+                ],
+            };
             let clock = Instant::now();
             let status = Command::new(&fppm)
                 .arg("render")
                 .arg(&scene_path)
                 .args(["--method", method_name])
                 .args(&switches)
-                .args(["--time", &format!("{}ms", (flags.seconds * 1000.0) as u64)])
+                .args(&budget)
                 .args(["--threads", &flags.threads.to_string()])
                 .args([
                     "--width",
@@ -223,12 +272,20 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
             let file = dir.join(format!("mitsuba-{integrator}.exr"));
             eprintln!("{name}: Mitsuba {integrator} for {} s", flags.seconds);
             let clock = Instant::now();
+            // The driver's budget: seconds, or `spp=N` for a fixed sample count.
+            let budget = match flags.paths {
+                Some(paths) => {
+                    let pixels = u64::from(width) * u64::from(height);
+                    format!("spp={}", paths.div_ceil(pixels))
+                }
+                None => flags.seconds.to_string(),
+            };
             let report = run_mitsuba(
                 &python,
                 &script,
                 &xml,
                 integrator,
-                flags.seconds,
+                &budget,
                 &file,
                 flags.threads,
                 7,
@@ -372,14 +429,15 @@ pub(crate) fn build_fppm(root: &Path) -> Result<PathBuf> {
     Ok(root.join("target/release/fppm"))
 }
 
-/// Runs the Mitsuba driver script; returns its report line.
+/// Runs the Mitsuba driver script for `budget` (seconds, or `spp=N`); returns its report
+/// line.
 #[allow(clippy::too_many_arguments)]
 fn run_mitsuba(
     python: &Path,
     script: &Path,
     xml: &Path,
     integrator: &str,
-    seconds: f64,
+    budget: &str,
     out: &Path,
     threads: u32,
     seed: u32,
@@ -388,7 +446,7 @@ fn run_mitsuba(
         .arg(script)
         .arg(xml)
         .arg(integrator)
-        .arg(seconds.to_string())
+        .arg(budget)
         .arg(out)
         .arg(threads.to_string())
         .arg(seed.to_string())

@@ -29,6 +29,17 @@ pub(crate) struct Flags {
     calibrate: bool,
     bless: Option<String>,
     filter: Option<String>,
+    /// Only these methods (all if empty).
+    methods: Vec<ppm::Method>,
+}
+
+impl Flags {
+    /// The methods to render, in `Method::ALL`'s order.
+    fn methods(&self) -> impl Iterator<Item = ppm::Method> + '_ {
+        ppm::Method::ALL
+            .into_iter()
+            .filter(|m| self.methods.is_empty() || self.methods.contains(m))
+    }
 }
 
 impl Flags {
@@ -50,6 +61,15 @@ impl Flags {
                 "--filter" => {
                     flags.filter = Some(it.next().context("--filter needs a scene name")?.clone())
                 }
+                "--methods" => {
+                    let list = it.next().context("--methods needs a list of methods")?;
+                    for name in list.split(',') {
+                        flags.methods.push(
+                            ppm::Method::from_name(name)
+                                .with_context(|| format!("render-all: no method `{name}`"))?,
+                        );
+                    }
+                }
                 other => bail!("render-all: unknown flag `{other}`"),
             }
         }
@@ -61,7 +81,8 @@ impl Flags {
 }
 
 pub(crate) const HELP: &str = "\
-cargo xtask render-all [--quick] [--full] [--bless NAME|all] [--filter NAME] [--calibrate]
+cargo xtask render-all [--quick] [--full] [--bless NAME|all] [--filter NAME] [--methods a,b]
+                       [--calibrate]
 
 Renders every scene of tests/scenes.toml with every method (ppm, sppm, appm, freq, freq-sppm,
 path) at the suite's small budgets, compares each with tests/golden/<name>.exr (path-traced) by
@@ -70,6 +91,7 @@ relative MSE and mean, and writes target/render-all/report.html. Exits 1 if a sc
   --full       4x the passes of every method (errors only shrink, same tolerances)
   --bless NAME re-render the golden reference of NAME (or `all`) with the path tracer
   --filter NAME  only scenes whose name contains NAME
+  --methods a,b  only these methods (e.g. --methods light with --calibrate)
   --calibrate  render every method with each calibration seed and print suggested tolerances";
 
 /// One method's result on one scene.
@@ -125,7 +147,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
 
     if flags.calibrate {
         for entry in &scenes {
-            calibrate(root, entry, &suite.calibration_seeds)?;
+            calibrate(root, entry, &suite.calibration_seeds, &flags)?;
         }
         return Ok(true);
     }
@@ -245,9 +267,9 @@ fn check_scene(
     )?;
     report.sheet_row.push(scale(&reference, exposure));
     let scene = suite::load_scene(root, entry)?;
-    let mask = suite::transport_mask(&scene);
     let factor = if flags.full { FULL_FACTOR } else { 1 };
-    for method in ppm::Method::ALL {
+    for method in flags.methods() {
+        let mask = suite::method_mask(&scene, method);
         let passes = suite::passes(entry, method) * factor;
         let rendered = suite::render(
             &scene,
@@ -309,15 +331,15 @@ fn scale(image: &Image, factor: f32) -> Image {
 
 /// Renders every method with every calibration seed and prints suggested tolerances:
 /// relMSE ≤ 1.5 × the largest seen, |mean ratio − 1| ≤ 1.5 × the largest seen + 0.005.
-fn calibrate(root: &Path, entry: &SuiteScene, seeds: &[u64]) -> Result<()> {
+fn calibrate(root: &Path, entry: &SuiteScene, seeds: &[u64], flags: &Flags) -> Result<()> {
     let golden = golden_path(root, &entry.name);
     let reference = film::read_exr(&golden)
         .with_context(|| format!("run `cargo xtask render-all --bless {}` first", entry.name))?;
     let scene = suite::load_scene(root, entry)?;
-    let mask = suite::transport_mask(&scene);
     println!("# {}: calibration over seeds {seeds:?}", entry.name);
     let mut lines = Vec::new();
-    for method in ppm::Method::ALL {
+    for method in flags.methods() {
+        let mask = suite::method_mask(&scene, method);
         let mut rel = Vec::new();
         let mut dev = Vec::new();
         for &seed in seeds {

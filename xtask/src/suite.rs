@@ -172,25 +172,45 @@ pub(crate) fn passes(entry: &SuiteScene, method: ppm::Method) -> u32 {
 /// PPM's single fixed hitpoint per pixel lands either on or off the lamp, would otherwise
 /// dominate both the mean and the relative MSE; they say nothing about light transport.
 pub(crate) fn transport_mask(scene: &scene::Scene) -> Vec<bool> {
+    first_hit_mask(scene, |m| m.emission.max_element() > 0.0)
+}
+
+/// The pixels whose error is measured for `method`: the [`transport_mask`], and for the light
+/// tracer only those that do not see a mirror or glass first (with the same one-pixel
+/// dilation), which it cannot reach by construction (as Mitsuba's `ptracer` cannot).
+pub(crate) fn method_mask(scene: &scene::Scene, method: ppm::Method) -> Vec<bool> {
+    let mut mask = transport_mask(scene);
+    if method == ppm::Method::Light {
+        let seen_direct = first_hit_mask(scene, |m| m.kind.is_specular());
+        for (m, d) in mask.iter_mut().zip(seen_direct) {
+            *m &= d;
+        }
+    }
+    mask
+}
+
+/// Every pixel except those whose first hit through the pixel centre, or a neighbour's (a
+/// one-pixel dilation), is a material for which `excluded` holds.
+fn first_hit_mask(scene: &scene::Scene, excluded: impl Fn(&scene::Material) -> bool) -> Vec<bool> {
     let film = scene.description().film;
     let (w, h) = (film.width as usize, film.height as usize);
-    let mut emitter = vec![false; w * h];
+    let mut hit = vec![false; w * h];
     for y in 0..h {
         for x in 0..w {
             let ray = scene.camera().generate_ray(
                 glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5),
                 glam::Vec2::splat(0.5),
             );
-            emitter[y * w + x] = scene
+            hit[y * w + x] = scene
                 .intersect(&ray)
                 .and_then(|hit| scene.material(hit.material))
-                .is_some_and(|m| m.emission.max_element() > 0.0);
+                .is_some_and(&excluded);
         }
     }
     let mut mask = vec![true; w * h];
     for y in 0..h {
         for x in 0..w {
-            if emitter[y * w + x] {
+            if hit[y * w + x] {
                 for yy in y.saturating_sub(1)..(y + 2).min(h) {
                     for xx in x.saturating_sub(1)..(x + 2).min(w) {
                         mask[yy * w + xx] = false;

@@ -420,7 +420,7 @@ impl Progress {
         let left = remaining.map_or(String::new(), |r| {
             format!(", ~{} left", duration::format(Duration::from_secs_f64(r)))
         });
-        let photons = if renderer.params().method.is_photon_mapper() {
+        let photons = if renderer.params().method.traces_light_paths() {
             format!(", {} photons", human_count(renderer.photons_emitted()))
         } else {
             String::new()

@@ -42,6 +42,8 @@ mod checkpoint;
 mod disc;
 mod independent;
 mod integrator;
+mod light_path;
+mod light_tracer;
 mod methods;
 mod params;
 mod path;

@@ -8,6 +8,7 @@ use scene::Scene;
 
 use crate::independent::{self, PassIndependent};
 use crate::integrator::Integrator;
+use crate::light_tracer::{self, LightTracer};
 use crate::params::{Method, ParamError, RenderParams};
 use crate::path::{self, PathTracer};
 use crate::photon_mapper::{self, PhotonMapper};
@@ -38,6 +39,10 @@ fn entry(method: Method) -> Entry {
         Method::Path => Entry {
             build: |scene, params| Ok(Box::new(PathTracer::new(scene, params))),
             estimate: path::estimate,
+        },
+        Method::Light => Entry {
+            build: |scene, params| Ok(Box::new(LightTracer::new(scene, params))),
+            estimate: light_tracer::estimate,
         },
     }
 }

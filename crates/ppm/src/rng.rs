@@ -20,6 +20,10 @@ use glam::Vec2;
 use rand_pcg::Pcg32;
 use rand_pcg::rand_core::Rng;
 
+/// The bit that sets the streams of camera samples (hitpoint slots, pixels) apart from those of
+/// light paths, which are indexed by the photon's number.
+pub(crate) const CAMERA_STREAM: u64 = 1 << 63;
+
 /// The random stream of one photon or pixel in one pass.
 #[derive(Clone, Debug)]
 pub struct Sampler {

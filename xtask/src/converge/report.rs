@@ -12,6 +12,7 @@ pub(super) fn colour(method: ppm::Method) -> (u8, u8, u8) {
         ppm::Method::FreqSppm => (214, 39, 40),
         ppm::Method::Appm => (148, 103, 189),
         ppm::Method::Path => (100, 100, 100),
+        ppm::Method::Light => (23, 190, 207),
     }
 }
 

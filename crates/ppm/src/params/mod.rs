@@ -29,17 +29,21 @@ pub enum Method {
     Appm,
     /// Unidirectional path tracing with next-event estimation and MIS: the reference.
     Path,
+    /// Light tracing (Mitsuba's `ptracer`): light paths connected to the lens at every
+    /// non-specular vertex, no merging; blind to what is seen only through specular surfaces.
+    Light,
 }
 
 impl Method {
     /// Every method, in the order reports list them.
-    pub const ALL: [Method; 6] = [
+    pub const ALL: [Method; 7] = [
         Method::Ppm,
         Method::Sppm,
         Method::FreqPpm,
         Method::FreqSppm,
         Method::Appm,
         Method::Path,
+        Method::Light,
     ];
 
     /// The name used on the command line and in scene files.
@@ -52,6 +56,7 @@ impl Method {
             Method::FreqSppm => "freq-sppm",
             Method::Appm => "appm",
             Method::Path => "path",
+            Method::Light => "light",
         }
     }
 
@@ -67,9 +72,16 @@ impl Method {
         matches!(self, Method::FreqPpm | Method::FreqSppm)
     }
 
-    /// Whether this is a photon mapper (everything but the path tracer).
+    /// Whether this is a photon mapper (everything but the path tracer and the light tracer):
+    /// it has hitpoints with gather radii.
     #[must_use]
     pub fn is_photon_mapper(self) -> bool {
+        !matches!(self, Method::Path | Method::Light)
+    }
+
+    /// Whether it traces paths from the emitters (the photon mappers and the light tracer).
+    #[must_use]
+    pub fn traces_light_paths(self) -> bool {
         !matches!(self, Method::Path)
     }
 

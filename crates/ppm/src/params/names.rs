@@ -81,6 +81,10 @@ pub const PARAMS: &[Param] = &[
                     "path",
                     "Path tracing with next-event estimation: the reference",
                 ),
+                (
+                    "light",
+                    "Light tracing (Mitsuba's ptracer): light paths connected to the lens, no merging; black where only mirrors or glass are seen",
+                ),
             ],
         },
         get: |p| p.method.name().to_owned(),

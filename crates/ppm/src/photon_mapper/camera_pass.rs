@@ -9,10 +9,7 @@ use scene::{Bsdf, Hit, Rgb, TransportMode};
 
 use super::frequency::SlotFrequency;
 use super::{NO_VISIBLE_POINT, PhotonMapper, SLOT_CHUNK, Setup};
-use crate::rng::Sampler;
-
-/// Camera streams live in their own half of the sampler's index space.
-const CAMERA_STREAM: u64 = 1 << 63;
+use crate::rng::{CAMERA_STREAM, Sampler};
 
 /// A camera path up to its first non-specular hit ([`PhotonMapper::camera_chain`]).
 pub(crate) struct CameraChain {

@@ -1,12 +1,13 @@
 //! Tracing one photon path: emission, Russian roulette, scattering, and the photons it stores
 //! on non-specular surfaces (with the frequency steps of `frequency.rs` for frequency photons).
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use photon::Photon;
-use scene::{Bsdf, Hit, Rgb, TransportMode};
+use scene::{Bsdf, Hit, Rgb};
 
 use super::Setup;
 use super::frequency::{FrequencyPhoton, arrived, scatter_spectrum};
+use crate::light_path::{Scatter, lens_point, lens_radiance, scatter};
 use crate::rng::Sampler;
 
 /// Photons of one chunk, in trace order.
@@ -67,10 +68,6 @@ impl LightTracing<'_> {
 /// Photons are connected to the camera where a kernel covers at most this many camera
 /// samples ([`LightTracing::connection_rate`]).
 const CONNECT_BELOW: f64 = 2.0;
-
-/// The sampler dimension where a photon's lens samples start (two per bounce), far beyond
-/// what its path draws, so that light tracing leaves the photon paths as they are.
-const LENS_DIMENSION: u64 = 1 << 40;
 
 impl TracedPhotons {
     /// Empties the chunk for the next pass, keeping the allocations.
@@ -180,53 +177,20 @@ impl Setup {
             let u_lobe = sampler.next_f32();
             let u = sampler.next_2d();
             let u_roulette = sampler.next_f32();
-            // Russian roulette (pbrt-v4 SPPM): keep the photon's power roughly constant, killing
-            // it with probability q = 1 − lum(scattered power) / lum(power) and dividing the
-            // survivor by 1 − q. On a Lambertian surface the scattered power is power × albedo
-            // whatever the direction (up to the shading-normal correction, which the roulette
-            // leaves out there), so the roulette runs before the direction is drawn and a killed
-            // photon costs no BSDF sample; elsewhere it needs the sampled weight. Either way q
-            // is fixed before `u_roulette` is compared with it: unbiased.
             let roulette = depth + 1 >= rr_depth;
-            let kill_probability = |scattered: Rgb| {
-                let ratio = luminance(scattered) / luminance(power).max(f32::MIN_POSITIVE);
-                (1.0 - ratio).max(0.0)
-            };
-            // The survival probability, when the roulette is decided before sampling.
-            let decided = match bsdf.lambertian_albedo() {
-                Some(albedo) if roulette => {
-                    let q = kill_probability(power * albedo);
-                    if u_roulette < q {
-                        break;
-                    }
-                    Some(1.0 - q)
+            let sample = match scatter(
+                &hit, &bsdf, incoming, power, roulette, u_lobe, u, u_roulette,
+            ) {
+                Scatter::Continue { sample, power: p } => {
+                    power = p;
+                    sample
                 }
-                _ => None,
-            };
-            let Some(sample) = bsdf.sample(incoming, u_lobe, u, TransportMode::Importance) else {
-                break;
-            };
-            let new_power =
-                power * sample.weight * shading_normal_correction(&hit, incoming, sample.incoming);
-            let survive = match decided {
-                Some(survive) => survive,
-                None if roulette => {
-                    let q = kill_probability(new_power);
-                    if u_roulette < q {
-                        break;
-                    }
-                    1.0 - q
+                Scatter::End => break,
+                Scatter::NonFinite => {
+                    out.non_finite += 1;
+                    break;
                 }
-                None => 1.0,
             };
-            power = new_power / survive;
-            if !power.is_finite() {
-                out.non_finite += 1;
-                break;
-            }
-            if power == Rgb::ZERO {
-                break;
-            }
             if let Some(s) = here {
                 spectrum = Some(scatter_spectrum(
                     s, &hit, incoming, &sample, &bsdf, material, &self.caps,
@@ -261,38 +225,21 @@ impl Setup {
         light: LightTracing<'_>,
         out: &mut TracedPhotons,
     ) {
-        let camera = self.scene.camera();
-        let u_lens = if camera.aperture_radius() > 0.0 {
-            let mut lens = sampler.clone();
-            lens.skip_to(LENS_DIMENSION + 2 * u64::from(depth));
-            lens.next_2d()
-        } else {
-            Vec2::ZERO
-        };
-        let Some(connection) = camera.connect(hit.position, u_lens) else {
+        let Some((connection, pixel)) =
+            lens_point(&self.scene, hit, sampler, depth, (self.width, self.height))
+        else {
             return;
         };
+        let camera = self.scene.camera();
         let rho = f64::from(camera.film_density(hit.position, hit.geometric_normal));
-        // The film position is on the film (`connect`); its far edges belong to the last pixel.
-        let x = (connection.film.x as u32).min(self.width - 1);
-        let y = (connection.film.y as u32).min(self.height - 1);
-        let pixel = y * self.width + x;
         let rate = light.connection_rate(pixel, rho);
         if rate == 0.0 {
             return;
         }
-        let to_lens = connection.lens - hit.position;
-        let distance = to_lens.length();
-        if distance.is_nan() || distance <= 0.0 {
+        let Some(value) = lens_radiance(&self.scene, hit, bsdf, incoming, power, &connection)
+        else {
             return;
-        }
-        let toward = to_lens / distance;
-        let f = bsdf.eval(toward, incoming);
-        if f == Rgb::ZERO || !self.scene.visible(hit, connection.lens) {
-            return;
-        }
-        let cos = toward.dot(hit.geometric_normal).abs();
-        let value = f * power * (cos * connection.density);
+        };
         if !value.is_finite() {
             out.non_finite += 1;
             return;
@@ -306,25 +253,4 @@ impl Setup {
             out.splats.push((pixel * spp + i as u32, [v.x, v.y, v.z]));
         }
     }
-}
-
-/// Veach's correction for shading normals on light paths (thesis §5.3; pbrt's
-/// `CorrectShadingNormal`): the BSDF is not symmetric once the shading normal differs from the
-/// geometric one, and flux carried by photons must be multiplied by
-/// |ωo·n_s|·|ωi·n_g| / (|ωo·n_g|·|ωi·n_s|) at every bounce (ωo toward where the photon came
-/// from, ωi the new direction). Without it photons through smooth-shaded meshes (the water
-/// surface of the Cornell box) carry a few per cent too much or too little light.
-fn shading_normal_correction(hit: &Hit, from: Vec3, to: Vec3) -> f32 {
-    let (ns, ng) = (hit.shading_normal, hit.geometric_normal);
-    let numerator = from.dot(ns).abs() * to.dot(ng).abs();
-    let denominator = from.dot(ng).abs() * to.dot(ns).abs();
-    if denominator > 0.0 {
-        numerator / denominator
-    } else {
-        0.0
-    }
-}
-
-fn luminance(c: Rgb) -> f32 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
 }

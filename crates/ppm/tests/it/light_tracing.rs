@@ -9,7 +9,7 @@ use crate::support::{mean, params, render, scene};
 
 /// Mean ratio to the reference and mean relative error over the pixels whose reference is at
 /// least half its peak.
-fn bright_region_errors(image: &[[f32; 3]], reference: &[f64]) -> (f64, f64, usize) {
+pub(crate) fn bright_region_errors(image: &[[f32; 3]], reference: &[f64]) -> (f64, f64, usize) {
     let peak = reference.iter().copied().fold(0.0, f64::max);
     let (mut ratio, mut rel, mut n) = (0.0, 0.0, 0);
     for (pixel, &expected) in image.iter().zip(reference) {

@@ -15,6 +15,7 @@ mod determinism;
 mod environment;
 mod frequency;
 mod kernels;
+mod light_tracer;
 mod light_tracing;
 mod memory;
 mod non_finite;

@@ -102,11 +102,12 @@ fn a_healthy_scene_drops_nothing() {
 }
 
 /// Huge emission on a nearly smooth glossy sphere: the BSDF weight of its sharp lobe times the
-/// photon's power overflows f32. Those photons are dropped and counted by every photon mapper.
+/// photon's power overflows f32. Those photons are dropped and counted by every method that
+/// traces them (the photon mappers and the light tracer).
 #[test]
 fn overflowing_photon_power_is_dropped_and_counted() {
     for (method, count) in dropped(&box_scene(1.0e37, 1.0e-12, "")) {
-        if method.is_photon_mapper() {
+        if method.traces_light_paths() {
             assert!(count > 0, "{method}: nothing counted");
         }
     }
