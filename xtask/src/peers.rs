@@ -23,15 +23,17 @@ cargo xtask peers [--scenes a,b,...] [--seconds 60] [--film WxH] [--threads 2]
                   [--methods freq-sppm,sppm,freq,ppm] [--peers path,ptracer]
                   [--reference-seconds 1200] [--out DIR] [--fppm-args \"...\"] [--paths N]
 
-Renders every scene of scenes/peers/ (or those named) with each fppm method and each Mitsuba 3
+Renders every scene of scenes/peers/ (or those named: a name of scenes/peers/ or the path of any
+scene file fppm reads, e.g. ../shared/scenes/cornell_box/CornellBox-Water.obj) with each fppm method and each Mitsuba 3
 integrator for the same wall-clock time, one renderer at a time, all with --threads threads,
 and scores them against a Mitsuba `path` reference (max_depth unlimited) rendered as two
 independent halves of --reference-seconds / 2 each (kept in DIR/SCENE/ and reused; delete them
-to re-render). Reports relMSE (mean of (x - ref)^2 / (ref^2 + 0.01)) over all pixels and over
-the pixels whose first hit is diffuse, the reference's own noise in the same units, and the
-image mean over the reference's. A method may carry switches of its own after `+`:
-`sppm+no-light-tracing` renders `--method sppm --no-light-tracing`. Writes DIR/SCENE/*.exr and DIR/table.md; DIR defaults to
-target/peers. The Mitsuba venv is created in target/peers-venv on first use (pip install
+to re-render). Reports relMSE (mean of (x - ref)^2 / (ref^2 + 0.01)) over all pixels, over
+the pixels whose first hit is diffuse and over those whose first hit is a mirror or glass, the
+reference's own noise in the same units, and the image mean over the reference's. A method may
+carry switches of its own after `+`: `sppm+no-light-tracing` renders `--method sppm
+--no-light-tracing`, `freq-sppm+photons-per-pass=400k` `--photons-per-pass=400k`. Writes
+DIR/SCENE/*.exr and DIR/table.md; DIR defaults to target/peers. The Mitsuba venv is created in target/peers-venv on first use (pip install
 mitsuba drjit numpy; the llvm_ad_rgb variant needs Debian's libllvm19).
 
 --paths N (e.g. 117M) compares at an equal path count instead of equal time: each fppm method
@@ -117,6 +119,23 @@ impl Flags {
     }
 }
 
+/// A scene of the comparison: a name of `scenes/peers/`, or the path of any scene file fppm
+/// reads (named by its file stem in the table and the output folder).
+fn scene_file(root: &Path, arg: &str) -> (String, PathBuf) {
+    if arg.contains('/') || arg.contains('.') {
+        let path = root.join(arg);
+        let stem = path
+            .file_stem()
+            .map_or_else(|| arg.to_owned(), |s| s.to_string_lossy().into_owned());
+        (stem, path)
+    } else {
+        (
+            arg.to_owned(),
+            root.join("scenes/peers").join(format!("{arg}.toml")),
+        )
+    }
+}
+
 /// A count written as `117000000`, `117M` or `500k`.
 fn parse_count(text: &str) -> Result<u64> {
     let (digits, scale) = match text.strip_suffix(['M', 'm']) {
@@ -149,6 +168,8 @@ struct Row {
     seconds: f64,
     rel_mse: f64,
     rel_mse_diffuse: f64,
+    /// Over the pixels whose first hit is a mirror or glass (NaN where there are none).
+    rel_mse_specular: f64,
     mean_ratio: f64,
     note: String,
 }
@@ -166,8 +187,9 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
 
     let mut rows = Vec::new();
     let mut noise_lines = Vec::new();
-    for name in &flags.scenes {
-        let scene_path = root.join("scenes/peers").join(format!("{name}.toml"));
+    for scene_arg in &flags.scenes {
+        let (name, scene_path) = scene_file(root, scene_arg);
+        let name = &name;
         let mut description = import::load(&scene_path)
             .with_context(|| format!("loading {}", scene_path.display()))?;
         if let Some((w, h)) = flags.film {
@@ -178,7 +200,15 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         let dir = out.join(name);
         let xml = write_mitsuba(&description, &dir.join("mitsuba"))?;
         let scene = scene::Scene::new(description)?;
-        let diffuse = diffuse_first_hit_mask(&scene, width as usize, height as usize);
+        let (w, h) = (width as usize, height as usize);
+        let diffuse = first_hit_mask(&scene, w, h, |m| {
+            m.emission.max_element() == 0.0 && matches!(m.kind, scene::MaterialKind::Diffuse(_))
+        });
+        let specular = first_hit_mask(&scene, w, h, |m| m.kind.is_specular());
+        let masks = Masks {
+            diffuse: &diffuse,
+            specular: &specular,
+        };
 
         // The reference: two independent halves.
         let halves = ["ref-a", "ref-b"].map(|h| dir.join(format!("{h}.exr")));
@@ -206,9 +236,10 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         let reference = Image::new(a.width, a.height, pixels);
         let all = vec![true; diffuse.len()];
         noise_lines.push(format!(
-            "| {name} | {:.6} | {:.6} | {:.4} |",
+            "| {name} | {:.6} | {:.6} | {:.6} | {:.4} |",
             noise_rel_mse(&variance, &reference, &all),
             noise_rel_mse(&variance, &reference, &diffuse),
+            noise_rel_mse(&variance, &reference, &specular),
             reference.mean()
         ));
 
@@ -264,7 +295,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
                 seconds,
                 &file,
                 &reference,
-                &diffuse,
+                masks,
                 "",
             )?);
         }
@@ -297,7 +328,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
                 seconds,
                 &file,
                 &reference,
-                &diffuse,
+                masks,
                 &report,
             )?);
         }
@@ -306,14 +337,21 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
     let mut table = String::new();
     writeln!(
         table,
-        "| scene | renderer | wall s | relMSE | relMSE diffuse-seen | mean / ref | notes |"
+        "| scene | renderer | wall s | relMSE | relMSE diffuse-seen | relMSE specular-seen | mean / ref | notes |"
     )?;
-    writeln!(table, "|---|---|---|---|---|---|---|")?;
+    writeln!(table, "|---|---|---|---|---|---|---|---|")?;
     for r in &rows {
         writeln!(
             table,
-            "| {} | {} | {:.1} | {:.6} | {:.6} | {:.4} | {} |",
-            r.scene, r.renderer, r.seconds, r.rel_mse, r.rel_mse_diffuse, r.mean_ratio, r.note
+            "| {} | {} | {:.1} | {:.6} | {:.6} | {:.6} | {:.4} | {} |",
+            r.scene,
+            r.renderer,
+            r.seconds,
+            r.rel_mse,
+            r.rel_mse_diffuse,
+            r.rel_mse_specular,
+            r.mean_ratio,
+            r.note
         )?;
     }
     writeln!(table)?;
@@ -324,9 +362,9 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
     writeln!(table)?;
     writeln!(
         table,
-        "| scene | all pixels | diffuse-seen | reference mean |"
+        "| scene | all pixels | diffuse-seen | specular-seen | reference mean |"
     )?;
-    writeln!(table, "|---|---|---|---|")?;
+    writeln!(table, "|---|---|---|---|---|")?;
     for line in &noise_lines {
         writeln!(table, "{line}")?;
     }
@@ -341,39 +379,56 @@ fn score(
     seconds: f64,
     file: &Path,
     reference: &Image,
-    diffuse: &[bool],
+    masks: Masks<'_>,
     note: &str,
 ) -> Result<Row> {
     let image = film::read_exr(file)?;
     let all = film::errors(&image, reference, None)?;
-    let on_diffuse = film::errors(&image, reference, Some(diffuse))?;
+    let on_diffuse = film::errors(&image, reference, Some(masks.diffuse))?;
+    let on_specular = if masks.specular.contains(&true) {
+        film::errors(&image, reference, Some(masks.specular))?.rel_mse
+    } else {
+        f64::NAN
+    };
     Ok(Row {
         scene: scene.to_owned(),
         renderer: renderer.to_owned(),
         seconds,
         rel_mse: all.rel_mse,
         rel_mse_diffuse: on_diffuse.rel_mse,
+        rel_mse_specular: on_specular,
         mean_ratio: all.mean_ratio,
         note: note.to_owned(),
     })
 }
 
-/// Pixels whose camera ray through the pixel centre first hits a diffuse, non-emitting surface.
-fn diffuse_first_hit_mask(scene: &scene::Scene, width: usize, height: usize) -> Vec<bool> {
+/// The pixel classes the table scores apart.
+#[derive(Clone, Copy)]
+struct Masks<'a> {
+    /// First hit diffuse and not emitting.
+    diffuse: &'a [bool],
+    /// First hit a mirror or glass.
+    specular: &'a [bool],
+}
+
+/// Pixels whose camera ray through the pixel centre first hits a material for which `class`
+/// holds.
+fn first_hit_mask(
+    scene: &scene::Scene,
+    width: usize,
+    height: usize,
+    class: impl Fn(&scene::Material) -> bool,
+) -> Vec<bool> {
     let mut mask = vec![false; width * height];
     for y in 0..height {
         for x in 0..width {
             let ray = scene
                 .camera()
                 .generate_ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), Vec2::splat(0.5));
-            let diffuse = scene
+            mask[y * width + x] = scene
                 .intersect(&ray)
                 .and_then(|hit| scene.material(hit.material))
-                .is_some_and(|m| {
-                    m.emission.max_element() == 0.0
-                        && matches!(m.kind, scene::MaterialKind::Diffuse(_))
-                });
-            mask[y * width + x] = diffuse;
+                .is_some_and(&class);
         }
     }
     mask
