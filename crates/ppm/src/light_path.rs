@@ -4,13 +4,31 @@
 //! their paths with these, so that both draw the same random numbers for the same path.
 
 use glam::{Vec2, Vec3};
-use scene::{Bsdf, BsdfSample, Hit, LensConnection, Rgb, Scene, TransportMode};
+use scene::{Bsdf, BsdfSample, EmissionSample, Hit, LensConnection, Rgb, Scene, TransportMode};
 
 use crate::rng::Sampler;
 
 /// The sampler dimension where a light path's lens samples start (two per bounce), far beyond
 /// what its path draws, so that connecting to the camera leaves the paths as they are.
 const LENS_DIMENSION: u64 = 1 << 40;
+
+/// The start of light path `index` of pass `pass` in a render seeded `seed`: its random
+/// stream, past the emission's dimensions, and its emission sample; `None` if no emitter could
+/// be drawn.
+#[inline]
+pub(crate) fn emit(
+    scene: &Scene,
+    seed: u64,
+    pass: u32,
+    index: u64,
+) -> Option<(Sampler, EmissionSample)> {
+    let mut sampler = Sampler::new(seed, pass, index);
+    let u_light = sampler.next_f32();
+    let u_pos = sampler.next_2d();
+    let u_dir = sampler.next_2d();
+    let emission = scene.lights().sample_emission(u_light, u_pos, u_dir)?;
+    Some((sampler, emission))
+}
 
 /// How a light path goes on after [`scatter`].
 pub(crate) enum Scatter {

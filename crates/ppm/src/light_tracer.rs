@@ -19,7 +19,7 @@ use scene::{Rgb, Scene};
 
 use crate::checkpoint::codec::{Reader, StateError, Writer};
 use crate::integrator::Integrator;
-use crate::light_path::{Scatter, lens_point, lens_radiance, scatter};
+use crate::light_path::{Scatter, emit, lens_point, lens_radiance, scatter};
 use crate::params::RenderParams;
 use crate::rng::{CAMERA_STREAM, Sampler};
 use crate::stats::{MemoryEstimate, PassStats};
@@ -103,11 +103,7 @@ impl LightTracer {
     /// lens. `TEXTURED_HITS` must be the scene's `Scene::textured_hits`.
     fn trace<const TEXTURED_HITS: bool>(&self, pass: u32, index: u64, out: &mut Chunk) {
         let scene = &*self.scene;
-        let mut sampler = Sampler::new(self.params.seed, pass, index);
-        let u_light = sampler.next_f32();
-        let u_pos = sampler.next_2d();
-        let u_dir = sampler.next_2d();
-        let Some(emission) = scene.lights().sample_emission(u_light, u_pos, u_dir) else {
+        let Some((mut sampler, emission)) = emit(scene, self.params.seed, pass, index) else {
             return;
         };
         let mut power = emission.power;

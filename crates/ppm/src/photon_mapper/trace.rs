@@ -7,7 +7,7 @@ use scene::{Bsdf, Hit, Rgb};
 
 use super::Setup;
 use super::frequency::{FrequencyPhoton, arrived, scatter_spectrum};
-use crate::light_path::{Scatter, lens_point, lens_radiance, scatter};
+use crate::light_path::{Scatter, emit, lens_point, lens_radiance, scatter};
 use crate::rng::Sampler;
 
 /// Photons of one chunk, in trace order.
@@ -105,11 +105,7 @@ impl Setup {
         light: Option<LightTracing<'_>>,
         out: &mut TracedPhotons,
     ) {
-        let mut sampler = Sampler::new(self.params.seed, pass, index);
-        let u_light = sampler.next_f32();
-        let u_pos = sampler.next_2d();
-        let u_dir = sampler.next_2d();
-        let Some(emission) = self.scene.lights().sample_emission(u_light, u_pos, u_dir) else {
+        let Some((mut sampler, emission)) = emit(&self.scene, self.params.seed, pass, index) else {
             return;
         };
         let mut power = emission.power;
