@@ -13,7 +13,7 @@ use std::process::Command;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 use crate::converge::{noise_rel_mse, reference_from_halves};
 use film::Image;
@@ -200,11 +200,10 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         let dir = out.join(name);
         let xml = write_mitsuba(&description, &dir.join("mitsuba"))?;
         let scene = scene::Scene::new(description)?;
-        let (w, h) = (width as usize, height as usize);
-        let diffuse = first_hit_mask(&scene, w, h, |m| {
+        let diffuse = crate::suite::first_hits(&scene, |m| {
             m.emission.max_element() == 0.0 && matches!(m.kind, scene::MaterialKind::Diffuse(_))
         });
-        let specular = first_hit_mask(&scene, w, h, |m| m.kind.is_specular());
+        let specular = crate::suite::first_hits(&scene, |m| m.kind.is_specular());
         let masks = Masks {
             diffuse: &diffuse,
             specular: &specular,
@@ -409,29 +408,6 @@ struct Masks<'a> {
     diffuse: &'a [bool],
     /// First hit a mirror or glass.
     specular: &'a [bool],
-}
-
-/// Pixels whose camera ray through the pixel centre first hits a material for which `class`
-/// holds.
-fn first_hit_mask(
-    scene: &scene::Scene,
-    width: usize,
-    height: usize,
-    class: impl Fn(&scene::Material) -> bool,
-) -> Vec<bool> {
-    let mut mask = vec![false; width * height];
-    for y in 0..height {
-        for x in 0..width {
-            let ray = scene
-                .camera()
-                .generate_ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), Vec2::splat(0.5));
-            mask[y * width + x] = scene
-                .intersect(&ray)
-                .and_then(|hit| scene.material(hit.material))
-                .is_some_and(&class);
-        }
-    }
-    mask
 }
 
 /// The venv's Python with Mitsuba 3, created on first use.

@@ -194,19 +194,7 @@ pub(crate) fn method_mask(scene: &scene::Scene, method: ppm::Method) -> Vec<bool
 fn first_hit_mask(scene: &scene::Scene, excluded: impl Fn(&scene::Material) -> bool) -> Vec<bool> {
     let film = scene.description().film;
     let (w, h) = (film.width as usize, film.height as usize);
-    let mut hit = vec![false; w * h];
-    for y in 0..h {
-        for x in 0..w {
-            let ray = scene.camera().generate_ray(
-                glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5),
-                glam::Vec2::splat(0.5),
-            );
-            hit[y * w + x] = scene
-                .intersect(&ray)
-                .and_then(|hit| scene.material(hit.material))
-                .is_some_and(&excluded);
-        }
-    }
+    let hit = first_hits(scene, excluded);
     let mut mask = vec![true; w * h];
     for y in 0..h {
         for x in 0..w {
@@ -220,4 +208,28 @@ fn first_hit_mask(scene: &scene::Scene, excluded: impl Fn(&scene::Material) -> b
         }
     }
     mask
+}
+
+/// Per pixel of the scene's film, whether the camera ray through the pixel centre first hits a
+/// material for which `class` holds.
+pub(crate) fn first_hits(
+    scene: &scene::Scene,
+    class: impl Fn(&scene::Material) -> bool,
+) -> Vec<bool> {
+    let film = scene.description().film;
+    let (w, h) = (film.width as usize, film.height as usize);
+    let mut hits = vec![false; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let ray = scene.camera().generate_ray(
+                glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5),
+                glam::Vec2::splat(0.5),
+            );
+            hits[y * w + x] = scene
+                .intersect(&ray)
+                .and_then(|hit| scene.material(hit.material))
+                .is_some_and(&class);
+        }
+    }
+    hits
 }

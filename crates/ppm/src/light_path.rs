@@ -14,19 +14,24 @@ const LENS_DIMENSION: u64 = 1 << 40;
 
 /// The start of light path `index` of pass `pass` in a render seeded `seed`: its random
 /// stream, past the emission's dimensions, and its emission sample; `None` if no emitter could
-/// be drawn.
+/// be drawn or the emitted power is NaN or infinite (counted in `non_finite`).
 #[inline]
 pub(crate) fn emit(
     scene: &Scene,
     seed: u64,
     pass: u32,
     index: u64,
+    non_finite: &mut u64,
 ) -> Option<(Sampler, EmissionSample)> {
     let mut sampler = Sampler::new(seed, pass, index);
     let u_light = sampler.next_f32();
     let u_pos = sampler.next_2d();
     let u_dir = sampler.next_2d();
     let emission = scene.lights().sample_emission(u_light, u_pos, u_dir)?;
+    if !emission.power.is_finite() {
+        *non_finite += 1;
+        return None;
+    }
     Some((sampler, emission))
 }
 
@@ -40,8 +45,9 @@ pub(crate) enum Scatter {
     NonFinite,
 }
 
-/// Scatters a light path of power `power` that arrived at `hit` along −`incoming`, with the
-/// random numbers `u_lobe`, `u` (the BSDF sample) and `u_roulette`; `roulette` says whether
+/// Scatters a light path of power `power` that arrived at `hit` along −`incoming`, drawing the
+/// lobe choice, the BSDF sample and the roulette's number from `sampler` (always all three, so
+/// that the path's later dimensions do not depend on the outcome); `roulette` says whether
 /// Russian roulette may end it at this bounce.
 ///
 /// Russian roulette (pbrt-v4 SPPM) keeps the path's power roughly constant: it kills the path
@@ -51,17 +57,17 @@ pub(crate) enum Scatter {
 /// before the direction is drawn and a killed path costs no BSDF sample; elsewhere it needs the
 /// sampled weight. Either way q is fixed before `u_roulette` is compared with it: unbiased.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn scatter(
     hit: &Hit,
     bsdf: &Bsdf,
     incoming: Vec3,
     power: Rgb,
     roulette: bool,
-    u_lobe: f32,
-    u: Vec2,
-    u_roulette: f32,
+    sampler: &mut Sampler,
 ) -> Scatter {
+    let u_lobe = sampler.next_f32();
+    let u = sampler.next_2d();
+    let u_roulette = sampler.next_f32();
     let kill_probability = |scattered: Rgb| {
         let ratio = luminance(scattered) / luminance(power).max(f32::MIN_POSITIVE);
         (1.0 - ratio).max(0.0)

@@ -103,14 +103,12 @@ impl LightTracer {
     /// lens. `TEXTURED_HITS` must be the scene's `Scene::textured_hits`.
     fn trace<const TEXTURED_HITS: bool>(&self, pass: u32, index: u64, out: &mut Chunk) {
         let scene = &*self.scene;
-        let Some((mut sampler, emission)) = emit(scene, self.params.seed, pass, index) else {
+        let seed = self.params.seed;
+        let Some((mut sampler, emission)) = emit(scene, seed, pass, index, &mut out.non_finite)
+        else {
             return;
         };
         let mut power = emission.power;
-        if !power.is_finite() {
-            out.non_finite += 1;
-            return;
-        }
         let mut ray = emission.ray();
         let film = (self.width, self.height);
         let (max_depth, rr_depth) = (self.params.budget.max_depth, self.params.budget.rr_depth);
@@ -138,13 +136,8 @@ impl LightTracer {
             if depth + 1 == max_depth {
                 break;
             }
-            let u_lobe = sampler.next_f32();
-            let u = sampler.next_2d();
-            let u_roulette = sampler.next_f32();
             let roulette = depth + 1 >= rr_depth;
-            match scatter(
-                &hit, &bsdf, incoming, power, roulette, u_lobe, u, u_roulette,
-            ) {
+            match scatter(&hit, &bsdf, incoming, power, roulette, &mut sampler) {
                 Scatter::Continue { sample, power: p } => {
                     power = p;
                     ray = hit.spawn_ray(sample.incoming);

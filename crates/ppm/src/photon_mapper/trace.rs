@@ -105,14 +105,13 @@ impl Setup {
         light: Option<LightTracing<'_>>,
         out: &mut TracedPhotons,
     ) {
-        let Some((mut sampler, emission)) = emit(&self.scene, self.params.seed, pass, index) else {
+        let seed = self.params.seed;
+        let Some((mut sampler, emission)) =
+            emit(&self.scene, seed, pass, index, &mut out.non_finite)
+        else {
             return;
         };
         let mut power = emission.power;
-        if !power.is_finite() {
-            out.non_finite += 1;
-            return;
-        }
         let mut ray = emission.ray();
         let mut spectrum = self.start_spectrum(index, emission.emitter);
         if spectrum.is_some() {
@@ -170,13 +169,8 @@ impl Setup {
             if depth + 1 == max_depth {
                 break;
             }
-            let u_lobe = sampler.next_f32();
-            let u = sampler.next_2d();
-            let u_roulette = sampler.next_f32();
             let roulette = depth + 1 >= rr_depth;
-            let sample = match scatter(
-                &hit, &bsdf, incoming, power, roulette, u_lobe, u, u_roulette,
-            ) {
+            let sample = match scatter(&hit, &bsdf, incoming, power, roulette, &mut sampler) {
                 Scatter::Continue { sample, power: p } => {
                     power = p;
                     sample
