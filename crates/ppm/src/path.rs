@@ -206,7 +206,7 @@ impl PathTracer {
 }
 
 /// Veach's power heuristic (β = 2) for the strategy with density `f` against one with `g`.
-fn power_heuristic(f: f32, g: f32) -> f32 {
+pub(crate) fn power_heuristic(f: f32, g: f32) -> f32 {
     let (f2, g2) = (f * f, g * g);
     if f2 + g2 > 0.0 { f2 / (f2 + g2) } else { 0.0 }
 }

@@ -24,6 +24,11 @@ use rand_pcg::rand_core::Rng;
 /// light paths, which are indexed by the photon's number.
 pub(crate) const CAMERA_STREAM: u64 = 1 << 63;
 
+/// The bit that sets the streams of the photon mappers' connection-only light paths
+/// (`extra_light_paths`, indexed by their number within the pass) apart from those of the
+/// photons (numbered over the whole render, far below 2⁶²) and of camera samples.
+pub(crate) const CONNECT_ONLY_STREAM: u64 = 1 << 62;
+
 /// The random stream of one photon or pixel in one pass.
 #[derive(Clone, Debug)]
 pub struct Sampler {

@@ -265,9 +265,11 @@ fn base_params(
     let mut params = suite::params(entry, scene, method, flags.seed)?;
     params.budget.photons_per_pass = flags.photons;
     // Against the pointwise reference (the radiance at PPM's fixed hitpoints) the renders
-    // gather only: light-traced connections converge to the pixel's average instead.
+    // gather only: light-traced connections and direct lighting (a light sample per camera
+    // pass, at jittered points) converge to the pixel's average instead.
     if flags.pointwise.is_some() {
         params.connections.light_tracing = false;
+        params.connections.direct_lighting = false;
     }
     flags.overrides.apply(&mut params)?;
     Ok(params)

@@ -192,10 +192,12 @@ fn frequency_flags_take_effect() {
 }
 
 #[test]
-fn direct_lighting_flag_renders() {
+fn direct_lighting_flag_renders_and_is_recorded() {
     let dir = temp_dir("direct_lighting");
     render_cornell(&dir, &["--direct-lighting"]).ok();
-    assert!(read_exr(&dir.join("fppm.exr")).mean() > 0.0);
+    let exr = read_exr(&dir.join("fppm.exr"));
+    assert!(exr.mean() > 0.0);
+    assert_eq!(exr.metadata["fppm.direct_lighting"], "on");
 }
 
 #[test]

@@ -333,6 +333,34 @@ pub const PARAMS: &[Param] = &[
         },
     },
     Param {
+        name: "connect_below",
+        flag: "connect-below",
+        help: "Photon mappers with light tracing: connect a photon to the camera where the kernels of its pixel cover at most this many camera samples (pi R^2 times the samples per unit area), in [0, inf] [default: 2]",
+        kind: ParamKind::Value {
+            value_name: "N",
+            choices: &[],
+        },
+        get: |p| p.connections.connect_below.to_string(),
+        set: |p, v| {
+            p.connections.connect_below = parse_number(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "extra_light_paths",
+        flag: "extra-light-paths",
+        help: "Photon mappers with light tracing: light paths traced per pass only for their connections to the camera, as a multiple of photons_per_pass, in [0, 64] [default: 0]",
+        kind: ParamKind::Value {
+            value_name: "R",
+            choices: &[],
+        },
+        get: |p| p.connections.extra_light_paths.to_string(),
+        set: |p, v| {
+            p.connections.extra_light_paths = parse_number(v)?;
+            Ok(())
+        },
+    },
+    Param {
         name: "max_depth",
         flag: "max-depth",
         help: "Maximum number of scattering events on a light path, in [1, 1024] [default: scene, else 1024: in effect unlimited, paths end by Russian roulette]",
@@ -393,7 +421,7 @@ pub const PARAMS: &[Param] = &[
     Param {
         name: "direct_lighting",
         flag: "direct-lighting",
-        help: "Add direct lighting by light sampling at hitpoints instead of gathering photons that arrive straight from an emitter",
+        help: "Photon mappers: estimate the light arriving straight from emitters at each visible point by a light sample and a BSDF sample combined by multiple importance sampling, instead of gathering (and connecting) the photons that arrive straight from an emitter",
         kind: ParamKind::Switch { sets: true },
         get: |p| on_off(p.connections.direct_lighting),
         set: |p, v| {

@@ -9,6 +9,7 @@ use scene::{Bsdf, Hit, Rgb, TransportMode};
 
 use super::frequency::SlotFrequency;
 use super::{NO_VISIBLE_POINT, PhotonMapper, SLOT_CHUNK, Setup};
+use crate::path::power_heuristic;
 use crate::rng::{CAMERA_STREAM, Sampler};
 
 /// A camera path up to its first non-specular hit ([`PhotonMapper::camera_chain`]).
@@ -261,7 +262,11 @@ impl Setup {
         CameraChain { direct, end: None }
     }
 
-    /// One light sample of next-event estimation at a non-specular camera hit.
+    /// The direct lighting at a non-specular camera hit: one light sample and one BSDF sample,
+    /// combined by multiple importance sampling (the power heuristic, as the path tracer's
+    /// next-event estimation does). Light sampling alone is unbiased too, but on a sharp
+    /// glossy surface under a large emitter it almost never finds the narrow lobe (the
+    /// Veach MIS scene reads 7.6× the error without the BSDF sample, docs/convergence.md).
     fn direct_lighting(
         &self,
         hit: &Hit,
@@ -271,13 +276,53 @@ impl Setup {
     ) -> Rgb {
         let u_light = sampler.next_f32();
         let u = sampler.next_2d();
-        let Some(sample) = self.scene.lights().sample_direct(hit.position, u_light, u) else {
-            return Rgb::ZERO;
-        };
-        if sample.pdf <= 0.0 || !self.scene.light_visible(hit, &sample) {
-            return Rgb::ZERO;
+        let u_lobe = sampler.next_f32();
+        let u_bsdf = sampler.next_2d();
+        let lights = self.scene.lights();
+        let mut radiance = Rgb::ZERO;
+        if let Some(sample) = lights.sample_direct(hit.position, u_light, u)
+            && sample.pdf > 0.0
+            && self.scene.light_visible(hit, &sample)
+        {
+            let f = bsdf.eval(outgoing, sample.incoming);
+            let cos = sample.incoming.dot(hit.shading_normal).abs();
+            let weight = if sample.is_delta {
+                1.0
+            } else {
+                power_heuristic(sample.pdf, bsdf.pdf(outgoing, sample.incoming))
+            };
+            radiance += f * sample.radiance * (cos * weight / sample.pdf);
         }
-        let cos = sample.incoming.dot(hit.shading_normal).abs();
-        bsdf.eval(outgoing, sample.incoming) * sample.radiance * (cos / sample.pdf)
+        let Some(sample) = bsdf.sample(outgoing, u_lobe, u_bsdf, TransportMode::Radiance) else {
+            return radiance;
+        };
+        if sample.weight == Rgb::ZERO || !sample.weight.is_finite() {
+            return radiance;
+        }
+        let ray = hit.spawn_ray(sample.incoming);
+        match self.scene.intersect(&ray) {
+            Some(next) => {
+                let emitted = self.scene.emitted(&next);
+                if emitted != Rgb::ZERO {
+                    // A specular lobe cannot be found by light sampling: it counts in full.
+                    let weight = if sample.is_specular {
+                        1.0
+                    } else {
+                        power_heuristic(sample.pdf, lights.pdf_direct(hit.position, &next))
+                    };
+                    radiance += sample.weight * emitted * weight;
+                }
+            }
+            None if lights.has_environment() => {
+                let weight = if sample.is_specular {
+                    1.0
+                } else {
+                    power_heuristic(sample.pdf, lights.pdf_environment(ray.direction))
+                };
+                radiance += sample.weight * lights.environment_radiance(ray.direction) * weight;
+            }
+            None => {}
+        }
+        radiance
     }
 }

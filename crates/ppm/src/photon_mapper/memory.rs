@@ -58,7 +58,9 @@ pub(crate) fn estimate(pixels: u64, params: &RenderParams, frequency: bool) -> M
     MemoryEstimate {
         hitpoints: slots.saturating_mul(per_slot),
         photons: MemoryEstimate::photon_bytes(photons_per_pass).saturating_add(if light_tracing {
+            // The connection-only paths' splats come on top of the photons'.
             photons_per_pass
+                .saturating_add(params.connect_only_paths())
                 .saturating_mul(LIGHT_BYTES_PER_PHOTON)
                 .saturating_mul(u64::from(params.film.samples_per_pixel))
         } else {

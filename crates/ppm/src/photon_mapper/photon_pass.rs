@@ -13,6 +13,7 @@ use super::frequency::FrequencyPhoton;
 use super::index::NOT_IN_GRID;
 use super::trace::{LightTracing, TracedPhotons};
 use super::{NO_VISIBLE_POINT, PHOTON_CHUNK, PassStats, PhotonMapper};
+use crate::rng::CONNECT_ONLY_STREAM;
 
 /// The photon pass's buffers and what it leaves for the update: M and Φ per grid entry.
 ///
@@ -23,6 +24,9 @@ use super::{NO_VISIBLE_POINT, PHOTON_CHUNK, PassStats, PhotonMapper};
 pub(crate) struct PhotonPass {
     /// Per chunk of [`PHOTON_CHUNK`] photon paths, what they stored.
     pub(super) traced: Vec<TracedPhotons>,
+    /// Per chunk of [`PHOTON_CHUNK`] connection-only light paths (`extra_light_paths`), what
+    /// they connected.
+    connect_only: Vec<TracedPhotons>,
     /// Morton keys of the stored photons.
     keys: MortonScratch,
     /// The stored photons in Morton order.
@@ -62,13 +66,14 @@ impl PhotonPass {
         let traced: usize = self
             .traced
             .iter()
+            .chain(&self.connect_only)
             .map(|t| {
                 t.photons.capacity() * size_of::<Photon>()
                     + t.frequency.capacity() * size_of::<FrequencyPhoton>()
                     + t.splats.capacity() * size_of::<(u32, [f32; 3])>()
             })
             .sum::<usize>()
-            + self.traced.capacity() * size_of::<TracedPhotons>();
+            + (self.traced.capacity() + self.connect_only.capacity()) * size_of::<TracedPhotons>();
         (
             traced
                 + self.sorted.capacity() * size_of::<Photon>()
@@ -100,6 +105,7 @@ impl PhotonMapper {
             .frequency
             .layout(n_chunks, setup.params.budget.max_depth);
         let textured_hits = setup.scene.textured_hits();
+        let connect_only = setup.params.connect_only_paths();
         let light = setup
             .params
             .connections
@@ -107,22 +113,43 @@ impl PhotonMapper {
             .then(|| LightTracing {
                 radii: self.slots.radius(),
                 samples_per_pixel: setup.params.film.samples_per_pixel,
+                connect_below: setup.params.connections.connect_below,
+                paths_per_photon: 1.0 + connect_only as f64 / n as f64,
             });
+        let n_connect_chunks = usize::try_from(connect_only.div_ceil(PHOTON_CHUNK)).unwrap_or(0);
+        buffers
+            .connect_only
+            .resize_with(n_connect_chunks, TracedPhotons::default);
+        // The photons' chunks, then the connection-only paths' chunks, in one parallel loop.
         buffers
             .traced
             .par_iter_mut()
+            .chain(buffers.connect_only.par_iter_mut())
             .enumerate()
             .for_each(|(chunk, out)| {
                 out.clear();
-                let start = chunk as u64 * PHOTON_CHUNK;
-                let end = (start + PHOTON_CHUNK).min(n);
-                let tag_base = layout.chunk_base(chunk);
-                for idx in start..end {
-                    let index = first_index + idx;
-                    if textured_hits {
-                        setup.trace_photon::<true>(pass, index, tag_base, light, out);
-                    } else {
-                        setup.trace_photon::<false>(pass, index, tag_base, light, out);
+                if chunk < n_chunks {
+                    let start = chunk as u64 * PHOTON_CHUNK;
+                    let end = (start + PHOTON_CHUNK).min(n);
+                    let tag_base = layout.chunk_base(chunk);
+                    for idx in start..end {
+                        let index = first_index + idx;
+                        if textured_hits {
+                            setup.trace_photon::<true, true>(pass, index, tag_base, light, out);
+                        } else {
+                            setup.trace_photon::<false, true>(pass, index, tag_base, light, out);
+                        }
+                    }
+                } else {
+                    let start = (chunk - n_chunks) as u64 * PHOTON_CHUNK;
+                    let end = (start + PHOTON_CHUNK).min(connect_only);
+                    for idx in start..end {
+                        let index = CONNECT_ONLY_STREAM | idx;
+                        if textured_hits {
+                            setup.trace_photon::<true, false>(pass, index, 0, light, out);
+                        } else {
+                            setup.trace_photon::<false, false>(pass, index, 0, light, out);
+                        }
                     }
                 }
             });
@@ -132,7 +159,7 @@ impl PhotonMapper {
             let n_slots = self.slots.len();
             buffers.light.clear();
             buffers.light.resize(n_slots, [0.0; 3]);
-            for chunk in &buffers.traced {
+            for chunk in buffers.traced.iter().chain(&buffers.connect_only) {
                 stats.light_connections += chunk.connections;
                 for &(slot, v) in &chunk.splats {
                     let sum = &mut buffers.light[slot as usize];
@@ -142,7 +169,7 @@ impl PhotonMapper {
                 }
             }
             // The balance heuristic against the photon's connection to the camera
-            // (`trace.rs`): N/(q + N), N = πR²ρ, ρ the camera samples per unit area at the
+            // (`trace.rs`): N/(kq + N), N = πR²ρ, ρ the camera samples per unit area at the
             // visible point; 1 where the camera sees it only through specular bounces (a
             // connection cannot reach it).
             let camera = setup.scene.camera();
@@ -152,19 +179,23 @@ impl PhotonMapper {
             let (budgets, radii) = (&self.photon_bounces, self.slots.radius());
             let spp = setup.params.film.samples_per_pixel as usize;
             buffers.merge_weight.clear();
-            buffers.merge_weight.extend((0..n_slots).map(|slot| {
-                let budget = budgets[slot];
-                if budget == NO_VISIBLE_POINT || budget < direct_budget {
-                    return 1.0;
-                }
-                let rho = f64::from(camera.film_density(positions[slot], normals[slot]));
-                let n = std::f64::consts::PI * radii[slot] * radii[slot] * rho;
-                let q = light.connection_rate((slot / spp) as u32, rho);
-                (n / (q + n)) as f32
-            }));
+            buffers
+                .merge_weight
+                .par_extend((0..n_slots).into_par_iter().map(|slot| {
+                    let budget = budgets[slot];
+                    if budget == NO_VISIBLE_POINT || budget < direct_budget {
+                        return 1.0;
+                    }
+                    let rho = f64::from(camera.film_density(positions[slot], normals[slot]));
+                    let n = std::f64::consts::PI * radii[slot] * radii[slot] * rho;
+                    let q = light.connection_rate((slot / spp) as u32, rho);
+                    (n / (light.paths_per_photon * q + n)) as f32
+                }));
         }
         let frequency_photons = buffers.traced.iter().map(|c| c.frequency_photons).sum();
-        stats.non_finite += buffers.traced.iter().map(|c| c.non_finite).sum::<u64>();
+        stats.non_finite += (buffers.traced.iter().chain(&buffers.connect_only))
+            .map(|c| c.non_finite)
+            .sum::<u64>();
         let trace_seconds = clock.elapsed().as_secs_f64();
         let uses_frequency = setup.params.method.uses_frequency();
         let frequency_clock = Instant::now();

@@ -34,6 +34,10 @@ pub(super) struct TracedPhotons {
 pub(super) struct LightTracing<'a> {
     pub(super) radii: &'a [f64],
     pub(super) samples_per_pixel: u32,
+    /// `connect_below`: see [`LightTracing::connection_rate`].
+    pub(super) connect_below: f64,
+    /// Light paths connected per photon stored: 1 + `extra_light_paths`.
+    pub(super) paths_per_photon: f64,
 }
 
 impl LightTracing<'_> {
@@ -48,26 +52,24 @@ impl LightTracing<'_> {
     }
 
     /// The probability q that a photon at a point is connected to the camera, given the N of
-    /// its pixel's slots: 1 where the smallest N is at most [`CONNECT_BELOW`], else 0. The
-    /// balance heuristic weighs the connection strategy by its rate: q/(q + N) for the
-    /// connection, N/(q + N) for the merge, so that where q = 0 merging takes all the weight.
+    /// its pixel's slots: 1 where the smallest N is at most `connect_below`, else 0. The
+    /// balance heuristic weighs the connection strategy by its rate: kq/(kq + N) for the
+    /// connection, N/(kq + N) for the merge (k = `paths_per_photon`, the light paths connected
+    /// per photon stored), so that where q = 0 merging takes all the weight.
     ///
     /// Why a threshold: per photon landing in a pixel, the combined variance goes as
     /// 1/(q + N) and the cost as t + q·c (t the photon's own cost, c a connection's), so the
     /// efficiency (q + N)/(t + q·c) grows with q exactly when N < t/c: connect always or never.
     /// A connection costs about a third of a stored photon's share of the pass (its shadow ray
-    /// against the photon's tracing, gathering and the pass's overhead), hence a few.
+    /// against the photon's tracing, gathering and the pass's overhead), hence a few; the
+    /// default was chosen at equal time (docs/integrators.md).
     pub(super) fn connection_rate(&self, pixel: u32, rho: f64) -> f64 {
         let n = self
             .kernel_samples(pixel, rho)
             .fold(f64::INFINITY, f64::min);
-        if n <= CONNECT_BELOW { 1.0 } else { 0.0 }
+        if n <= self.connect_below { 1.0 } else { 0.0 }
     }
 }
-
-/// Photons are connected to the camera where a kernel covers at most this many camera
-/// samples ([`LightTracing::connection_rate`]).
-const CONNECT_BELOW: f64 = 2.0;
 
 impl TracedPhotons {
     /// Empties the chunk for the next pass, keeping the allocations.
@@ -89,7 +91,10 @@ impl AsRef<[Photon]> for TracedPhotons {
 
 impl Setup {
     /// Traces photon path `index` of pass `pass` and stores its non-specular hits in `out`.
-    /// `TEXTURED_HITS` must be the scene's `Scene::textured_hits`.
+    /// `TEXTURED_HITS` must be the scene's `Scene::textured_hits`. Without `STORE` the path is
+    /// a connection-only light path (`extra_light_paths`, `index` with
+    /// `CONNECT_ONLY_STREAM` set): it carries no spectrum and stores nothing, and its
+    /// non-specular hits are only connected to the camera.
     ///
     /// The hot loop of a pass: `Scene::intersect_inlined` compiles the BVH traversal and the
     /// hit into it, so that the `Hit` is not returned through memory, and one copy per kind of
@@ -97,7 +102,7 @@ impl Setup {
     /// call per path), so that it stays visible in profiles; docs/performance.md says where
     /// its time goes.
     #[inline(never)]
-    pub(super) fn trace_photon<const TEXTURED_HITS: bool>(
+    pub(super) fn trace_photon<const TEXTURED_HITS: bool, const STORE: bool>(
         &self,
         pass: u32,
         index: u64,
@@ -113,7 +118,11 @@ impl Setup {
         };
         let mut power = emission.power;
         let mut ray = emission.ray();
-        let mut spectrum = self.start_spectrum(index, emission.emitter);
+        let mut spectrum = if STORE {
+            self.start_spectrum(index, emission.emitter)
+        } else {
+            None
+        };
         if spectrum.is_some() {
             out.frequency_photons += 1;
         }
@@ -141,7 +150,13 @@ impl Setup {
             // With direct lighting by light sampling, photons straight from an emitter are
             // already accounted for at the hitpoints.
             let counted_by_light_sampling = direct_lighting && depth == 0;
-            if !bsdf.is_specular() && !counted_by_light_sampling {
+            if !bsdf.is_specular() && !counted_by_light_sampling && !STORE {
+                if let Some(light) = light {
+                    self.connect_to_camera(
+                        &hit, &bsdf, incoming, power, &sampler, depth, light, out,
+                    );
+                }
+            } else if !bsdf.is_specular() && !counted_by_light_sampling {
                 let tag = self.record_frequency_photon(
                     here,
                     &hit,
@@ -199,10 +214,11 @@ impl Setup {
     /// pixel is one unit of film area, `CameraModel::connect`), the same flux per unit area as
     /// a merge evaluates with f·Φ/(πR²). The photon is connected with probability q
     /// ([`LightTracing::connection_rate`]); slot s of the pixel takes the connection with the
-    /// balance heuristic's weight q/(q + N), N = πR_s²·ρ(x), ρ the camera samples per unit
-    /// area at the photon (`CameraModel::film_density`), divided by q and by spp; a merge at a
-    /// directly seen hitpoint takes N/(q + N) with ρ and q at the hitpoint (`photon_pass.rs`),
-    /// so that the two weights of a path sum to one as the kernel shrinks onto it.
+    /// balance heuristic's weight kq/(kq + N), N = πR_s²·ρ(x), ρ the camera samples per unit
+    /// area at the photon (`CameraModel::film_density`), k the light paths connected per photon
+    /// stored, divided by q, by k and by spp; a merge at a directly seen hitpoint takes
+    /// N/(kq + N) with ρ and q at the hitpoint (`photon_pass.rs`), so that the two weights of a
+    /// path sum to one as the kernel shrinks onto it.
     #[allow(clippy::too_many_arguments)]
     fn connect_to_camera(
         &self,
@@ -236,9 +252,11 @@ impl Setup {
         }
         out.connections += 1;
         let spp = light.samples_per_pixel;
+        let k = light.paths_per_photon;
         for (i, n) in light.kernel_samples(pixel, rho).enumerate() {
-            // Weight q/(q + N) over the connection's probability q (q = 1 here).
-            let weight = 1.0 / ((rate + n) * f64::from(spp));
+            // Weight kq/(kq + N) over the connection's probability q (q = 1 here) and over the
+            // k connecting paths per photon emitted.
+            let weight = 1.0 / ((k * rate + n) * f64::from(spp));
             let v = value * weight as f32;
             out.splats.push((pixel * spp + i as u32, [v.x, v.y, v.z]));
         }

@@ -3,7 +3,7 @@
 use std::f64::consts::PI;
 
 use glam::Vec2;
-use ppm::Method;
+use ppm::{Method, RenderParams};
 
 use crate::support::{PHOTON_METHODS, mean, params, render, rmse, scene};
 
@@ -252,6 +252,14 @@ fn plane_radiance_at(scene: &scene::Scene, film: Vec2) -> f64 {
     0.8 / PI * 10.0 * f64::from(to_light.y) / d2.sqrt() / d2
 }
 
+/// PPM without direct lighting (a light sample per camera pass at jittered points would
+/// estimate the pixel's average, not the radiance at the fixed hitpoints).
+fn fixed_hitpoints() -> RenderParams {
+    let mut p = params(Method::Ppm, 1);
+    p.connections.direct_lighting = false;
+    p
+}
+
 /// Over a plane lit by a point light, light sampling is exact, so the pointwise reference is
 /// the analytic radiance at each slot's hitpoint: inside the range the pixel's footprint spans,
 /// and (the slots being single points) not the pixel average.
@@ -259,7 +267,7 @@ fn plane_radiance_at(scene: &scene::Scene, film: Vec2) -> f64 {
 fn pointwise_reference_is_the_radiance_at_the_hitpoints() {
     let scene = scene(PLANE);
     let average = plane_reference(&scene);
-    let reference = ppm::pointwise_reference(&scene, params(Method::Ppm, 1), 2, 1).unwrap();
+    let reference = ppm::pointwise_reference(&scene, fixed_hitpoints(), 2, 1).unwrap();
     let (width, _) = scene.camera().resolution();
     let mut off_average = 0;
     for (i, (pixel, &mean)) in reference.iter().zip(&average).enumerate() {
@@ -288,8 +296,7 @@ fn pointwise_reference_is_the_radiance_at_the_hitpoints() {
     // Disjoint path ranges are independent estimates of the same image; light sampling being
     // exact here, each equals the whole reference, and their mean is it.
     for range in [0..1, 1..2] {
-        let half =
-            ppm::pointwise_reference_paths(&scene, params(Method::Ppm, 1), range, 1).unwrap();
+        let half = ppm::pointwise_reference_paths(&scene, fixed_hitpoints(), range, 1).unwrap();
         for (h, r) in half.iter().zip(&reference) {
             assert!(
                 (h[1] - r[1]).abs() <= 1e-5 * r[1].abs() + 1e-7,
@@ -315,8 +322,10 @@ fn ppm_converges_to_the_pointwise_reference() {
         .collect();
     let mut p = params(Method::Ppm, 100_000);
     p.kernel.initial_radius = Some(0.05);
-    // Connections to the camera converge to the pixel average, not to the hitpoints'.
+    // Connections to the camera and direct lighting converge to the pixel average, not to the
+    // hitpoints'.
     p.connections.light_tracing = false;
+    p.connections.direct_lighting = false;
     let pointwise = ppm::pointwise_reference(&scene, p, 2, 1).unwrap();
     let mut renderer = ppm::Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
     let mut errors = Vec::new();

@@ -183,8 +183,8 @@ fn upward_irradiance(map: &scene::EnvironmentMap) -> [f64; 3] {
 
 /// A grey floor seen from straight above under a map with a sun: its radiance is
 /// albedo/π × the irradiance summed over the texels, for the path tracer (light sampling and
-/// BSDF sampling of the sky, MIS-weighted) and for every photon mapper (photons from the
-/// sky's disc).
+/// BSDF sampling of the sky, MIS-weighted), for every photon mapper (photons from the
+/// sky's disc) and for their direct lighting (the same two samples at visible points).
 #[test]
 fn floor_under_a_sun_map_matches_the_texel_sum() {
     let map = sun_map();
@@ -237,8 +237,17 @@ radiance = [1.0, 1.0, 1.0]
     p.film.samples_per_pixel = 64;
     let mut runs = vec![(Method::Path, render(&scene, p, 4))];
     for method in PHOTON_METHODS {
-        runs.push((method, render(&scene, params(method, 100_000), 8)));
+        // The sky's light as photons from its disc.
+        let mut p = params(method, 100_000);
+        p.connections.direct_lighting = false;
+        runs.push((method, render(&scene, p, 8)));
     }
+    // And by direct lighting: light and BSDF samples of the sky at the visible points (as
+    // many per pixel as the path tracer's paths).
+    let mut p = params(Method::FreqSppm, 20_000);
+    p.film.samples_per_pixel = 32;
+    p.connections.direct_lighting = true;
+    runs.push((Method::FreqSppm, render(&scene, p, 8)));
     for (method, image) in runs {
         let got = channel_means(&image);
         for c in 0..3 {

@@ -48,6 +48,9 @@ fn shadow_edges_predict_smaller_kernels_than_smooth_light() {
     let mut p = params(Method::FreqPpm, 40_000);
     p.frequency.fraction = 1.0;
     p.kernel.initial_radius = Some(0.02);
+    // The frequency analysis of the photons straight from the light, which direct lighting
+    // would leave out.
+    p.connections.direct_lighting = false;
     let mut renderer = Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
     for _ in 0..4 {
         renderer.iterate();
@@ -98,6 +101,9 @@ fn smooth_direct_light_holds_most_kernels() {
     let scene = scene(SHADOW_EDGE);
     let mut p = params(Method::FreqPpm, 40_000);
     p.kernel.initial_radius = Some(0.02);
+    // The frequency analysis of the photons straight from the light, which direct lighting
+    // would leave out.
+    p.connections.direct_lighting = false;
     p.frequency.fraction = 0.5;
     let mut renderer = Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
     let mut held = 0.0;

@@ -35,6 +35,9 @@ fn grown_kernels_are_larger_than_the_start_where_the_light_is_smooth() {
     let scene = scene(PLANE);
     let mut p = params(Method::FreqPpm, 100_000);
     p.kernel.initial_radius = Some(0.03);
+    // Kernels sized by the photons straight from the light, which direct lighting would
+    // leave out.
+    p.connections.direct_lighting = false;
     p.frequency.grow = 4.0;
     p.frequency.pilot = 2;
     let mut renderer = Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();

@@ -36,6 +36,8 @@ fn merging_and_connections_sum_to_the_analytic_pixel_averages_at_any_radius() {
             let mut p = params(method, 100_000);
             p.kernel.initial_radius = Some(radius);
             p.connections.light_tracing = true;
+            // Photons straight from the light are what these tests connect and merge.
+            p.connections.direct_lighting = false;
             let image = render(&scene, p, 8);
             let (ratio, rel, n) = bright_region_errors(&image, &reference);
             println!("{method} radius {radius}: ratio {ratio:.4}, mean relative error {rel:.4}");
@@ -54,6 +56,76 @@ fn merging_and_connections_sum_to_the_analytic_pixel_averages_at_any_radius() {
 }
 
 #[test]
+fn connection_only_paths_and_any_connection_rule_keep_the_analytic_pixel_averages() {
+    // `extra_light_paths` adds light paths that are only connected, and `connect_below` moves
+    // where connections are made: both only move the MIS weights, so every combination must
+    // still sum to the analytic averages, at a kernel of about a pixel (both strategies share
+    // the weight) and of a few (merging takes most of it where it connects).
+    let scene = scene(PLANE);
+    let reference = plane_reference(&scene);
+    for (extra, connect_below) in [(1.0, 2.0), (3.0, f64::INFINITY), (0.5, 0.0)] {
+        for radius in [0.05, 0.15] {
+            let mut p = params(Method::FreqSppm, 100_000);
+            p.kernel.initial_radius = Some(radius);
+            p.connections.light_tracing = true;
+            // Photons straight from the light are what these tests connect and merge.
+            p.connections.direct_lighting = false;
+            p.connections.extra_light_paths = extra;
+            p.connections.connect_below = connect_below;
+            let image = render(&scene, p, 8);
+            let (ratio, rel, n) = bright_region_errors(&image, &reference);
+            println!(
+                "extra {extra}, connect below {connect_below}, radius {radius}: ratio {ratio:.4}, \
+                 mean relative error {rel:.4}"
+            );
+            assert!(n >= 40, "only {n} pixels in the bright region");
+            assert!(
+                (ratio - 1.0).abs() < 0.015,
+                "extra {extra}, connect below {connect_below}, radius {radius}: mean ratio {ratio}"
+            );
+            // Measured 0.012–0.025; 0.051 for merging alone (`connect_below` 0) with kernels
+            // below a pixel.
+            let bound = if connect_below == 0.0 { 0.08 } else { 0.04 };
+            assert!(
+                rel < bound,
+                "extra {extra}, connect below {connect_below}, radius {radius}: mean relative \
+                 error {rel} over {n} pixels"
+            );
+        }
+    }
+}
+
+#[test]
+fn connection_only_paths_lower_the_noise_where_kernels_are_below_a_pixel() {
+    // With kernels a tenth of a pixel the connections carry the image: three connection-only
+    // paths per photon give them four times the samples, so the error of the same passes
+    // falls by about half (1/√4).
+    let scene = scene(PLANE);
+    let reference = plane_reference(&scene);
+    let mut errors = Vec::new();
+    for extra in [0.0, 3.0] {
+        let mut p = params(Method::Sppm, 100_000);
+        p.kernel.initial_radius = Some(0.002);
+        p.connections.light_tracing = true;
+        // Photons straight from the light are what these tests connect and merge.
+        p.connections.direct_lighting = false;
+        p.connections.extra_light_paths = extra;
+        let image = render(&scene, p, 8);
+        errors.push(bright_region_errors(&image, &reference).1);
+        println!(
+            "extra {extra}: {:?}",
+            bright_region_errors(&image, &reference)
+        );
+    }
+    assert!(
+        errors[1] < 0.65 * errors[0],
+        "mean relative error with three connection-only paths per photon {} against {} without",
+        errors[1],
+        errors[0]
+    );
+}
+
+#[test]
 fn connections_lower_the_noise_where_kernels_are_below_a_pixel() {
     // With kernels a tenth of a pixel, merging alone sees few photons per pixel; the
     // connections see every photon in the pixel's footprint.
@@ -64,6 +136,7 @@ fn connections_lower_the_noise_where_kernels_are_below_a_pixel() {
         let mut p = params(Method::Sppm, 100_000);
         p.kernel.initial_radius = Some(0.002);
         p.connections.light_tracing = light_tracing;
+        p.connections.direct_lighting = false;
         let image = render(&scene, p, 8);
         errors.push(bright_region_errors(&image, &reference).1);
         println!(
@@ -87,6 +160,8 @@ fn furnace_keeps_its_radiance_with_light_tracing() {
         let mut p = params(method, 20_000);
         p.budget.max_depth = 64;
         p.connections.light_tracing = true;
+        // Photons straight from the light are what these tests connect and merge.
+        p.connections.direct_lighting = false;
         let m = mean(&render(&scene, p, 8));
         println!("furnace {method}: {m:.4}");
         assert!(
@@ -142,6 +217,8 @@ fn thin_lens_connections_render_the_path_tracer_s_defocus() {
     // Kernels far below a pixel: the image is the connections'.
     p.kernel.initial_radius = Some(0.001);
     p.connections.light_tracing = true;
+    // Photons straight from the light are what these tests connect and merge.
+    p.connections.direct_lighting = false;
     let image = render(&scene, p, 8);
     // The columns across the blurred edge, in the middle rows: the profile must match the
     // path tracer's, whose own noise at 256 paths per pixel is about 1 %.
