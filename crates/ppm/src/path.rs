@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use glam::Vec2;
 use rayon::prelude::*;
-use scene::{Bsdf, Hit, Rgb, Scene, TransportMode};
+use scene::{Bsdf, BsdfSample, Hit, Ray, Rgb, Scene, TransportMode};
 
 use crate::checkpoint::codec::{Reader, StateError, Writer};
 use crate::integrator::Integrator;
@@ -125,7 +125,8 @@ impl PathTracer {
             let u_light = sampler.next_f32();
             let u_light_2d = sampler.next_2d();
             if !bsdf.is_specular() {
-                radiance += beta * self.next_event(&hit, &bsdf, outgoing, u_light, u_light_2d);
+                radiance +=
+                    beta * next_event(&self.scene, &hit, &bsdf, outgoing, u_light, u_light_2d);
             }
             let u_lobe = sampler.next_f32();
             let u = sampler.next_2d();
@@ -149,11 +150,7 @@ impl PathTracer {
                 // The path escapes: it sees the environment, shared with light sampling as an
                 // emitter's emission is.
                 if lights.has_environment() {
-                    let weight = if sample.is_specular {
-                        1.0
-                    } else {
-                        power_heuristic(sample.pdf, lights.pdf_environment(ray.direction))
-                    };
+                    let weight = bsdf_emission_weight(&self.scene, &hit, &sample, None, &ray);
                     radiance += beta * lights.environment_radiance(ray.direction) * weight;
                 }
                 break;
@@ -162,11 +159,7 @@ impl PathTracer {
             if emitted != Rgb::ZERO {
                 // After a specular bounce emission counts in full (light sampling cannot find
                 // it); otherwise it shares the path with light sampling at `hit`.
-                let weight = if sample.is_specular {
-                    1.0
-                } else {
-                    power_heuristic(sample.pdf, lights.pdf_direct(hit.position, &next))
-                };
+                let weight = bsdf_emission_weight(&self.scene, &hit, &sample, Some(&next), &ray);
                 radiance += beta * emitted * weight;
             }
             hit = next;
@@ -175,38 +168,61 @@ impl PathTracer {
         }
         radiance
     }
+}
 
-    /// Light sampling at a non-specular vertex, MIS-weighted against BSDF sampling.
-    fn next_event(
-        &self,
-        hit: &Hit,
-        bsdf: &Bsdf,
-        outgoing: glam::Vec3,
-        u_light: f32,
-        u: Vec2,
-    ) -> Rgb {
-        let Some(sample) = self.scene.lights().sample_direct(hit.position, u_light, u) else {
-            return Rgb::ZERO;
-        };
-        if sample.pdf.is_nan() || sample.pdf <= 0.0 || !self.scene.light_visible(hit, &sample) {
-            return Rgb::ZERO;
-        }
-        let f = bsdf.eval(outgoing, sample.incoming);
-        if f == Rgb::ZERO {
-            return Rgb::ZERO;
-        }
-        let cos = sample.incoming.dot(hit.shading_normal).abs();
-        let weight = if sample.is_delta {
-            1.0
-        } else {
-            power_heuristic(sample.pdf, bsdf.pdf(outgoing, sample.incoming))
-        };
-        f * sample.radiance * (cos * weight / sample.pdf)
+/// Light sampling at a non-specular vertex `hit` seen along −`outgoing`, MIS-weighted against
+/// BSDF sampling by the power heuristic: the path tracer's next-event estimation, and the photon
+/// mappers' direct lighting.
+pub(crate) fn next_event(
+    scene: &Scene,
+    hit: &Hit,
+    bsdf: &Bsdf,
+    outgoing: glam::Vec3,
+    u_light: f32,
+    u: Vec2,
+) -> Rgb {
+    let Some(sample) = scene.lights().sample_direct(hit.position, u_light, u) else {
+        return Rgb::ZERO;
+    };
+    if sample.pdf.is_nan() || sample.pdf <= 0.0 || !scene.light_visible(hit, &sample) {
+        return Rgb::ZERO;
     }
+    let f = bsdf.eval(outgoing, sample.incoming);
+    if f == Rgb::ZERO {
+        return Rgb::ZERO;
+    }
+    let cos = sample.incoming.dot(hit.shading_normal).abs();
+    let weight = if sample.is_delta {
+        1.0
+    } else {
+        power_heuristic(sample.pdf, bsdf.pdf(outgoing, sample.incoming))
+    };
+    f * sample.radiance * (cos * weight / sample.pdf)
+}
+
+/// The MIS weight of emission that BSDF sample `sample` at `hit` found along `ray`: at the
+/// emitter it hit (`next`) or, escaping, in the environment. After a specular lobe it counts in
+/// full (light sampling cannot find it); otherwise it shares the light with [`next_event`].
+pub(crate) fn bsdf_emission_weight(
+    scene: &Scene,
+    hit: &Hit,
+    sample: &BsdfSample,
+    next: Option<&Hit>,
+    ray: &Ray,
+) -> f32 {
+    if sample.is_specular {
+        return 1.0;
+    }
+    let lights = scene.lights();
+    let light_pdf = match next {
+        Some(next) => lights.pdf_direct(hit.position, next),
+        None => lights.pdf_environment(ray.direction),
+    };
+    power_heuristic(sample.pdf, light_pdf)
 }
 
 /// Veach's power heuristic (β = 2) for the strategy with density `f` against one with `g`.
-pub(crate) fn power_heuristic(f: f32, g: f32) -> f32 {
+fn power_heuristic(f: f32, g: f32) -> f32 {
     let (f2, g2) = (f * f, g * g);
     if f2 + g2 > 0.0 { f2 / (f2 + g2) } else { 0.0 }
 }

@@ -9,7 +9,7 @@ use scene::{Bsdf, Hit, Rgb, TransportMode};
 
 use super::frequency::SlotFrequency;
 use super::{NO_VISIBLE_POINT, PhotonMapper, SLOT_CHUNK, Setup};
-use crate::path::power_heuristic;
+use crate::path::{bsdf_emission_weight, next_event};
 use crate::rng::{CAMERA_STREAM, Sampler};
 
 /// A camera path up to its first non-specular hit ([`PhotonMapper::camera_chain`]).
@@ -278,21 +278,8 @@ impl Setup {
         let u = sampler.next_2d();
         let u_lobe = sampler.next_f32();
         let u_bsdf = sampler.next_2d();
-        let lights = self.scene.lights();
-        let mut radiance = Rgb::ZERO;
-        if let Some(sample) = lights.sample_direct(hit.position, u_light, u)
-            && sample.pdf > 0.0
-            && self.scene.light_visible(hit, &sample)
-        {
-            let f = bsdf.eval(outgoing, sample.incoming);
-            let cos = sample.incoming.dot(hit.shading_normal).abs();
-            let weight = if sample.is_delta {
-                1.0
-            } else {
-                power_heuristic(sample.pdf, bsdf.pdf(outgoing, sample.incoming))
-            };
-            radiance += f * sample.radiance * (cos * weight / sample.pdf);
-        }
+        let scene = &*self.scene;
+        let mut radiance = next_event(scene, hit, bsdf, outgoing, u_light, u);
         let Some(sample) = bsdf.sample(outgoing, u_lobe, u_bsdf, TransportMode::Radiance) else {
             return radiance;
         };
@@ -300,28 +287,15 @@ impl Setup {
             return radiance;
         }
         let ray = hit.spawn_ray(sample.incoming);
-        match self.scene.intersect(&ray) {
-            Some(next) => {
-                let emitted = self.scene.emitted(&next);
-                if emitted != Rgb::ZERO {
-                    // A specular lobe cannot be found by light sampling: it counts in full.
-                    let weight = if sample.is_specular {
-                        1.0
-                    } else {
-                        power_heuristic(sample.pdf, lights.pdf_direct(hit.position, &next))
-                    };
-                    radiance += sample.weight * emitted * weight;
-                }
-            }
-            None if lights.has_environment() => {
-                let weight = if sample.is_specular {
-                    1.0
-                } else {
-                    power_heuristic(sample.pdf, lights.pdf_environment(ray.direction))
-                };
-                radiance += sample.weight * lights.environment_radiance(ray.direction) * weight;
-            }
-            None => {}
+        let next = scene.intersect(&ray);
+        let emitted = match &next {
+            Some(next) => scene.emitted(next),
+            None => scene.lights().environment_radiance(ray.direction),
+        };
+        if emitted != Rgb::ZERO {
+            radiance += sample.weight
+                * emitted
+                * bsdf_emission_weight(scene, hit, &sample, next.as_ref(), &ray);
         }
         radiance
     }

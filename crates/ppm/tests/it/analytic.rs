@@ -37,14 +37,22 @@ intensity = [3.14159265, 3.14159265, 3.14159265]
 fn furnace_sphere_gives_the_analytic_radiance_for_every_method() {
     let scene = scene(FURNACE);
     for method in PHOTON_METHODS {
-        let mut p = params(method, 20_000);
-        p.budget.max_depth = 64;
-        let image = render(&scene, p, 8);
-        let m = mean(&image);
-        assert!(
-            (m - 1.0).abs() < 0.02,
-            "{method}: mean radiance {m}, expected 1"
-        );
+        // With direct lighting the light straight from the point light comes from a light
+        // sample at the visible points (16 per pixel and pass), the rest from photons.
+        for direct_lighting in [false, true] {
+            let mut p = params(method, 20_000);
+            p.budget.max_depth = 64;
+            p.connections.direct_lighting = direct_lighting;
+            if direct_lighting {
+                p.film.samples_per_pixel = 16;
+            }
+            let image = render(&scene, p, 8);
+            let m = mean(&image);
+            assert!(
+                (m - 1.0).abs() < 0.02,
+                "{method} (direct lighting {direct_lighting}): mean radiance {m}, expected 1"
+            );
+        }
     }
     let mut p = params(Method::Path, 1);
     p.film.samples_per_pixel = 16;
@@ -113,6 +121,18 @@ fn max_depth_bounds_the_bounces_of_the_whole_light_path() {
                     "{method}, {view}, max_depth {k}: mean radiance {m}, expected {expected}"
                 );
             }
+            // Direct lighting: the walls' emission found by light and BSDF samples at the
+            // visible points counts as one more scattering event, photons from the second on.
+            let mut p = params(Method::FreqSppm, 20_000);
+            p.budget.max_depth = k;
+            p.connections.direct_lighting = true;
+            p.film.samples_per_pixel = 16;
+            let m = mean(&render(scene, p, 8));
+            assert!(
+                (m / expected - 1.0).abs() < 0.02,
+                "freq-sppm with direct lighting, {view}, max_depth {k}: mean radiance {m}, \
+                 expected {expected}"
+            );
             let mut p = params(Method::Path, 1);
             p.film.samples_per_pixel = 16;
             p.budget.max_depth = k;
