@@ -21,9 +21,7 @@ fn planes(
     let numpy = array.py().import("numpy")?;
     let converted = numpy
         .call_method1("ascontiguousarray", (array, "float32"))
-        .map_err(|e| {
-            PyTypeError::new_err(format!("{what} is not an array of numbers: {e}"))
-        })?;
+        .map_err(|e| PyTypeError::new_err(format!("{what} is not an array of numbers: {e}")))?;
     let array = converted.cast::<PyArrayDyn<f32>>()?;
     let shape = array.shape().to_vec();
     let ok = match shape.as_slice() {
@@ -51,10 +49,7 @@ fn image_of(value: &Bound<'_, PyAny>, what: &str) -> PyResult<film::Image> {
         return guarded(|| film::read_exr(&path).map_err(|e| film_error(&e)));
     }
     let (height, width, values) = planes(value, what, 3)?;
-    let pixels = values
-        .chunks_exact(3)
-        .map(|p| [p[0], p[1], p[2]])
-        .collect();
+    let pixels = values.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
     Ok(film::Image::new(width, height, pixels))
 }
 
@@ -80,10 +75,7 @@ pub(crate) fn write_exr(
     metadata: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<()> {
     let (height, width, values) = planes(image, "image", 3)?;
-    let pixels = values
-        .chunks_exact(3)
-        .map(|p| [p[0], p[1], p[2]])
-        .collect();
+    let pixels = values.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
     let mut frame = film::Frame::new(film::Image::new(width, height, pixels));
     if let Some(aovs) = aovs {
         for (key, value) in aovs.iter() {

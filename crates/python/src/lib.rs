@@ -14,7 +14,7 @@
 //! `film`. So an image made here is bit for bit the command's for the same scene, parameters and
 //! seed.
 //!
-//! Every call into the library runs under [`guarded`]: a panic (a bug) becomes
+//! Every call into the library runs under `guarded` (`errors.rs`): a panic (a bug) becomes
 //! `fppm.InternalError`, a `RuntimeError`, rather than PyO3's `PanicException`, which derives
 //! from `BaseException` and escapes `except Exception`. Errors of the input are `ValueError`,
 //! `OSError` (a file that cannot be read or written) or `fppm.SceneError`, each with the one-line

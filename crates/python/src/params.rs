@@ -38,9 +38,9 @@ pub(crate) fn render_params(
         .with_scene_defaults(&description.render)
         .map_err(|e| SceneError::new_err(format!("{source}: [render] {}", param_message(&e))))?;
     let params = apply(base, &values)?;
-    params.validate().map_err(|e| {
-        PyValueError::new_err(format!("{source}: [render] {}", param_message(&e)))
-    })?;
+    params
+        .validate()
+        .map_err(|e| PyValueError::new_err(format!("{source}: [render] {}", param_message(&e))))?;
     Ok(params)
 }
 

@@ -155,8 +155,7 @@ impl Renderer {
         let film = description.film;
         check_memory(film.width, film.height, &params, max_memory)?;
         Self::make(py, scene, threads, move |shared| {
-            ppm::Renderer::new(shared, params)
-                .map_err(|e| PyValueError::new_err(param_message(&e)))
+            ppm::Renderer::new(shared, params).map_err(|e| PyValueError::new_err(param_message(&e)))
         })
     }
 
@@ -234,8 +233,7 @@ impl Renderer {
         let start = Instant::now();
         let mut done = 0u32;
         loop {
-            if passes.is_some_and(|n| done >= n) || budget.is_some_and(|t| start.elapsed() >= t)
-            {
+            if passes.is_some_and(|n| done >= n) || budget.is_some_and(|t| start.elapsed() >= t) {
                 break;
             }
             self.pass(py)?;
@@ -405,11 +403,8 @@ impl Renderer {
             let seconds = state.seconds;
             let r = &state.renderer;
             let (width, height) = r.resolution();
-            let mut frame = film::Frame::new(film::Image::new(
-                width as usize,
-                height as usize,
-                r.image(),
-            ));
+            let mut frame =
+                film::Frame::new(film::Image::new(width as usize, height as usize, r.image()));
             frame.metadata = vec![
                 ("scene".to_owned(), source),
                 ("passes".to_owned(), r.passes().to_string()),

@@ -45,10 +45,7 @@ impl Scene {
             })?;
             if let Some(object) = value.as_object_mut() {
                 object.insert("emitters".to_owned(), summary.emitters().into());
-                object.insert(
-                    "environment".to_owned(),
-                    summary.environment.clone().into(),
-                );
+                object.insert("environment".to_owned(), summary.environment.clone().into());
             }
             crate::convert::to_python(py, &value)
         })

@@ -121,7 +121,7 @@ def test_render_needs_a_budget(scene):
         r.render()
     with pytest.raises(ValueError, match="time -1 is not a duration"):
         r.render(time=-1.0)
-    with pytest.raises(ValueError, match="time nan is not a duration"):
+    with pytest.raises(ValueError, match="time NaN is not a duration"):
         r.render(time=float("nan"))
 
 
