@@ -186,6 +186,7 @@ class Renderer:
         """Every render parameter of this render by name, as text."""
     def write_exr(self, path: StrPath, aovs: Sequence[str] = ()) -> None:
         """Writes the image as `fppm render -o` does (AOV channels, parameters as metadata)."""
+    def _internal_error_for_tests(self) -> None: ...
     @property
     def passes(self) -> int: ...
     @property

@@ -30,20 +30,20 @@ create_exception!(
 /// PyO3 would turn an uncaught panic into `pyo3_runtime.PanicException`, a `BaseException`
 /// that `except Exception` does not catch; this keeps every failure an ordinary exception.
 pub(crate) fn guarded<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
-    match catch_unwind(AssertUnwindSafe(f)) {
-        Ok(result) => result,
-        Err(payload) => {
-            let message = payload
-                .downcast_ref::<&str>()
-                .map(|s| (*s).to_owned())
-                .or_else(|| payload.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "a panic without a message".to_owned());
-            Err(InternalError::new_err(format!(
-                "internal error in fppm (a bug, please report it): {}",
-                one_line(&message)
-            )))
-        }
-    }
+    catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|payload| Err(panic_error(payload.as_ref())))
+}
+
+/// The [`InternalError`] of a caught panic, with its message.
+pub(crate) fn panic_error(payload: &(dyn std::any::Any + Send)) -> PyErr {
+    let message = payload
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_owned())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic without a message".to_owned());
+    InternalError::new_err(format!(
+        "internal error in fppm (a bug, please report it): {}",
+        one_line(&message)
+    ))
 }
 
 /// The error and its causes joined by `: `, skipping a cause whose text the message already

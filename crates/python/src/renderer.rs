@@ -1,5 +1,6 @@
 //! `fppm.Renderer`: a progressive render driven pass by pass from Python.
 
+use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -9,7 +10,7 @@ use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 
-use crate::errors::message;
+use crate::errors::{message, panic_error};
 use crate::params::{param_message, render_params};
 use crate::scene::Scene;
 use crate::{InternalError, guarded};
@@ -29,6 +30,14 @@ struct State {
     seconds: f64,
     /// NaN or infinite values dropped over those passes.
     non_finite: u64,
+    /// A call panicked: the state may be half updated.
+    broken: bool,
+}
+
+fn broken() -> PyErr {
+    InternalError::new_err(
+        "this renderer stopped in an internal error (a bug, please report it) and cannot be used any more",
+    )
 }
 
 /// A progressive render of a scene: run passes with `iterate` or `render`, read the current
@@ -63,20 +72,27 @@ pub(crate) struct Renderer {
 impl Renderer {
     /// Runs `f` on the state without the GIL, once the state is free (a render in another
     /// thread holds it during a pass), in this renderer's thread pool (or the global one).
+    ///
+    /// A panic in `f` (a bug) becomes [`InternalError`] and leaves the renderer broken: its
+    /// state may be half updated, so every later call raises [`InternalError`] too.
     fn with<R: Send>(&self, py: Python<'_>, f: impl FnOnce(&mut State) -> R + Send) -> PyResult<R> {
         py.detach(|| {
-            let mut state = self.state.lock().map_err(|_| {
-                InternalError::new_err(
-                    "this renderer stopped in an internal error and cannot be used any more",
-                )
-            })?;
-            let state = &mut *state;
-            guarded(|| {
-                Ok(match &self.pool {
-                    Some(pool) => pool.install(|| f(state)),
-                    None => f(state),
-                })
-            })
+            let mut guard = self.state.lock().map_err(|_| broken())?;
+            let state = &mut *guard;
+            if state.broken {
+                return Err(broken());
+            }
+            let run = || match &self.pool {
+                Some(pool) => pool.install(|| f(state)),
+                None => f(state),
+            };
+            match catch_unwind(AssertUnwindSafe(run)) {
+                Ok(result) => Ok(result),
+                Err(payload) => {
+                    guard.broken = true;
+                    Err(panic_error(payload.as_ref()))
+                }
+            }
         })
     }
 
@@ -123,6 +139,7 @@ impl Renderer {
                 last: None,
                 seconds: 0.0,
                 non_finite: 0,
+                broken: false,
             }),
             pool,
         })
@@ -433,6 +450,14 @@ impl Renderer {
             }
             film::write_exr(&path, &frame).map_err(|e| crate::errors::film_error(&e))
         })?
+    }
+
+    /// Panics inside a call on the renderer's state, to test that the renderer then refuses
+    /// every call with `fppm.InternalError`.
+    fn _internal_error_for_tests(&self, py: Python<'_>) -> PyResult<()> {
+        self.with(py, |_| {
+            panic!("a panic raised on purpose by the test suite")
+        })
     }
 
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {

@@ -69,3 +69,13 @@ def test_bad_film_sizes():
     with pytest.raises(OverflowError):
         fppm.default_scene(height=-1)
     assert REPO.exists()
+
+
+def test_a_renderer_that_panicked_refuses_every_later_call():
+    r = fppm.Renderer(fppm.default_scene(width=8, height=8), photons_per_pass="1k")
+    r.iterate()
+    with pytest.raises(fppm.InternalError, match="on purpose"):
+        r._internal_error_for_tests()
+    for call in (r.iterate, r.image, r.stats, r.save_state, lambda: r.passes):
+        with pytest.raises(fppm.InternalError, match="cannot be used any more"):
+            call()
