@@ -21,6 +21,7 @@ import matplotlib
 
 matplotlib.use("Agg")  # a file, no window
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 
 import fppm  # noqa: E402
 
@@ -88,6 +89,7 @@ def main() -> None:
     ax.set_ylabel("relMSE against the reference")
     name = pathlib.Path(args.scene).name if args.scene else "built-in default scene"
     ax.set_title(f"{name}, {scene.width}x{scene.height}, {args.photons_per_pass} photons/pass")
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()

@@ -3,7 +3,8 @@
 1. time per pass of `Renderer.iterate()` against the `fppm` command's on the built-in default
    scene (512 x 384, the default method and parameters), in paired runs: each pair runs the
    command (`fppm --passes N --json`, per-pass times from its `elapsed_seconds`) and then the
-   module for the same passes, alternating which goes first;
+   module for the same passes, alternating which goes first, and compares the median pass of
+   each;
 2. `Renderer.image()` of a 1920 x 1080 film (median of repeated calls).
 
     python crates/python/examples/overhead.py [--pairs 6] [--passes 16] [--fppm target/release/fppm]
@@ -20,10 +21,16 @@ import time
 import fppm
 
 REPO = pathlib.Path(__file__).resolve().parents[3]
+# The phases of a pass; the wall-clock time of a pass outside them is the driver's overhead.
+PHASES = ("camera", "index", "trace", "gather", "update")
+OUTSIDE: dict[str, list[float]] = {"command": [], "module": []}
+# Median time in the phases of a pass, per run.
+INSIDE: dict[str, list[float]] = {"command": [], "module": []}
 
 
 def cli_pass_seconds(binary: pathlib.Path, passes: int) -> float:
-    """Mean wall-clock seconds per pass of the command, from its --json pass lines."""
+    """Median wall-clock seconds of the command's passes, from its --json pass lines (the
+    median, so that a pass slowed by another process on the machine does not count)."""
     with tempfile.TemporaryDirectory() as out:
         done = subprocess.run(
             [str(binary), "--passes", str(passes), "--json", "--quiet", "-o", f"{out}/x.exr"],
@@ -32,16 +39,25 @@ def cli_pass_seconds(binary: pathlib.Path, passes: int) -> float:
     lines = [json.loads(l) for l in done.stdout.splitlines()]
     elapsed = [l["elapsed_seconds"] for l in lines if l.get("event") == "pass"]
     assert len(elapsed) == passes
-    return elapsed[-1] / passes
+    phases = [l["timings"] for l in lines if l.get("event") == "pass"]
+    walls = [b - a for a, b in zip([0.0, *elapsed], elapsed)]
+    OUTSIDE["command"].extend(w - sum(t[k] for k in PHASES) for w, t in zip(walls, phases))
+    INSIDE["command"].append(statistics.median(sum(t[k] for k in PHASES) for t in phases))
+    return statistics.median(walls)
 
 
 def python_pass_seconds(scene: fppm.Scene, passes: int) -> float:
-    """Mean wall-clock seconds per `iterate()` call, the call's own time included."""
+    """Median wall-clock seconds of an `iterate()` call, the call's own time included."""
     r = fppm.Renderer(scene)
-    start = time.perf_counter()
+    times, inside = [], []
     for _ in range(passes):
-        r.iterate()
-    return (time.perf_counter() - start) / passes
+        start = time.perf_counter()
+        stats = r.iterate()
+        times.append(time.perf_counter() - start)
+        inside.append(sum(stats["timings"][k] for k in PHASES))
+        OUTSIDE["module"].append(times[-1] - inside[-1])
+    INSIDE["module"].append(statistics.median(inside))
+    return statistics.median(times)
 
 
 def main() -> None:
@@ -67,6 +83,11 @@ def main() -> None:
         f"iterate(): median ratio module/command {statistics.median(ratios):.4f} "
         f"(min {min(ratios):.4f}, max {max(ratios):.4f}) over {args.pairs} pairs of {args.passes} passes"
     )
+
+    phase_ratios = [m / c for m, c in zip(INSIDE["module"], INSIDE["command"])]
+    print(f"time in the phases of a pass: median ratio module/command {statistics.median(phase_ratios):.4f}")
+    for who, values in OUTSIDE.items():
+        print(f"time of a pass outside its phases, {who}: median {statistics.median(values) * 1e3:.2f} ms")
 
     big = fppm.Renderer(fppm.default_scene(width=1920, height=1080), photons_per_pass="100k")
     big.iterate(2)
