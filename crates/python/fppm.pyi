@@ -15,7 +15,7 @@ import numpy.typing as npt
 __version__: str
 
 AOVS: list[str]
-"""Every AOV name: radius, count, freq.radius, freq.held, albedo, normal, depth."""
+"""Every AOV name: radius, count, freq.radius, freq.held, pool.width, albedo, normal, depth."""
 
 StrPath = str | os.PathLike[str]
 ParamValue = str | int | float | bool

@@ -393,6 +393,11 @@ pub(crate) enum AovArg {
     /// Frequency radius and share of hitpoints held by it (freq, freq-sppm): channels
     /// `freq.radius`, `freq.held`.
     Freq,
+    /// Standard deviation of the pooling Gaussian per pixel (photon mappers with `--pool`):
+    /// channel `pool.width`.
+    #[value(name = "pool.width")]
+    #[serde(rename = "pool.width")]
+    PoolWidth,
     /// Albedo of the first surface: `albedo.R`, `albedo.G`, `albedo.B`.
     Albedo,
     /// Shading normal of the first surface: `normal.X`, `normal.Y`, `normal.Z`.
@@ -408,6 +413,7 @@ impl AovArg {
             AovArg::Radius => &[ppm::Aov::Radius],
             AovArg::Count => &[ppm::Aov::PhotonCount],
             AovArg::Freq => &[ppm::Aov::FreqRadius, ppm::Aov::FreqHeld],
+            AovArg::PoolWidth => &[ppm::Aov::PoolWidth],
             AovArg::Albedo => &[ppm::Aov::Albedo],
             AovArg::Normal => &[ppm::Aov::Normal],
             AovArg::Depth => &[ppm::Aov::Depth],
@@ -420,6 +426,7 @@ impl AovArg {
             AovArg::Radius => "radius",
             AovArg::Count => "count",
             AovArg::Freq => "freq",
+            AovArg::PoolWidth => "pool.width",
             AovArg::Albedo => "albedo",
             AovArg::Normal => "normal",
             AovArg::Depth => "depth",

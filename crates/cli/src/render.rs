@@ -153,7 +153,7 @@ fn drive(job: &Job, mut renderer: Renderer) -> anyhow::Result<Outcome> {
     let elapsed = start.elapsed();
     let interrupted = INTERRUPTED.load(Ordering::SeqCst);
     progress.finish();
-    write_images(job, &renderer, elapsed)?;
+    let readout = write_images(job, &renderer, elapsed)?;
     if let Some(checkpoint) = &job.checkpoint {
         write_checkpoint(job, &renderer, checkpoint, elapsed)?;
     }
@@ -167,6 +167,7 @@ fn drive(job: &Job, mut renderer: Renderer) -> anyhow::Result<Outcome> {
             "non_finite": progress.non_finite,
             "seconds": elapsed.as_secs_f64(),
             "total_seconds": seconds,
+            "readout_seconds": readout,
             "exr": job.outputs.exr,
             "png": job.outputs.png,
             "checkpoint": job.checkpoint,
@@ -245,7 +246,9 @@ fn install_ctrlc_handler() {
 }
 
 /// The EXR (with AOVs and metadata) and the PNG.
-fn write_images(job: &Job, renderer: &Renderer, elapsed: Duration) -> anyhow::Result<()> {
+/// Writes the EXR (with its AOVs) and the PNG; returns the seconds the image read-out took (the
+/// photon mappers' pooling runs there).
+fn write_images(job: &Job, renderer: &Renderer, elapsed: Duration) -> anyhow::Result<f64> {
     let (width, height) = renderer.resolution();
     let params = renderer.params();
     let scene_name = job.scene_path.as_ref().map_or_else(
@@ -269,11 +272,10 @@ fn write_images(job: &Job, renderer: &Renderer, elapsed: Duration) -> anyhow::Re
         format!("{:.3}", job.earlier_seconds + elapsed.as_secs_f64()),
     ));
     metadata.push(("version".to_owned(), env!("CARGO_PKG_VERSION").to_owned()));
-    let mut frame = film::Frame::new(film::Image::new(
-        width as usize,
-        height as usize,
-        renderer.image(),
-    ));
+    let readout_clock = Instant::now();
+    let image = renderer.image();
+    let readout = readout_clock.elapsed().as_secs_f64();
+    let mut frame = film::Frame::new(film::Image::new(width as usize, height as usize, image));
     frame.metadata = metadata;
     for aov_flag in &job.outputs.aovs {
         for &aov in aov_flag.aovs() {
@@ -293,7 +295,7 @@ fn write_images(job: &Job, renderer: &Renderer, elapsed: Duration) -> anyhow::Re
         job.outputs.tonemap.film(),
         1,
     )?;
-    Ok(())
+    Ok(readout)
 }
 
 /// The renderer's state with a note that lets `fppm resume` find the scene and the outputs.

@@ -279,7 +279,7 @@ pub(crate) fn check_outputs(outputs: &Outputs, checkpoint: Option<&Path>) -> any
 pub(crate) fn check_aovs(aovs: &[AovArg], method: Method) -> anyhow::Result<()> {
     for &aov in aovs {
         let ok = match aov {
-            AovArg::Radius | AovArg::Count => method.is_photon_mapper(),
+            AovArg::Radius | AovArg::Count | AovArg::PoolWidth => method.is_photon_mapper(),
             AovArg::Freq => method.uses_frequency(),
             AovArg::Albedo | AovArg::Normal | AovArg::Depth => true,
         };

@@ -13,6 +13,9 @@ pub enum Aov {
     /// Share of the pixel's slots whose radius is held by the frequency floor (R ≤ r_freq);
     /// frequency methods only.
     FreqHeld,
+    /// Standard deviation of the Gaussian that pools the pixel's estimate with its neighbours'
+    /// in scene units (mean over the slots; 0 where nothing is pooled); photon mappers only.
+    PoolWidth,
     /// Albedo (reflectance) of the first surface seen through the pixel centre (RGB).
     Albedo,
     /// Shading normal of the first surface seen through the pixel centre, facing the camera
@@ -24,11 +27,12 @@ pub enum Aov {
 
 impl Aov {
     /// Every AOV.
-    pub const ALL: [Aov; 7] = [
+    pub const ALL: [Aov; 8] = [
         Aov::Radius,
         Aov::PhotonCount,
         Aov::FreqRadius,
         Aov::FreqHeld,
+        Aov::PoolWidth,
         Aov::Albedo,
         Aov::Normal,
         Aov::Depth,
@@ -42,6 +46,7 @@ impl Aov {
             Aov::PhotonCount => &["count"],
             Aov::FreqRadius => &["freq.radius"],
             Aov::FreqHeld => &["freq.held"],
+            Aov::PoolWidth => &["pool.width"],
             Aov::Albedo => &["albedo.R", "albedo.G", "albedo.B"],
             Aov::Normal => &["normal.X", "normal.Y", "normal.Z"],
             Aov::Depth => &["depth"],

@@ -148,7 +148,7 @@ impl Renderer {
     pub fn aov(&self, aov: Aov) -> Option<Vec<f32>> {
         match aov {
             Aov::Albedo | Aov::Normal | Aov::Depth => Some(self.first_hit_aov(aov)),
-            Aov::Radius | Aov::PhotonCount | Aov::FreqRadius | Aov::FreqHeld => {
+            Aov::Radius | Aov::PhotonCount | Aov::FreqRadius | Aov::FreqHeld | Aov::PoolWidth => {
                 self.integrator.aov(aov)
             }
         }

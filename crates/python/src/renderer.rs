@@ -272,7 +272,7 @@ impl Renderer {
     }
 
     /// An auxiliary image by name (`fppm.AOVS`): `radius`, `count`, `freq.radius`,
-    /// `freq.held`, `albedo`, `normal`, `depth`. One-channel images are height × width, the
+    /// `freq.held`, `pool.width`, `albedo`, `normal`, `depth`. One-channel images are height × width, the
     /// others height × width × 3, float32.
     ///
     /// Raises:

@@ -183,7 +183,7 @@ def test_thread_count_does_not_change_the_image(scene):
 def test_every_aov_of_a_frequency_method(scene, tmp_path):
     r = fppm.Renderer(scene, "freq-sppm", photons_per_pass="10k")
     r.iterate(2)
-    assert fppm.AOVS == ["radius", "count", "freq.radius", "freq.held", "albedo", "normal", "depth"]
+    assert fppm.AOVS == ["radius", "count", "freq.radius", "freq.held", "pool.width", "albedo", "normal", "depth"]
     for name in fppm.AOVS:
         a = r.aov(name)
         assert a.dtype == np.float32

@@ -123,6 +123,8 @@ pub struct RenderParams {
     pub connections: Connections,
     /// The frequency analysis of the frequency-guided methods.
     pub frequency: FrequencyParams,
+    /// The image-space reconstruction of the photon mappers' estimate.
+    pub pool: Pooling,
 }
 
 /// What a pass spends.
@@ -233,6 +235,49 @@ pub struct FrequencyParams {
     /// well inside the probed disc (`PhotonMapper::probe_clear_radii`); otherwise every
     /// candidate probes its own.
     pub probe_share: bool,
+}
+
+/// How a photon mapper's image pools the estimates of neighbouring pixels whose visible points
+/// lie on the same surface (`photon_mapper::pool`), when the image is read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PoolMode {
+    /// Every pixel reads its own slots only.
+    Off,
+    /// The pooling width follows the frequency prediction of the light; methods without
+    /// frequency photons do not pool.
+    Frequency,
+    /// The pooling width is the window's alone, whatever the light: a cross-bilateral filter on
+    /// position, normal, material and texture, the control for `Frequency`.
+    Geometry,
+}
+
+impl PoolMode {
+    /// The name in parameters and metadata.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            PoolMode::Off => "off",
+            PoolMode::Frequency => "freq",
+            PoolMode::Geometry => "geometry",
+        }
+    }
+}
+
+/// The image-space reconstruction of the photon mappers (`photon_mapper::pool`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pooling {
+    /// Which width pools neighbouring pixels.
+    pub mode: PoolMode,
+    /// The blur budget as a multiple of the frequency radius r_freq, in (0, 64]: a pixel pools
+    /// with a Gaussian of standard deviation √((scale·r_freq)² − R²)/2, so that its gather disc
+    /// and the pooling together blur no more than a disc of radius scale·r_freq.
+    pub scale: f64,
+    /// The pooling window's radius in pixels, in [0, 32]; the Gaussian's standard deviation is
+    /// at most half of it (in world units, measured from the neighbours' visible points).
+    pub max_pixels: u32,
+    /// How the width shrinks with the photons counted n: by (n₀/n)^decay once n > n₀ = 10⁷,
+    /// in [0, 1], so that the image converges to the unpooled estimator's limit.
+    pub decay: f64,
 }
 
 /// A parameter outside its domain.
@@ -360,6 +405,12 @@ impl RenderParams {
                 clear_cap: true,
                 probe_share: true,
             },
+            pool: Pooling {
+                mode: PoolMode::Frequency,
+                scale: 0.5,
+                max_pixels: 4,
+                decay: 1.0 / 6.0,
+            },
         }
     }
 
@@ -411,6 +462,15 @@ impl RenderParams {
         }
         if !(self.frequency.hold_alpha > 0.0 && self.frequency.hold_alpha <= 1.0) {
             return Err(out("freq_hold_alpha", self.frequency.hold_alpha, "(0, 1]"));
+        }
+        if !(self.pool.scale > 0.0 && self.pool.scale <= 64.0) {
+            return Err(out("pool_scale", self.pool.scale, "(0, 64]"));
+        }
+        if self.pool.max_pixels > 32 {
+            return Err(out("pool_max", self.pool.max_pixels, "[0, 32]"));
+        }
+        if !(0.0..=1.0).contains(&self.pool.decay) {
+            return Err(out("pool_decay", self.pool.decay, "[0, 1]"));
         }
         if self.connections.connect_below.is_nan() || self.connections.connect_below < 0.0 {
             return Err(out(

@@ -7,7 +7,7 @@
 
 use spectrum::{K_POSTER, K_STRICT, MergePolicy};
 
-use super::{Method, ParamError, RenderParams};
+use super::{Method, ParamError, PoolMode, RenderParams};
 use crate::update::FrequencyFloor;
 
 /// One render parameter.
@@ -426,6 +426,77 @@ pub const PARAMS: &[Param] = &[
         get: |p| on_off(p.connections.direct_lighting),
         set: |p, v| {
             p.connections.direct_lighting = parse_switch(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "pool",
+        flag: "pool",
+        help: "Photon mappers: pool the estimates of neighbouring pixels on the same surface when the image is read [default: freq]",
+        kind: ParamKind::Value {
+            value_name: "MODE",
+            choices: &[
+                ("off", "Every pixel reads its own estimate"),
+                (
+                    "freq",
+                    "Pool as far as the frequency prediction of the light allows (frequency methods; others do not pool)",
+                ),
+                (
+                    "geometry",
+                    "Pool over the whole window on the same surface, whatever the light (the control for freq)",
+                ),
+            ],
+        },
+        get: |p| p.pool.mode.name().to_owned(),
+        set: |p, v| {
+            p.pool.mode = match v {
+                "off" => PoolMode::Off,
+                "freq" => PoolMode::Frequency,
+                "geometry" => PoolMode::Geometry,
+                _ => return Err("is not one of off, freq, geometry".to_owned()),
+            };
+            Ok(())
+        },
+    },
+    Param {
+        name: "pool_scale",
+        flag: "pool-scale",
+        help: "Pooling: the blur budget of pixel and pooling together, as a multiple of the frequency radius, in (0, 64] [default: 0.5]",
+        kind: ParamKind::Value {
+            value_name: "S",
+            choices: &[],
+        },
+        get: |p| p.pool.scale.to_string(),
+        set: |p, v| {
+            p.pool.scale = parse_number(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "pool_max",
+        flag: "pool-max",
+        help: "Pooling: the window's radius in pixels, in [0, 32] [default: 4]",
+        kind: ParamKind::Value {
+            value_name: "PIXELS",
+            choices: &[],
+        },
+        get: |p| p.pool.max_pixels.to_string(),
+        set: |p, v| {
+            p.pool.max_pixels = parse_small(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "pool_decay",
+        flag: "pool-decay",
+        help: "Pooling: the width shrinks as (n0/n)^decay beyond n0 = 1e7 photons, so that the image converges, in [0, 1] [default: 1/6]",
+        kind: ParamKind::Value {
+            value_name: "D",
+            choices: &[],
+        },
+        get: |p| p.pool.decay.to_string(),
+        set: |p, v| {
+            p.pool.decay = parse_number(v)?;
             Ok(())
         },
     },

@@ -19,6 +19,7 @@ mod frequency;
 mod index;
 mod memory;
 mod photon_pass;
+mod pool;
 mod state;
 #[cfg(test)]
 mod tests;
@@ -42,7 +43,6 @@ use crate::checkpoint::codec::{Reader, StateError, Writer};
 use crate::integrator::Integrator;
 use crate::params::{ParamError, RenderParams};
 use crate::stats::{MemoryUse, PassStats};
-use crate::update::GatherStats;
 
 /// Photons per parallel work item. Fixed (not derived from the thread count) so that the
 /// reduction order, hence the image, does not depend on the number of threads.
@@ -270,13 +270,16 @@ impl PhotonMapper {
     }
 
     /// A per-slot quantity averaged over each pixel's valid slots: radius, photon count,
-    /// frequency radius or whether the radius is held (`Aov::Radius`, `PhotonCount`,
-    /// `FreqRadius`, `FreqHeld`); `None` for the frequency AOVs of a classical method.
+    /// frequency radius, whether the radius is held or the pooling width (`Aov::Radius`,
+    /// `PhotonCount`, `FreqRadius`, `FreqHeld`, `PoolWidth`); `None` for the frequency AOVs of
+    /// a classical method.
     pub(crate) fn slot_aov(&self, aov: Aov) -> Option<Vec<f32>> {
         let params = &self.setup.params;
         if matches!(aov, Aov::FreqRadius | Aov::FreqHeld) && !params.method.uses_frequency() {
             return None;
         }
+        let pool_width =
+            (aov == Aov::PoolWidth && !self.slots.is_empty()).then(|| self.pooled().width);
         let spp = params.film.samples_per_pixel as usize;
         let n_pixels = self.setup.width as usize * self.setup.height as usize;
         let slots = &self.slots;
@@ -297,6 +300,7 @@ impl PhotonMapper {
                         Aov::Radius => Some(slots.radius()[slot]),
                         Aov::PhotonCount => Some(slots.photon_count()[slot]),
                         Aov::FreqRadius => freq.frequency_radius(k),
+                        Aov::PoolWidth => pool_width.as_ref().map(|w| f64::from(w[slot])),
                         _ => Some(
                             freq.hold_radius(k, self.setup.kernel_max())
                                 .map_or(0.0, |r| f64::from(u8::from(slots.radius()[slot] <= r))),
@@ -355,22 +359,14 @@ impl Integrator for PhotonMapper {
         if self.slots.is_empty() {
             return image;
         }
-        let radius = self.slots.radius();
-        let count = self.slots.photon_count();
-        let flux = self.slots.flux();
-        let n_emitted = self.photons_counted() as f64;
+        let photons = self.pooled().radiance;
         let camera_passes = f64::from(self.camera_passes.max(1));
         image.par_iter_mut().enumerate().for_each(|(pixel, out)| {
             let mut sum = [0.0f64; 3];
-            for slot in pixel * spp..(pixel + 1) * spp {
-                let stats = GatherStats {
-                    radius: radius[slot],
-                    photon_count: count[slot],
-                    flux: flux[slot],
-                };
-                let photons = stats.radiance(n_emitted).unwrap_or([0.0; 3]);
+            let slots = pixel * spp..(pixel + 1) * spp;
+            for (photons, direct) in photons[slots.clone()].iter().zip(&self.direct[slots]) {
                 for c in 0..3 {
-                    sum[c] += photons[c] + self.direct[slot][c] / camera_passes;
+                    sum[c] += photons[c] + direct[c] / camera_passes;
                 }
             }
             *out = sum.map(|v| v as f32);

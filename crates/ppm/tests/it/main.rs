@@ -19,5 +19,6 @@ mod light_tracer;
 mod light_tracing;
 mod memory;
 mod non_finite;
+mod pooling;
 mod statistics;
 mod support;
