@@ -129,9 +129,11 @@ fn spectrum_depends_on_nothing_but_std() {
 }
 
 /// The third-party libraries only one workspace crate may name: the BVH builder belongs to the
-/// scene runtime, the file-format parsers and image decoders to the importers.
+/// scene runtime, the file-format parsers and image decoders to the importers, the HTTP server
+/// of the live preview to the command.
 const OWNED_LIBRARIES: &[(&str, &[&str])] = &[
     ("scene", &["obvhs"]),
+    ("cli", &["tiny_http"]),
     (
         "import",
         &[

@@ -262,7 +262,11 @@ struct Watch {
 impl Watch {
     fn new(job: &Job, renderer: &Renderer, live: Live) -> Self {
         let (width, height) = renderer.resolution();
+        let started = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap_or_default();
         let status = Status {
+            run: format!("{}-{}", std::process::id(), started.as_millis()),
             scene: job.scene_path.as_ref().map_or_else(
                 || DEFAULT_SCENE_NAME.to_string(),
                 |p| p.display().to_string(),

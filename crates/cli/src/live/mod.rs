@@ -20,6 +20,9 @@ use crate::usage;
 /// What the live views show besides the image, after each pass.
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub(crate) struct Status {
+    /// Which render this is (process id and start time): a page left open across renders on
+    /// one address starts afresh when it changes.
+    pub(crate) run: String,
     /// The scene file (or the built-in scene's name).
     pub(crate) scene: String,
     pub(crate) method: String,

@@ -191,6 +191,15 @@ impl Stream {
     }
 }
 
+impl Drop for Stream {
+    /// A render that ends in an error ends the thread too, without a last frame.
+    fn drop(&mut self) {
+        let (lock, wake) = &*self.mailbox;
+        lock.lock().unwrap_or_else(PoisonError::into_inner).finished = true;
+        wake.notify_one();
+    }
+}
+
 /// The thread: sends each frame it is handed until told there are no more.
 fn run(mut connection: Connection, mailbox: &(Mutex<Mailbox>, Condvar)) {
     let (lock, wake) = mailbox;
@@ -246,8 +255,24 @@ impl Connection {
             }
         }
         if let Err(e) = self.send_tiles(frame) {
+            // Once more at once on a new connection (tev may have been restarted), then with
+            // the next image.
             self.stream = None;
-            return self.failed(&format!("lost the connection ({e})"));
+            let again = self.connect(frame).and_then(|stream| {
+                self.stream = Some(stream);
+                self.send_tiles(frame)
+            });
+            if again.is_err() {
+                self.stream = None;
+                return self.failed(&format!("lost the connection ({e})"));
+            }
+            if !self.quiet {
+                note = Some(format!(
+                    "fppm: warning: display server {}: lost the connection ({}); connected again",
+                    self.text,
+                    film::lower_first(&e.to_string())
+                ));
+            }
         }
         note
     }
