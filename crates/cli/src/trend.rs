@@ -95,7 +95,7 @@ mod tests {
     }
 
     /// The trend of a mean of passes with independent noise is the relative noise of the mean:
-    /// a uniform noise in [-1, 1) around 1 has σ = 1/√3, so σ/√n relative to a level of about 1.
+    /// a uniform noise in [-1, 1) around 1 has σ = 1/√3.
     #[test]
     fn the_trend_of_independent_passes_is_the_noise_of_their_mean() {
         let pixels = 64 * 64;
@@ -117,7 +117,9 @@ mod tests {
         assert_eq!(seen[0].1, None, "no snapshot from half as many passes yet");
         for &(n, value) in &seen[1..] {
             let value = value.expect("a trend from pass 2 on");
-            let expected = (1.0 / 3.0f64).sqrt() / f64::from(n).sqrt();
+            // σ/√n, relative to the RMS of the mean, √(1 + σ²/n).
+            let noise = (1.0 / 3.0 / f64::from(n)).sqrt();
+            let expected = noise / (1.0 + noise * noise).sqrt();
             assert!(
                 (value / expected - 1.0).abs() < 0.05,
                 "pass {n}: {value} against {expected}"
