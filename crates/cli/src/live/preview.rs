@@ -259,13 +259,16 @@ fn serve(server: &tiny_http::Server, shared: &Shared) {
     }
 }
 
-/// A 200 response with `body` of `content_type`, never cached.
+/// A 200 response with `body` of `content_type`.
 fn reply(body: Vec<u8>, content_type: &str) -> tiny_http::Response<std::io::Cursor<Vec<u8>>> {
+    // An image's address names its number, exposure and curve: it may be kept.
+    let cache = if content_type == "image/png" {
+        "private, max-age=600"
+    } else {
+        "no-store"
+    };
     let mut response = tiny_http::Response::from_data(body);
-    for (name, value) in [
-        ("Content-Type", content_type),
-        ("Cache-Control", "no-store"),
-    ] {
+    for (name, value) in [("Content-Type", content_type), ("Cache-Control", cache)] {
         if let Ok(header) = tiny_http::Header::from_bytes(name.as_bytes(), value.as_bytes()) {
             response.add_header(header);
         }
