@@ -15,6 +15,7 @@ const EDGES: &[(&str, &[&str])] = &[
     ("film", &[]),
     ("cli", &["scene", "import", "ppm", "film"]),
     ("xtask", &["scene", "import", "ppm", "film"]),
+    ("python", &["scene", "import", "ppm", "film"]),
 ];
 
 /// The direction of ARCHITECTURE.md: the crates each crate may depend on.
@@ -31,6 +32,10 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ),
     (
         "xtask",
+        &["spectrum", "scene", "import", "photon", "ppm", "film"],
+    ),
+    (
+        "python",
         &["spectrum", "scene", "import", "photon", "ppm", "film"],
     ),
 ];
@@ -129,8 +134,8 @@ fn spectrum_depends_on_nothing_but_std() {
 }
 
 /// The third-party libraries only one workspace crate may name: the BVH builder belongs to the
-/// scene runtime, the file-format parsers and image decoders to the importers, the HTTP server
-/// of the live preview to the command.
+/// scene runtime, the file-format parsers and image decoders to the importers, the Python
+/// bindings to the Python module, the HTTP server of the live preview to the command.
 const OWNED_LIBRARIES: &[(&str, &[&str])] = &[
     ("scene", &["obvhs"]),
     ("cli", &["tiny_http"]),
@@ -146,6 +151,7 @@ const OWNED_LIBRARIES: &[(&str, &[&str])] = &[
             "flate2",
         ],
     ),
+    ("python", &["pyo3", "numpy"]),
 ];
 
 #[test]
