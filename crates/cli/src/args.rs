@@ -182,6 +182,8 @@ pub(crate) struct RenderArgs {
     pub(crate) checkpoint: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) run: RunArgs,
+    #[command(flatten)]
+    pub(crate) live: LiveArgs,
 }
 
 /// The film and the light around it: what `render` and `plan` share.
@@ -349,6 +351,24 @@ pub(crate) struct ResumeArgs {
     pub(crate) aov: Vec<AovArg>,
     #[command(flatten)]
     pub(crate) run: RunArgs,
+    #[command(flatten)]
+    pub(crate) live: LiveArgs,
+}
+
+/// Watching a render while it runs: the preview page and the tev stream (`live/`). Options of
+/// the command, not render parameters: they never change the image.
+#[derive(Debug, Args)]
+#[command(next_help_heading = "Live view")]
+pub(crate) struct LiveArgs {
+    /// Serve a page that shows the image as it renders, with pass count, time left, the error
+    /// trend and a stop button, at http://HOST:PORT/ [default: 127.0.0.1:8700, or a free port
+    /// if that one is taken; the address is printed on stderr].
+    #[arg(long, value_name = "HOST:PORT", num_args = 0..=1, default_missing_value = "")]
+    pub(crate) preview: Option<String>,
+    /// Stream the image (R, G, B and the --aov channels) to the tev viewer listening at
+    /// HOST:PORT, as pbrt-v4's --display-server does (tev's default is 127.0.0.1:14158).
+    #[arg(long, value_name = "HOST:PORT")]
+    pub(crate) display_server: Option<String>,
 }
 
 /// `fppm diff`.

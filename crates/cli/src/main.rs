@@ -16,10 +16,13 @@
 mod args;
 mod diff;
 mod duration;
+mod live;
 mod memory;
 mod output;
+mod progress;
 mod render;
 mod settings;
+mod trend;
 mod units;
 
 use std::io::Write;

@@ -1,18 +1,20 @@
 //! The render loop: passes until the budget is spent or Ctrl-C, with progress, snapshots,
 //! checkpoints, and the outputs at the end.
 
-use std::io::IsTerminal;
 use std::path::Path;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
-use indicatif::{ProgressBar, ProgressStyle};
-use ppm::{PassStats, Renderer, StateHeader};
+use ppm::{Renderer, StateHeader};
 
-use crate::args::{RenderArgs, ResumeArgs};
+use crate::args::{LiveArgs, RenderArgs, ResumeArgs};
 use crate::duration;
+use crate::live::{Live, Status};
+use crate::progress::{Progress, human_count};
 use crate::settings::{self, Budget, Job};
+use crate::trend::Trend;
 use crate::{DEFAULT_SCENE_NAME, Outcome, usage};
 
 /// Set by the Ctrl-C handler; the loop stops after the current pass.
@@ -22,11 +24,12 @@ static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 pub(crate) fn render(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Result<Outcome> {
     let job = settings::render_job(scene, args)?;
     check_memory(&job)?;
+    let live = start_live(&args.live, &job)?;
     let scene = std::sync::Arc::new(scene::Scene::new(job.description.clone())?);
     in_pool(job.run.threads, || {
         let renderer = Renderer::new(std::sync::Arc::clone(&scene), job.params)
             .map_err(|e| anyhow::anyhow!("{}: {e}", job.description.source.display()))?;
-        drive(&job, renderer)
+        drive(&job, renderer, live)
     })
 }
 
@@ -69,6 +72,7 @@ pub(crate) fn resume(args: &ResumeArgs) -> anyhow::Result<Outcome> {
         earlier_seconds: note.render_seconds,
     };
     check_memory(&job)?;
+    let live = start_live(&args.live, &job)?;
     let scene = std::sync::Arc::new(scene::Scene::new(job.description.clone())?);
     in_pool(job.run.threads, || {
         let renderer = Renderer::restore(std::sync::Arc::clone(&scene), &bytes)
@@ -82,8 +86,26 @@ pub(crate) fn resume(args: &ResumeArgs) -> anyhow::Result<Outcome> {
                 path.display()
             );
         }
-        drive(&job, renderer)
+        drive(&job, renderer, live)
     })
+}
+
+/// Opens the live views the flags ask for, once the job is known to be sound and before the
+/// scene is built, so that a taken port fails at once.
+fn start_live(args: &LiveArgs, job: &Job) -> anyhow::Result<Live> {
+    let title = job
+        .outputs
+        .exr
+        .file_name()
+        .map_or_else(|| "fppm".to_owned(), |n| n.to_string_lossy().into_owned());
+    let live = Live::start(args, &title, job.run.quiet)?;
+    if let Some(url) = live.url()
+        && job.run.json
+    {
+        let line = serde_json::json!({ "event": "preview", "url": url });
+        crate::print_stdout(&format!("{line}\n"))?;
+    }
+    Ok(live)
 }
 
 /// Refuses a job whose estimated memory exceeds `--max-memory` (or its default).
@@ -112,16 +134,17 @@ pub(crate) fn in_pool<R: Send>(
     }
 }
 
-/// Passes until the budget is spent or Ctrl-C, then the outputs.
-fn drive(job: &Job, mut renderer: Renderer) -> anyhow::Result<Outcome> {
+/// Passes until the budget is spent, Ctrl-C or the preview's stop button, then the outputs.
+fn drive(job: &Job, mut renderer: Renderer, live: Live) -> anyhow::Result<Outcome> {
     install_ctrlc_handler();
     let start = Instant::now();
     let first_pass = renderer.passes();
     let mut progress = Progress::new(job, first_pass);
+    let mut watch = Watch::new(job, &renderer, live);
     let mut last_write = Instant::now();
     let mut checkpoints = CheckpointPace::default();
     loop {
-        if INTERRUPTED.load(Ordering::SeqCst) {
+        if INTERRUPTED.load(Ordering::SeqCst) || watch.live.stop_requested() {
             break;
         }
         if job.budget.passes.is_some_and(|n| renderer.passes() >= n)
@@ -131,7 +154,11 @@ fn drive(job: &Job, mut renderer: Renderer) -> anyhow::Result<Outcome> {
         }
         let stats = renderer.iterate();
         let elapsed = start.elapsed();
-        progress.pass(&renderer, &stats, elapsed);
+        let error_trend = watch.after_pass(job, &renderer, &progress, elapsed);
+        progress.pass(&renderer, &stats, elapsed, error_trend);
+        for note in watch.live.notes() {
+            progress.note(&note);
+        }
         if let Some(checkpoint) = &job.checkpoint
             && checkpoints.due()
         {
@@ -142,7 +169,7 @@ fn drive(job: &Job, mut renderer: Renderer) -> anyhow::Result<Outcome> {
         if let Some(every) = job.run.snapshot_every
             && last_write.elapsed() >= every
         {
-            write_images(job, &renderer, elapsed)?;
+            write_images(job, &exr_frame(job, &renderer, elapsed).0)?;
             progress.note(&format!(
                 "snapshot written to {}",
                 job.outputs.exr.display()
@@ -151,11 +178,18 @@ fn drive(job: &Job, mut renderer: Renderer) -> anyhow::Result<Outcome> {
         }
     }
     let elapsed = start.elapsed();
-    let interrupted = INTERRUPTED.load(Ordering::SeqCst);
+    let stopped_from_page = watch.live.stop_requested();
+    let interrupted = INTERRUPTED.load(Ordering::SeqCst) || stopped_from_page;
     progress.finish();
-    let readout = write_images(job, &renderer, elapsed)?;
+    watch.state(&renderer, "writing", elapsed);
+    let (frame, readout) = exr_frame(job, &renderer, elapsed);
+    let frame = Arc::new(frame);
+    write_images(job, &frame)?;
     if let Some(checkpoint) = &job.checkpoint {
         write_checkpoint(job, &renderer, checkpoint, elapsed)?;
+    }
+    for note in watch.finish(&renderer, &frame, elapsed) {
+        progress.note(&note);
     }
     let seconds = job.earlier_seconds + elapsed.as_secs_f64();
     if job.run.json {
@@ -165,6 +199,7 @@ fn drive(job: &Job, mut renderer: Renderer) -> anyhow::Result<Outcome> {
             "passes": renderer.passes(),
             "photons_emitted": renderer.photons_emitted(),
             "non_finite": progress.non_finite,
+            "error_trend": progress.trend(),
             "seconds": elapsed.as_secs_f64(),
             "total_seconds": seconds,
             "readout_seconds": readout,
@@ -176,7 +211,12 @@ fn drive(job: &Job, mut renderer: Renderer) -> anyhow::Result<Outcome> {
     }
     if !job.run.quiet {
         let (width, height) = renderer.resolution();
-        if interrupted {
+        if stopped_from_page {
+            eprintln!(
+                "fppm: stopped from the preview page after pass {}",
+                renderer.passes()
+            );
+        } else if interrupted {
             eprintln!("fppm: interrupted after pass {}", renderer.passes());
         }
         if progress.non_finite > 0 {
@@ -206,6 +246,134 @@ fn drive(job: &Job, mut renderer: Renderer) -> anyhow::Result<Outcome> {
     } else {
         Outcome::Done
     })
+}
+
+/// What watches the render besides the progress line: the error trend and the live views.
+/// The image is read from the renderer at most once a pass, and only when one of them needs
+/// it: a snapshot of the trend is due, the trend is older than [`Live::PERIOD`] (every pass
+/// with --json), or a live view wants an image.
+struct Watch {
+    live: Live,
+    trend: Trend,
+    /// Whether anything shows the trend.
+    trend_shown: bool,
+    last_trend: Option<Instant>,
+    status: Status,
+}
+
+impl Watch {
+    fn new(job: &Job, renderer: &Renderer, live: Live) -> Self {
+        let (width, height) = renderer.resolution();
+        let started = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap_or_default();
+        let status = Status {
+            run: format!("{}-{}", std::process::id(), started.as_millis()),
+            scene: job.scene_path.as_ref().map_or_else(
+                || DEFAULT_SCENE_NAME.to_string(),
+                |p| p.display().to_string(),
+            ),
+            method: renderer.params().method.to_string(),
+            width,
+            height,
+            pass: renderer.passes(),
+            passes: job.budget.passes,
+            time_budget: job.budget.time.map(|t| t.as_secs_f64()),
+            photons: renderer.photons_emitted(),
+            state: "rendering",
+            exposure: job.outputs.tonemap.exposure,
+            tonemap: match job.outputs.tonemap.curve {
+                crate::args::TonemapArg::Srgb => "srgb",
+                crate::args::TonemapArg::Filmic => "filmic",
+            },
+            ..Status::default()
+        };
+        let trend_shown = !job.run.quiet || job.run.json || live.is_on();
+        let mut watch = Watch {
+            live,
+            trend: Trend::default(),
+            trend_shown,
+            last_trend: None,
+            status,
+        };
+        watch.state(renderer, "rendering", Duration::ZERO);
+        watch
+    }
+
+    /// After a pass: the trend if it was measured, and what the live views are due.
+    fn after_pass(
+        &mut self,
+        job: &Job,
+        renderer: &Renderer,
+        progress: &Progress,
+        elapsed: Duration,
+    ) -> Option<f64> {
+        let passes = renderer.passes();
+        let live_image = self.live.wants_image();
+        let trend_due = self.trend_shown
+            && (self.trend.wants(passes)
+                || progress.trend_every_pass()
+                || self.last_trend.is_none_or(|t| t.elapsed() >= Live::PERIOD));
+        if !live_image && !trend_due {
+            self.status(renderer, progress, elapsed);
+            self.live.publish(&self.status, None);
+            return None;
+        }
+        let pixels = renderer.image();
+        let error_trend = if self.trend_shown {
+            self.last_trend = Some(Instant::now());
+            self.trend.observe(passes, &pixels)
+        } else {
+            None
+        };
+        if error_trend.is_some() {
+            self.status.error_trend = error_trend;
+        }
+        self.status(renderer, progress, elapsed);
+        let frame =
+            live_image.then(|| Arc::new(frame_of(job, renderer, pixels, self.live.wants_aovs())));
+        self.live.publish(&self.status, frame.as_ref());
+        error_trend
+    }
+
+    /// The status after a pass.
+    fn status(&mut self, renderer: &Renderer, progress: &Progress, elapsed: Duration) {
+        let outlook = progress.outlook(renderer.passes(), elapsed);
+        self.status.pass = renderer.passes();
+        self.status.photons = renderer.photons_emitted();
+        self.status.elapsed = elapsed.as_secs_f64();
+        self.status.remaining = outlook.remaining;
+        self.status.fraction = outlook.fraction;
+        self.status.state = if INTERRUPTED.load(Ordering::SeqCst) {
+            "stopping"
+        } else {
+            "rendering"
+        };
+    }
+
+    /// Tells the live views what the command is doing now.
+    fn state(&mut self, renderer: &Renderer, state: &'static str, elapsed: Duration) {
+        self.status.pass = renderer.passes();
+        self.status.photons = renderer.photons_emitted();
+        self.status.elapsed = elapsed.as_secs_f64();
+        self.status.state = state;
+        if state != "rendering" {
+            self.status.remaining = Some(0.0);
+        }
+        self.live.publish(&self.status, None);
+    }
+
+    /// The final image to the live views; their last messages.
+    fn finish(
+        mut self,
+        renderer: &Renderer,
+        frame: &Arc<film::Frame>,
+        elapsed: Duration,
+    ) -> Vec<String> {
+        self.state(renderer, "done", elapsed);
+        self.status.fraction = 1.0;
+        self.live.finish(&self.status, frame)
+    }
 }
 
 /// When to write the checkpoint during a render: after the first pass, then whenever the time
@@ -245,11 +413,23 @@ fn install_ctrlc_handler() {
     }
 }
 
-/// The EXR (with AOVs and metadata) and the PNG.
-/// Writes the EXR (with its AOVs) and the PNG; returns the seconds the image read-out took (the
-/// photon mappers' pooling runs there).
-fn write_images(job: &Job, renderer: &Renderer, elapsed: Duration) -> anyhow::Result<f64> {
+/// The image and, with `aovs`, the `--aov` channels, as the EXR holds them.
+fn frame_of(job: &Job, renderer: &Renderer, pixels: Vec<[f32; 3]>, aovs: bool) -> film::Frame {
     let (width, height) = renderer.resolution();
+    let mut frame = film::Frame::new(film::Image::new(width as usize, height as usize, pixels));
+    for aov_flag in job.outputs.aovs.iter().filter(|_| aovs) {
+        for &aov in aov_flag.aovs() {
+            if let Some(values) = renderer.aov(aov) {
+                frame.add_aov(aov.channel_names(), &values);
+            }
+        }
+    }
+    frame
+}
+
+/// What the EXR holds: the image, the AOVs (a warning for one the integrator lacks) and the
+/// metadata; and the seconds the image read-out took (the photon mappers' pooling runs there).
+fn exr_frame(job: &Job, renderer: &Renderer, elapsed: Duration) -> (film::Frame, f64) {
     let params = renderer.params();
     let scene_name = job.scene_path.as_ref().map_or_else(
         || DEFAULT_SCENE_NAME.to_string(),
@@ -275,27 +455,35 @@ fn write_images(job: &Job, renderer: &Renderer, elapsed: Duration) -> anyhow::Re
     let readout_clock = Instant::now();
     let image = renderer.image();
     let readout = readout_clock.elapsed().as_secs_f64();
-    let mut frame = film::Frame::new(film::Image::new(width as usize, height as usize, image));
+    let mut frame = frame_of(job, renderer, image, true);
     frame.metadata = metadata;
     for aov_flag in &job.outputs.aovs {
         for &aov in aov_flag.aovs() {
-            match renderer.aov(aov) {
-                Some(values) => frame.add_aov(aov.channel_names(), &values),
-                None => eprintln!(
+            if !frame
+                .channels
+                .iter()
+                .any(|(name, _)| aov.channel_names().contains(name))
+            {
+                eprintln!(
                     "fppm: warning: the {} integrator has no {aov:?} output",
                     params.method
-                ),
+                );
             }
         }
     }
-    film::write_exr(&job.outputs.exr, &frame)?;
+    (frame, readout)
+}
+
+/// The EXR (with AOVs and metadata) and the PNG.
+fn write_images(job: &Job, frame: &film::Frame) -> anyhow::Result<()> {
+    film::write_exr(&job.outputs.exr, frame)?;
     film::write_preview(
         &job.outputs.png,
         &frame.image,
         job.outputs.tonemap.film(),
         1,
     )?;
-    Ok(readout)
+    Ok(())
 }
 
 /// The renderer's state with a note that lets `fppm resume` find the scene and the outputs.
@@ -313,154 +501,4 @@ fn write_checkpoint(
         std::io::Write::write_all(w, &bytes).map_err(|e| film::lower_first(&e.to_string()))
     })?;
     Ok(())
-}
-
-/// `1.2M`, `350k`, `999`.
-fn human_count(n: u64) -> String {
-    if n >= 10_000_000 {
-        format!("{:.0}M", n as f64 / 1e6)
-    } else if n >= 1_000_000 {
-        format!("{:.1}M", n as f64 / 1e6)
-    } else if n >= 10_000 {
-        format!("{:.0}k", n as f64 / 1e3)
-    } else {
-        n.to_string()
-    }
-}
-
-/// Per-pass reporting: a progress bar on a terminal, plain lines otherwise, JSON on request.
-struct Progress {
-    bar: Option<ProgressBar>,
-    budget: Budget,
-    quiet: bool,
-    json: bool,
-    first_pass: u32,
-    /// NaN or infinite values dropped over the passes of this run.
-    non_finite: u64,
-}
-
-impl Progress {
-    fn new(job: &Job, first_pass: u32) -> Self {
-        let quiet = job.run.quiet;
-        let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
-            let bar = ProgressBar::new(1000);
-            let style =
-                ProgressStyle::with_template("{spinner} [{bar:30}] {elapsed_precise} {msg}")
-                    .unwrap_or_else(|_| ProgressStyle::default_bar())
-                    .progress_chars("=> ");
-            bar.set_style(style);
-            bar.set_message("first pass…");
-            bar.enable_steady_tick(Duration::from_millis(200));
-            bar
-        });
-        Progress {
-            bar,
-            budget: job.budget,
-            quiet,
-            json: job.run.json,
-            first_pass,
-            non_finite: 0,
-        }
-    }
-
-    fn pass(&mut self, renderer: &Renderer, stats: &PassStats, elapsed: Duration) {
-        let passes = renderer.passes();
-        self.non_finite += stats.non_finite;
-        if self.json {
-            let line = serde_json::json!({
-                "event": "pass",
-                "pass": stats.pass,
-                "passes": passes,
-                "camera_paths": stats.camera_paths,
-                "photons_traced": stats.photons_traced,
-                "frequency_photons": stats.frequency_photons,
-                "photons_deposited": stats.photons_deposited,
-                "hitpoints_hit": stats.hitpoints_hit,
-                "hitpoints_valid": stats.hitpoints_valid,
-                "mean_radius": finite_or_null(stats.mean_radius),
-                "min_radius": finite_or_null(stats.min_radius),
-                "max_radius": finite_or_null(stats.max_radius),
-                "frequency_held": finite_or_null(stats.frequency_held),
-                "photons_stored": stats.photons_stored,
-                "light_connections": stats.light_connections,
-                "non_finite": stats.non_finite,
-                "timings": {
-                    "camera": stats.timings.camera,
-                    "index": stats.timings.index,
-                    "trace": stats.timings.trace,
-                    "gather": stats.timings.gather,
-                    "update": stats.timings.update,
-                    "frequency": stats.timings.frequency,
-                },
-                "photons_emitted": renderer.photons_emitted(),
-                "elapsed_seconds": elapsed.as_secs_f64(),
-            });
-            // A closed stdout is not worth stopping the render for.
-            let _ = crate::print_stdout(&format!("{line}\n"));
-        }
-        if self.quiet {
-            return;
-        }
-        let done_here = passes.saturating_sub(self.first_pass).max(1);
-        let per_pass = elapsed.as_secs_f64() / f64::from(done_here);
-        let mut fraction: f64 = 0.0;
-        let mut remaining: Option<f64> = None;
-        if let Some(n) = self.budget.passes {
-            fraction = fraction.max(f64::from(passes) / f64::from(n.max(1)));
-            remaining = Some(per_pass * f64::from(n.saturating_sub(passes)));
-        }
-        if let Some(t) = self.budget.time {
-            let left = (t.as_secs_f64() - elapsed.as_secs_f64()).max(0.0);
-            fraction = fraction.max(elapsed.as_secs_f64() / t.as_secs_f64());
-            remaining = Some(remaining.map_or(left, |r| r.min(left)));
-        }
-        let of = self
-            .budget
-            .passes
-            .map(|n| format!("/{n}"))
-            .unwrap_or_default();
-        let left = remaining.map_or(String::new(), |r| {
-            format!(", ~{} left", duration::format(Duration::from_secs_f64(r)))
-        });
-        let photons = if renderer.params().method.traces_light_paths() {
-            format!(", {} photons", human_count(renderer.photons_emitted()))
-        } else {
-            String::new()
-        };
-        match &self.bar {
-            Some(bar) => {
-                bar.set_position((fraction.min(1.0) * 1000.0) as u64);
-                bar.set_message(format!("pass {passes}{of}{photons}{left}"));
-            }
-            None => eprintln!(
-                "pass {passes}{of}{photons}, {} elapsed{left}",
-                duration::format(elapsed)
-            ),
-        }
-    }
-
-    /// A remark between progress updates.
-    fn note(&self, message: &str) {
-        if self.quiet {
-            return;
-        }
-        match &self.bar {
-            Some(bar) => bar.println(message),
-            None => eprintln!("{message}"),
-        }
-    }
-
-    fn finish(&mut self) {
-        if let Some(bar) = self.bar.take() {
-            bar.finish_and_clear();
-        }
-    }
-}
-
-fn finite_or_null(v: f64) -> serde_json::Value {
-    if v.is_finite() {
-        serde_json::json!(v)
-    } else {
-        serde_json::Value::Null
-    }
 }

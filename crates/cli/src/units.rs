@@ -14,7 +14,7 @@ use std::time::Instant;
 use anyhow::Context;
 use ppm::{Part, Renderer, StateHeader};
 
-use crate::args::{BudgetArgs, MergeArgs, OutputArgs, PlanArgs, RenderArgs, UnitArgs};
+use crate::args::{BudgetArgs, LiveArgs, MergeArgs, OutputArgs, PlanArgs, RenderArgs, UnitArgs};
 use crate::render::in_pool;
 use crate::settings::{self, Note};
 use crate::{Outcome, usage};
@@ -77,6 +77,10 @@ pub(crate) fn plan(args: PlanArgs) -> anyhow::Result<Outcome> {
         aov: Vec::new(),
         checkpoint: None,
         run: args.run,
+        live: LiveArgs {
+            preview: None,
+            display_server: None,
+        },
     };
     let job = settings::render_job(Some(&args.scene), &render_args)?;
     if !job.params.method.is_pass_independent() {

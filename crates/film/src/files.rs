@@ -286,6 +286,32 @@ pub fn write_png(path: &Path, width: usize, height: usize, rgb8: Vec<u8>) -> Res
     })
 }
 
+/// The tone-mapped 8-bit RGB PNG of `image`, in memory, with fast compression: what a live
+/// view sends many times during a render rather than a file kept afterwards.
+///
+/// # Panics
+///
+/// If the image is wider or taller than 2³² pixels (a film cannot be).
+#[must_use]
+pub fn encode_png(image: &Image, tonemap: Tonemap) -> Vec<u8> {
+    use image::ImageEncoder;
+    let rgb8 = crate::to_srgb8(image, tonemap);
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new_with_quality(
+        &mut bytes,
+        image::codecs::png::CompressionType::Fast,
+        image::codecs::png::FilterType::Sub,
+    )
+    .write_image(
+        &rgb8,
+        image.width as u32,
+        image.height as u32,
+        image::ExtendedColorType::Rgb8,
+    )
+    .expect("a PNG encodes into memory");
+    bytes
+}
+
 /// Writes the tone-mapped PNG of `image`, enlarged `zoom` times (nearest neighbour) so that
 /// small films are easy to look at.
 ///

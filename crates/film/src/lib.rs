@@ -3,7 +3,8 @@
 //!
 //! The principal type is [`Image`], linear RGB pixels row-major from the top-left. Around it:
 //!
-//! - files ([`read_exr`], [`read_exr_bytes`], [`write_exr`] with auxiliary channels and metadata, [`write_png`]),
+//! - files ([`read_exr`], [`read_exr_bytes`], [`write_exr`] with auxiliary channels and metadata, [`write_png`];
+//!   [`encode_png`], a PNG in memory),
 //!   written atomically (a temporary sibling renamed over the target, [`write_atomically`]),
 //!   so that a killed process never leaves a truncated file;
 //! - display ([`Tonemap`]: exposure, the sRGB or filmic curve, the sRGB transfer function;
@@ -25,8 +26,8 @@ pub use crate::display::{
     Curve, Tonemap, auto_exposure, ramp, srgb_encode, to_srgb8, write_false_colour, write_sheet,
 };
 pub use crate::files::{
-    Frame, check_writable, read_exr, read_exr_bytes, write_atomically, write_exr, write_png,
-    write_preview,
+    Frame, check_writable, encode_png, read_exr, read_exr_bytes, write_atomically, write_exr,
+    write_png, write_preview,
 };
 pub use crate::metrics::{Errors, REL_MSE_EPSILON, errors, rel_mse_map, relative_error_map};
 

@@ -9,6 +9,7 @@
 mod bad_input;
 mod commands;
 mod flags;
+mod live;
 mod resume;
 mod units;
 
