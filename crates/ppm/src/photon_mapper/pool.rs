@@ -30,7 +30,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::PhotonMapper;
+use super::{NO_VISIBLE_POINT, PhotonMapper};
 use crate::params::PoolMode;
 use crate::update::GatherStats;
 
@@ -131,18 +131,19 @@ impl PhotonMapper {
                 width,
             };
         }
-        let width = self.pool_widths();
+        let guides = self.guides();
+        let width = self.pool_widths(&guides);
         let taps = taps(self.setup.params.pool.max_pixels);
         let radiance = (0..own.len())
             .into_par_iter()
-            .map(|slot| self.pool_slot(slot, &own, f64::from(width[slot]), &taps))
+            .map(|slot| self.pool_slot(&guides, slot, &own, f64::from(width[slot]), &taps))
             .collect();
         Pooled { radiance, width }
     }
 
     /// Each slot's pooling width: the Gaussian's standard deviation in scene units, 0 where it
     /// does not pool.
-    fn pool_widths(&self) -> Vec<f32> {
+    fn pool_widths(&self, guides: &[Guide]) -> Vec<f32> {
         let params = &self.setup.params;
         let pool = params.pool;
         let k = params.frequency.kernel_k;
@@ -157,7 +158,7 @@ impl PhotonMapper {
         (0..slots.len())
             .into_par_iter()
             .map(|slot| {
-                let Some(footprint) = self.footprint(slot) else {
+                let Some(footprint) = self.footprint(guides, slot) else {
                     return 0.0;
                 };
                 let window = 0.5 * f64::from(pool.max_pixels) * footprint;
@@ -189,15 +190,15 @@ impl PhotonMapper {
     /// The distance in scene units between the visible point of `slot` and those of the same
     /// slot index in the pixels beside it on the same surface (their mean), or `None` where
     /// no neighbour lies on its surface.
-    fn footprint(&self, slot: usize) -> Option<f64> {
-        if !self.is_valid(slot) {
+    fn footprint(&self, guides: &[Guide], slot: usize) -> Option<f64> {
+        if !guides[slot].is_valid() {
             return None;
         }
         let (width, height) = (self.setup.width as i32, self.setup.height as i32);
         let spp = self.setup.params.film.samples_per_pixel as usize;
         let pixel = (slot / spp) as i32;
         let (x, y) = (pixel % width, pixel / width);
-        let position = self.slots.position()[slot];
+        let position = guides[slot].position;
         let (mut sum, mut n) = (0.0f64, 0u32);
         for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
             let (qx, qy) = (x + dx, y + dy);
@@ -205,39 +206,40 @@ impl PhotonMapper {
                 continue;
             }
             let q = (qy * width + qx) as usize * spp + slot % spp;
-            if self.same_surface(slot, q) {
-                sum += f64::from(position.distance(self.slots.position()[q]));
+            if same_surface(&guides[slot], &guides[q]) {
+                sum += f64::from(position.distance(guides[q].position));
                 n += 1;
             }
         }
         (n > 0 && sum > 0.0).then(|| sum / f64::from(n))
     }
 
-    /// Whether the visible point of slot `q` lies on the surface of slot `p`'s, as pooling
-    /// requires (both valid).
-    fn same_surface(&self, p: usize, q: usize) -> bool {
+    /// What the surface tests read of every slot, packed so that a tap touches one record.
+    fn guides(&self) -> Vec<Guide> {
         let s = &self.slots;
-        if !self.is_valid(q)
-            || s.material_idx()[p] != s.material_idx()[q]
-            || self.photon_bounces[p] != self.photon_bounces[q]
-        {
-            return false;
-        }
-        let (np, nq) = (s.geometric_normal()[p], s.geometric_normal()[q]);
-        if np.dot(nq) < NORMAL_COS || s.shading_normal()[p].dot(s.shading_normal()[q]) < NORMAL_COS
-        {
-            return false;
-        }
-        let offset = s.position()[q] - s.position()[p];
-        if np.dot(offset).abs() > PLANE_SLOPE * offset.length() {
-            return false;
-        }
-        weights_agree(s.weight()[p], s.weight()[q])
+        (0..s.len())
+            .into_par_iter()
+            .map(|i| Guide {
+                position: s.position()[i],
+                normal: s.geometric_normal()[i],
+                shading_normal: s.shading_normal()[i],
+                weight: s.weight()[i],
+                material: s.material_idx()[i],
+                budget: self.photon_bounces[i],
+            })
+            .collect()
     }
 
     /// The pooled photon radiance of `slot` with standard deviation `s` (its own where `s` is
     /// 0).
-    fn pool_slot(&self, slot: usize, own: &[[f64; 3]], s: f64, taps: &[Tap]) -> [f64; 3] {
+    fn pool_slot(
+        &self,
+        guides: &[Guide],
+        slot: usize,
+        own: &[[f64; 3]],
+        s: f64,
+        taps: &[Tap],
+    ) -> [f64; 3] {
         if s <= 0.0 {
             return own[slot];
         }
@@ -245,9 +247,9 @@ impl PhotonMapper {
         let spp = self.setup.params.film.samples_per_pixel as usize;
         let pixel = (slot / spp) as i32;
         let (x, y) = (pixel % width, pixel / width);
-        let position = self.slots.position()[slot];
-        let w_p = self.slots.weight()[slot];
-        let (t, b) = self.slots.geometric_normal()[slot].any_orthonormal_pair();
+        let centre = &guides[slot];
+        let (position, w_p) = (centre.position, centre.weight);
+        let (t, b) = centre.normal.any_orthonormal_pair();
         let inv_two_var = 1.0 / (2.0 * s * s);
         let cutoff2 = (CUTOFF_SIGMAS * s) * (CUTOFF_SIGMAS * s);
         // A weighted least-squares plane L(u, v) = c + g·(u, v) over the tangent plane, read at
@@ -260,13 +262,14 @@ impl PhotonMapper {
                 continue;
             }
             let q = (qy * width + qx) as usize * spp + slot % spp;
-            let offset = self.slots.position()[q] - position;
+            let guide = &guides[q];
+            let offset = guide.position - position;
             let d2 = f64::from(offset.length_squared());
-            if d2 > cutoff2 || !self.same_surface(slot, q) {
+            if d2 > cutoff2 || !same_surface(centre, guide) {
                 continue;
             }
             let k = tap.area * (-d2 * inv_two_var).exp();
-            let w_q = self.slots.weight()[q];
+            let w_q = guide.weight;
             let value = std::array::from_fn(|c| {
                 if w_q[c] > 0.0 {
                     own[q][c] * f64::from(w_p[c] / w_q[c])
@@ -335,6 +338,39 @@ impl LinearFit {
             mean[c] - gu * cu - gv * cv
         })
     }
+}
+
+/// A slot's visible point as the surface tests read it.
+#[derive(Clone, Copy, Debug)]
+struct Guide {
+    position: Vec3,
+    normal: Vec3,
+    shading_normal: Vec3,
+    weight: Vec3,
+    material: u32,
+    /// The photon-bounce budget, [`NO_VISIBLE_POINT`] without a visible point.
+    budget: u16,
+}
+
+impl Guide {
+    fn is_valid(&self) -> bool {
+        self.budget != NO_VISIBLE_POINT
+    }
+}
+
+/// Whether the visible point `q` lies on the surface of `p`'s, as pooling requires (`p` valid).
+fn same_surface(p: &Guide, q: &Guide) -> bool {
+    if !q.is_valid() || p.material != q.material || p.budget != q.budget {
+        return false;
+    }
+    if p.normal.dot(q.normal) < NORMAL_COS || p.shading_normal.dot(q.shading_normal) < NORMAL_COS {
+        return false;
+    }
+    let offset = q.position - p.position;
+    if p.normal.dot(offset).abs() > PLANE_SLOPE * offset.length() {
+        return false;
+    }
+    weights_agree(p.weight, q.weight)
 }
 
 /// Whether two hitpoint weights agree within [`WEIGHT_TOLERANCE`] in every channel.
