@@ -258,6 +258,10 @@ struct Watch {
     /// Whether anything shows the trend.
     trend_shown: bool,
     last_trend: Option<Instant>,
+    /// What the last image read took: the views and the trend read one at most every
+    /// [`Live::PERIOD`], and no more often than keeps the reads under about 3 % of the time
+    /// (a pooled read-out of a large film takes a large part of a second).
+    read_cost: Duration,
     status: Status,
 }
 
@@ -294,6 +298,7 @@ impl Watch {
             trend: Trend::default(),
             trend_shown,
             last_trend: None,
+            read_cost: Duration::ZERO,
             status,
         };
         watch.state(renderer, "rendering", Duration::ZERO);
@@ -309,17 +314,20 @@ impl Watch {
         elapsed: Duration,
     ) -> Option<f64> {
         let passes = renderer.passes();
-        let live_image = self.live.wants_image();
+        let period = Live::PERIOD.max(self.read_cost * 32);
+        let live_image = self.live.wants_image(period);
         let trend_due = self.trend_shown
             && (self.trend.wants(passes)
                 || progress.trend_every_pass()
-                || self.last_trend.is_none_or(|t| t.elapsed() >= Live::PERIOD));
+                || self.last_trend.is_none_or(|t| t.elapsed() >= period));
         if !live_image && !trend_due {
             self.status(renderer, progress, elapsed);
             self.live.publish(&self.status, None);
             return None;
         }
+        let read_clock = Instant::now();
         let pixels = renderer.image();
+        self.read_cost = read_clock.elapsed();
         let error_trend = if self.trend_shown {
             self.last_trend = Some(Instant::now());
             self.trend.observe(passes, &pixels)

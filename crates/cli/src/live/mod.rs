@@ -110,11 +110,11 @@ impl Live {
     }
 
     /// Whether the views want an image after this pass: one is watching and the last image is
-    /// at least [`Live::PERIOD`] old.
-    pub(crate) fn wants_image(&self) -> bool {
+    /// at least `period` old (at least [`Live::PERIOD`], longer where reading one is costly).
+    pub(crate) fn wants_image(&self, period: Duration) -> bool {
         let watched =
             self.tev.is_some() || self.preview.as_ref().is_some_and(preview::Preview::watched);
-        watched && self.last_image.is_none_or(|t| t.elapsed() >= Self::PERIOD)
+        watched && self.last_image.is_none_or(|t| t.elapsed() >= period)
     }
 
     /// Whether the views that want an image also want the AOV channels (tev shows them).
