@@ -175,20 +175,7 @@ fn film_flags(width: Option<u32>, height: Option<u32>) -> anyhow::Result<FilmOve
 
 /// Sets the film size; a lone side keeps the scene's aspect ratio.
 pub(crate) fn apply_film(description: &mut SceneDescription, (width, height): FilmOverride) {
-    let film = &mut description.film;
-    let aspect = f64::from(film.width) / f64::from(film.height);
-    match (width, height) {
-        (Some(w), Some(h)) => (film.width, film.height) = (w, h),
-        (Some(w), None) => {
-            film.width = w;
-            film.height = ((f64::from(w) / aspect).round() as u32).clamp(1, scene::MAX_FILM_SIDE);
-        }
-        (None, Some(h)) => {
-            film.height = h;
-            film.width = ((f64::from(h) * aspect).round() as u32).clamp(1, scene::MAX_FILM_SIDE);
-        }
-        (None, None) => {}
-    }
+    description.film = description.film.resized(width, height);
 }
 
 /// `--passes` must be at least 1.

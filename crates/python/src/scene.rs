@@ -271,20 +271,7 @@ fn check_film(width: Option<u32>, height: Option<u32>) -> PyResult<()> {
 /// Sets the film size as `fppm render --width/--height` does: a lone side keeps the scene's
 /// aspect ratio.
 fn apply_film(description: &mut SceneDescription, (width, height): (Option<u32>, Option<u32>)) {
-    let film = &mut description.film;
-    let aspect = f64::from(film.width) / f64::from(film.height);
-    match (width, height) {
-        (Some(w), Some(h)) => (film.width, film.height) = (w, h),
-        (Some(w), None) => {
-            film.width = w;
-            film.height = ((f64::from(w) / aspect).round() as u32).clamp(1, scene::MAX_FILM_SIDE);
-        }
-        (None, Some(h)) => {
-            film.height = h;
-            film.width = ((f64::from(h) * aspect).round() as u32).clamp(1, scene::MAX_FILM_SIDE);
-        }
-        (None, None) => {}
-    }
+    description.film = description.film.resized(width, height);
 }
 
 /// `a/./b` and `a/c/../b` as `a/b`: the loaders join relative names to a file's directory.

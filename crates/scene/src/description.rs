@@ -86,6 +86,28 @@ pub struct Film {
     pub height: u32,
 }
 
+impl Film {
+    /// This film with `width` and/or `height` set, as `fppm render --width/--height` does: a
+    /// lone side keeps the aspect ratio (the other side rounded, within [1, MAX_FILM_SIDE]).
+    #[must_use]
+    pub fn resized(self, width: Option<u32>, height: Option<u32>) -> Film {
+        let aspect = f64::from(self.width) / f64::from(self.height);
+        let side = |v: f64| (v.round() as u32).clamp(1, MAX_FILM_SIDE);
+        match (width, height) {
+            (Some(width), Some(height)) => Film { width, height },
+            (Some(width), None) => Film {
+                width,
+                height: side(f64::from(width) / aspect),
+            },
+            (None, Some(height)) => Film {
+                width: side(f64::from(height) * aspect),
+                height,
+            },
+            (None, None) => self,
+        }
+    }
+}
+
 /// A named material: a scattering model plus optional emission from the front face.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
