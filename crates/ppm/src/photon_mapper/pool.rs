@@ -37,8 +37,8 @@ use crate::update::GatherStats;
 /// Photons counted after which the pooling width starts to shrink.
 const SHRINK_AFTER: f64 = 1e7;
 /// Neighbours closer than this many pixels are all taps; beyond, every other pixel in each
-/// direction is (each standing for 4 pixels' area): a window of 4 pixels has 36 taps, one of 8
-/// about 70.
+/// direction is (each standing for 4 pixels' area): a window of 4 pixels has 28 taps, one of 8
+/// 64.
 const DENSE_RADIUS: i32 = 2;
 /// The cosine two normals must reach to count as the same surface.
 const NORMAL_COS: f32 = 0.9;
