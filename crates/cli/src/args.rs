@@ -49,7 +49,7 @@ pub(crate) enum Command {
     Render {
         /// The scene file.
         #[arg(value_name = "SCENE")]
-        scene: PathBuf,
+        scene: Option<PathBuf>,
         #[command(flatten)]
         args: RenderArgs,
     },
@@ -369,6 +369,34 @@ pub(crate) struct LiveArgs {
     /// HOST:PORT, as pbrt-v4's --display-server does (tev's default is 127.0.0.1:14158).
     #[arg(long, value_name = "HOST:PORT")]
     pub(crate) display_server: Option<String>,
+}
+
+impl LiveArgs {
+    /// The scene of `fppm render`. `--preview` takes an optional address, so in
+    /// `fppm render --preview scene.toml` the parser hands the scene to it: a value that cannot
+    /// be a HOST:PORT, with no scene given apart, is the scene and the preview takes its
+    /// default address.
+    pub(crate) fn scene_of_render(&mut self, scene: Option<PathBuf>) -> anyhow::Result<PathBuf> {
+        if let Some(scene) = scene {
+            return Ok(scene);
+        }
+        let ends_in_port = |text: &str| {
+            text.rsplit_once(':')
+                .is_some_and(|(_, port)| port.parse::<u16>().is_ok())
+        };
+        match self.preview.take() {
+            Some(value) if !value.is_empty() && !ends_in_port(&value) => {
+                self.preview = Some(String::new());
+                Ok(PathBuf::from(value))
+            }
+            preview => {
+                self.preview = preview;
+                crate::usage!(
+                    "fppm render needs a scene file (fppm alone renders the built-in default scene)"
+                )
+            }
+        }
+    }
 }
 
 /// `fppm diff`.

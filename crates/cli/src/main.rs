@@ -99,7 +99,10 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> anyhow::Result<Outcome> {
     match cli.command {
         None => render::render(None, &cli.render),
-        Some(Command::Render { scene, args }) => render::render(Some(&scene), &args),
+        Some(Command::Render { scene, mut args }) => {
+            let scene = args.live.scene_of_render(scene)?;
+            render::render(Some(&scene), &args)
+        }
         Some(Command::Resume(args)) => render::resume(&args),
         Some(Command::Diff(args)) => diff::diff(&args),
         Some(Command::Info { scene, env }) => info(scene.as_deref(), env),

@@ -10,7 +10,7 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use super::{CORNELL, fppm, read_exr, render_cornell, temp_dir};
+use super::{CORNELL, TINY, fppm, read_exr, render_cornell, temp_dir};
 
 /// One channel image as the tev stand-in rebuilt it.
 type Channels = BTreeMap<String, Vec<f32>>;
@@ -621,4 +621,22 @@ fn help_lists_the_live_views() {
         run.stdout
     );
     assert!(run.stdout.contains("--display-server <HOST:PORT>"));
+}
+
+/// `fppm render --preview scene` is read as the user means it: the page at its default
+/// address and the scene rendered; with no scene at all the command says one is needed.
+#[test]
+fn a_scene_after_a_bare_preview_flag_is_the_scene() {
+    let dir = temp_dir("live-scene-after-flag");
+    let mut args = vec!["render", "--preview", CORNELL];
+    args.extend_from_slice(TINY);
+    let run = fppm(&dir, &args).ok();
+    assert!(
+        run.stderr.contains("fppm: preview at http://127.0.0.1:"),
+        "{}",
+        run.stderr
+    );
+    assert!(dir.join("fppm.exr").exists());
+    fppm(&dir, &["render", "--preview", "127.0.0.1:0"])
+        .fails(2, &["fppm render needs a scene file"]);
 }

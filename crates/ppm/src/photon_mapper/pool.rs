@@ -27,8 +27,10 @@
 //! Pooling is a function of the slots' saved state (positions, normals, weights, R, N, τ,
 //! frequency state), so it is exact across resume and the same for any thread count.
 
-use glam::Vec3;
+use std::ops::{Range, Sub};
+
 use rayon::prelude::*;
+use wide::{f32x8, u32x8};
 
 use super::{NO_VISIBLE_POINT, PhotonMapper};
 use crate::params::PoolMode;
@@ -48,14 +50,25 @@ const PLANE_SLOPE: f32 = 0.1;
 /// The largest relative difference of the hitpoint weights, per channel.
 const WEIGHT_TOLERANCE: f32 = 0.1;
 /// Taps beyond this many standard deviations carry nothing worth the work.
-const CUTOFF_SIGMAS: f64 = 3.0;
+const CUTOFF_SIGMAS: f32 = 3.0;
+/// Pixels of a row pooled at once, one per lane of a vector.
+const LANES: usize = 8;
+/// Rows of the film one task pools: its planes hold them and the window's rows around them.
+const BAND_ROWS: usize = 32;
+
+thread_local! {
+    /// Each worker thread's planes, kept from band to band and from read-out to read-out: a
+    /// band's planes are megabytes at 1920 pixels a row, and their first touch cost more than
+    /// the pooling itself. Nothing is carried over: `Planes::fill` writes every entry it reads.
+    static PLANES: std::cell::RefCell<Planes> = std::cell::RefCell::default();
+}
 
 /// One tap of the window: its offset in pixels and the film area it stands for.
 #[derive(Clone, Copy, Debug)]
 struct Tap {
     dx: i32,
     dy: i32,
-    area: f64,
+    area: f32,
 }
 
 /// The taps of a window of `radius` pixels, without the centre.
@@ -87,24 +100,15 @@ pub(super) struct Pooled {
 }
 
 impl PhotonMapper {
-    /// Every slot's own photon radiance τ/(πR²N) (zero where none was gathered).
-    fn slot_radiance(&self) -> Vec<[f64; 3]> {
-        let radius = self.slots.radius();
-        let count = self.slots.photon_count();
-        let flux = self.slots.flux();
-        let n_emitted = self.photons_counted() as f64;
-        (0..self.slots.len())
-            .into_par_iter()
-            .map(|slot| {
-                GatherStats {
-                    radius: radius[slot],
-                    photon_count: count[slot],
-                    flux: flux[slot],
-                }
-                .radiance(n_emitted)
-                .unwrap_or([0.0; 3])
-            })
-            .collect()
+    /// The slot's own photon radiance τ/(πR²N) (zero where none was gathered).
+    pub(super) fn own_radiance(&self, slot: usize) -> [f64; 3] {
+        GatherStats {
+            radius: self.slots.radius()[slot],
+            photon_count: self.slots.photon_count()[slot],
+            flux: self.slots.flux()[slot],
+        }
+        .radiance(self.photons_counted() as f64)
+        .unwrap_or([0.0; 3])
     }
 
     /// Whether this render pools at all (never `appm`, whose image is its exact pass sums).
@@ -122,170 +126,558 @@ impl PhotonMapper {
 
     /// The photon radiance of every slot, pooled as the parameters say (or each slot's own
     /// where this render does not pool).
+    ///
+    /// The film is pooled in bands of rows, each task copying the visible points of its band
+    /// and of the window's rows around it into planes (`Planes`), eight pixels of a row at a
+    /// time: the cost is the taps' arithmetic, not page faults on image-sized buffers or
+    /// scattered loads.
     pub(super) fn pooled(&self) -> Pooled {
-        let own = self.slot_radiance();
-        if !self.pools() || self.slots.is_empty() {
-            let width = vec![0.0; own.len()];
+        let n = self.slots.len();
+        if !self.pools() || n == 0 {
+            let radiance = (0..n)
+                .into_par_iter()
+                .map(|slot| self.own_radiance(slot))
+                .collect();
             return Pooled {
-                radiance: own,
-                width,
+                radiance,
+                width: vec![0.0; n],
             };
         }
-        let guides = self.guides();
-        let width = self.pool_widths(&guides);
+        let film = Film {
+            width: self.setup.width as usize,
+            height: self.setup.height as usize,
+            spp: self.setup.params.film.samples_per_pixel as usize,
+        };
+        let rule = WidthRule::new(self);
         let taps = taps(self.setup.params.pool.max_pixels);
-        let radiance = (0..own.len())
-            .into_par_iter()
-            .map(|slot| self.pool_slot(&guides, slot, &own, f64::from(width[slot]), &taps))
-            .collect();
+        // The window's rows and columns, and at least the footprint's neighbours.
+        let halo = (self.setup.params.pool.max_pixels as usize).max(1);
+        let mut radiance = vec![[0.0; 3]; n];
+        let mut width = vec![0.0f32; n];
+        let band_slots = BAND_ROWS * film.width * film.spp;
+        radiance
+            .par_chunks_mut(band_slots)
+            .zip(width.par_chunks_mut(band_slots))
+            .enumerate()
+            .for_each(|(band, (radiance, width))| {
+                PLANES.with_borrow_mut(|planes| {
+                    let rows = band * BAND_ROWS..((band + 1) * BAND_ROWS).min(film.height);
+                    let first_slot = rows.start * film.width * film.spp;
+                    for sample in 0..film.spp {
+                        let plane_rows =
+                            rows.start.saturating_sub(halo)..(rows.end + halo).min(film.height);
+                        planes.fill(self, film, sample, plane_rows, halo);
+                        for y in rows.clone() {
+                            for x0 in (0..film.width).step_by(LANES) {
+                                let out =
+                                    self.pool_group(planes, &rule, &taps, film, (x0, y), sample);
+                                for (lane, (l, s)) in out.into_iter().enumerate() {
+                                    let x = x0 + lane;
+                                    if x < film.width {
+                                        let slot = film.slot(x, y, sample) - first_slot;
+                                        radiance[slot] = l;
+                                        width[slot] = s;
+                                    }
+                                }
+                            }
+                        }
+                    }
+                });
+            });
         Pooled { radiance, width }
     }
 
-    /// Each slot's pooling width: the Gaussian's standard deviation in scene units, 0 where it
-    /// does not pool.
-    fn pool_widths(&self, guides: &[Guide]) -> Vec<f32> {
-        let params = &self.setup.params;
-        let pool = params.pool;
-        let k = params.frequency.kernel_k;
-        let r_top = self.setup.kernel_max();
-        let n = self.photons_counted() as f64;
-        let shrink = if n > SHRINK_AFTER {
-            (SHRINK_AFTER / n).powf(pool.decay)
-        } else {
-            1.0
-        };
-        let slots = &self.slots;
-        (0..slots.len())
-            .into_par_iter()
-            .map(|slot| {
-                let Some(footprint) = self.footprint(guides, slot) else {
-                    return 0.0;
-                };
-                let window = 0.5 * f64::from(pool.max_pixels) * footprint;
-                let freq = slots.freq()[slot];
-                let mut s = match pool.mode {
-                    PoolMode::Off => 0.0,
-                    PoolMode::Geometry => window,
-                    PoolMode::Frequency => freq.frequency_radius(k).map_or(0.0, |r_freq| {
-                        let budget = pool.scale * r_freq;
-                        let r = slots.radius()[slot];
-                        (budget * budget - r * r).max(0.0).sqrt() / 2.0
-                    }),
-                };
-                s = s.min(window);
-                // A disc not clear at the largest kernel sits near another surface: pool no
-                // further than half its clear radius.
-                if freq.clear_level() != 0
-                    && let Some(clear) = freq.clear_radius(r_top)
-                {
-                    s = s.min(0.5 * clear);
-                }
-                let s = s * shrink;
-                // A width far below a pixel pools nothing worth the taps.
-                if s < 0.25 * footprint { 0.0 } else { s as f32 }
-            })
-            .collect()
-    }
-
-    /// The distance in scene units between the visible point of `slot` and those of the same
-    /// slot index in the pixels beside it on the same surface (their mean), or `None` where
-    /// no neighbour lies on its surface.
-    fn footprint(&self, guides: &[Guide], slot: usize) -> Option<f64> {
-        if !guides[slot].is_valid() {
-            return None;
-        }
-        let (width, height) = (self.setup.width as i32, self.setup.height as i32);
-        let spp = self.setup.params.film.samples_per_pixel as usize;
-        let pixel = (slot / spp) as i32;
-        let (x, y) = (pixel % width, pixel / width);
-        let position = guides[slot].position;
-        let (mut sum, mut n) = (0.0f64, 0u32);
-        for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
-            let (qx, qy) = (x + dx, y + dy);
-            if qx < 0 || qy < 0 || qx >= width || qy >= height {
-                continue;
-            }
-            let q = (qy * width + qx) as usize * spp + slot % spp;
-            if same_surface(&guides[slot], &guides[q]) {
-                sum += f64::from(position.distance(guides[q].position));
-                n += 1;
-            }
-        }
-        (n > 0 && sum > 0.0).then(|| sum / f64::from(n))
-    }
-
-    /// What the surface tests read of every slot, packed so that a tap touches one record.
-    fn guides(&self) -> Vec<Guide> {
-        let s = &self.slots;
-        (0..s.len())
-            .into_par_iter()
-            .map(|i| Guide {
-                position: s.position()[i],
-                normal: s.geometric_normal()[i],
-                shading_normal: s.shading_normal()[i],
-                weight: s.weight()[i],
-                material: s.material_idx()[i],
-                budget: self.photon_bounces[i],
-            })
-            .collect()
-    }
-
-    /// The pooled photon radiance of `slot` with standard deviation `s` (its own where `s` is
-    /// 0).
-    fn pool_slot(
+    /// The pooled photon radiance and the width of the eight pixels of row `y` from `x0` on
+    /// (those past the film's edge are computed and thrown away).
+    fn pool_group(
         &self,
-        guides: &[Guide],
-        slot: usize,
-        own: &[[f64; 3]],
-        s: f64,
+        planes: &Planes,
+        rule: &WidthRule,
         taps: &[Tap],
-    ) -> [f64; 3] {
-        if s <= 0.0 {
-            return own[slot];
+        film: Film,
+        (x0, y): (usize, usize),
+        sample: usize,
+    ) -> [([f64; 3], f32); LANES] {
+        let centre = Centre::load(planes, planes.index(x0, y));
+        // The footprint: the mean distance to the pixels beside it on its surface.
+        let (mut sum, mut count) = (f32x8::ZERO, f32x8::ZERO);
+        for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
+            let Some(at) = planes.neighbour(x0, y, dx, dy) else {
+                continue;
+            };
+            let position = planes.position.load(at);
+            let offset = position - centre.position;
+            let d2 = offset.dot(offset);
+            let on = centre.on_surface(planes, at, offset, d2);
+            sum += d2.sqrt() & on;
+            count += f32x8::ONE & on;
         }
-        let (width, height) = (self.setup.width as i32, self.setup.height as i32);
-        let spp = self.setup.params.film.samples_per_pixel as usize;
-        let pixel = (slot / spp) as i32;
-        let (x, y) = (pixel % width, pixel / width);
-        let centre = &guides[slot];
-        let (position, w_p) = (centre.position, centre.weight);
-        let (t, b) = centre.normal.any_orthonormal_pair();
-        let inv_two_var = 1.0 / (2.0 * s * s);
-        let cutoff2 = (CUTOFF_SIGMAS * s) * (CUTOFF_SIGMAS * s);
-        // A weighted least-squares plane L(u, v) = c + g·(u, v) over the tangent plane, read at
-        // the centre: a linear gradient of the light costs no bias even where the neighbours
-        // lie on one side only (beside a wall, an edge of the surface).
-        let mut fit = LinearFit::new(own[slot]);
+        let (sum, count) = (sum.to_array(), count.to_array());
+        let slots: [Option<usize>; LANES] = std::array::from_fn(|lane| {
+            let x = x0 + lane;
+            (x < film.width).then(|| film.slot(x, y, sample))
+        });
+        let s: [f32; LANES] = std::array::from_fn(|lane| {
+            let Some(slot) = slots[lane] else {
+                return 0.0;
+            };
+            let footprint =
+                (count[lane] > 0.0 && sum[lane] > 0.0).then(|| f64::from(sum[lane] / count[lane]));
+            footprint.map_or(0.0, |footprint| rule.width(self, slot, footprint))
+        });
+        let own = |lane: usize| slots[lane].map_or([0.0; 3], |slot| self.own_radiance(slot));
+        if s.iter().all(|&s| s <= 0.0) {
+            return std::array::from_fn(|lane| (own(lane), 0.0));
+        }
+
+        let width = f32x8::new(s);
+        let active = width.simd_gt(f32x8::ZERO);
+        let inv_width = (f32x8::ONE / width) & active;
+        let inv_two_var = f32x8::splat(0.5) * inv_width * inv_width;
+        let reach = f32x8::splat(CUTOFF_SIGMAS) * width;
+        let cutoff2 = active.select(reach * reach, f32x8::splat(-1.0));
+        let (t, b) = centre.normal.orthonormal_pair();
+        let mut fit = Fit::new(centre.flat);
         for tap in taps {
-            let (qx, qy) = (x + tap.dx, y + tap.dy);
-            if qx < 0 || qy < 0 || qx >= width || qy >= height {
+            let Some(at) = planes.neighbour(x0, y, tap.dx, tap.dy) else {
+                continue;
+            };
+            let position = planes.position.load(at);
+            let offset = position - centre.position;
+            let d2 = offset.dot(offset);
+            let near = d2.simd_le(cutoff2);
+            if !near.any() {
                 continue;
             }
-            let q = (qy * width + qx) as usize * spp + slot % spp;
-            let guide = &guides[q];
-            let offset = guide.position - position;
-            let d2 = f64::from(offset.length_squared());
-            if d2 > cutoff2 || !same_surface(centre, guide) {
+            let on = near & centre.on_surface(planes, at, offset, d2);
+            if !on.any() {
                 continue;
             }
-            let k = tap.area * (-d2 * inv_two_var).exp();
-            let w_q = guide.weight;
-            let value = std::array::from_fn(|c| {
-                if w_q[c] > 0.0 {
-                    own[q][c] * f64::from(w_p[c] / w_q[c])
+            let k = (f32x8::splat(tap.area) * (-(d2 * inv_two_var)).exp()) & on;
+            let u = offset.dot(t) * inv_width;
+            let v = offset.dot(b) * inv_width;
+            let flat = planes.flat.load(at);
+            fit.add(k, u & on, v & on, [flat.x & on, flat.y & on, flat.z & on]);
+        }
+        let weight = centre.weight.to_arrays();
+        let fit = fit.lanes();
+        std::array::from_fn(|lane| {
+            let own = own(lane);
+            if s[lane] <= 0.0 {
+                return (own, 0.0);
+            }
+            let flat = fit[lane].centre();
+            // Remodulated by the pixel's own weight: a texture is not blurred.
+            let radiance = std::array::from_fn(|c| {
+                let w = weight[c][lane];
+                if w > 0.0 {
+                    f64::from(w) * flat[c]
                 } else {
-                    0.0
+                    own[c]
                 }
             });
-            let (u, v) = (f64::from(offset.dot(t)) / s, f64::from(offset.dot(b)) / s);
-            fit.add(k, u, v, value);
-        }
-        fit.centre()
+            (radiance, s[lane])
+        })
     }
 }
 
-/// The moments of a weighted least-squares plane fit through the centre's neighbourhood, in
-/// units of the pooling width.
+/// The film's shape as the slots are laid out: pixel-major, `spp` slots per pixel.
+#[derive(Clone, Copy, Debug)]
+struct Film {
+    width: usize,
+    height: usize,
+    spp: usize,
+}
+
+impl Film {
+    fn slot(self, x: usize, y: usize, sample: usize) -> usize {
+        (y * self.width + x) * self.spp + sample
+    }
+}
+
+/// How wide a slot pools, from its footprint, its frequency radius, its gather radius and its
+/// clear disc.
+struct WidthRule {
+    mode: PoolMode,
+    /// Half the window, in pixels.
+    half_window: f64,
+    scale: f64,
+    kernel_k: f64,
+    r_top: f64,
+    /// The consistency shrink (n₀/n)^decay, 1 before n₀.
+    shrink: f64,
+}
+
+impl WidthRule {
+    fn new(mapper: &PhotonMapper) -> Self {
+        let params = &mapper.setup.params;
+        let n = mapper.photons_counted() as f64;
+        Self {
+            mode: params.pool.mode,
+            half_window: 0.5 * f64::from(params.pool.max_pixels),
+            scale: params.pool.scale,
+            kernel_k: params.frequency.kernel_k,
+            r_top: mapper.setup.kernel_max(),
+            shrink: if n > SHRINK_AFTER {
+                (SHRINK_AFTER / n).powf(params.pool.decay)
+            } else {
+                1.0
+            },
+        }
+    }
+
+    /// The Gaussian's standard deviation in scene units of a slot whose neighbours on its
+    /// surface lie `footprint` away (their mean), 0 where it does not pool.
+    fn width(&self, mapper: &PhotonMapper, slot: usize, footprint: f64) -> f32 {
+        let slots = &mapper.slots;
+        let window = self.half_window * footprint;
+        let freq = slots.freq()[slot];
+        let mut s = match self.mode {
+            PoolMode::Off => 0.0,
+            PoolMode::Geometry => window,
+            PoolMode::Frequency => freq.frequency_radius(self.kernel_k).map_or(0.0, |r_freq| {
+                let budget = self.scale * r_freq;
+                let r = slots.radius()[slot];
+                (budget * budget - r * r).max(0.0).sqrt() / 2.0
+            }),
+        };
+        s = s.min(window);
+        // A disc not clear at the largest kernel sits near another surface: pool no further
+        // than half its clear radius.
+        if freq.clear_level() != 0
+            && let Some(clear) = freq.clear_radius(self.r_top)
+        {
+            s = s.min(0.5 * clear);
+        }
+        let s = s * self.shrink;
+        // A width far below a pixel pools nothing worth the taps.
+        if s < 0.25 * footprint { 0.0 } else { s as f32 }
+    }
+}
+
+/// Three planes of one vector quantity.
+#[derive(Default)]
+struct Plane3 {
+    x: Vec<f32>,
+    y: Vec<f32>,
+    z: Vec<f32>,
+}
+
+impl Plane3 {
+    fn resize(&mut self, len: usize) {
+        for plane in [&mut self.x, &mut self.y, &mut self.z] {
+            plane.resize(len, 0.0);
+        }
+    }
+
+    fn set(&mut self, at: usize, value: [f32; 3]) {
+        self.x[at] = value[0];
+        self.y[at] = value[1];
+        self.z[at] = value[2];
+    }
+
+    #[inline]
+    fn load(&self, at: usize) -> V3 {
+        V3 {
+            x: load(&self.x, at),
+            y: load(&self.y, at),
+            z: load(&self.z, at),
+        }
+    }
+}
+
+/// Eight consecutive values of a plane as a vector.
+#[inline]
+fn load(plane: &[f32], at: usize) -> f32x8 {
+    f32x8::from(&plane[at..at + LANES])
+}
+
+/// The visible points of one sample index over a band of rows and the window's rows around it,
+/// one plane per quantity, `stride` columns per row: the film's columns with `halo` columns
+/// before and `halo + LANES` after that hold no visible point, so that any tap of eight
+/// neighbouring pixels loads as one vector without a bounds test per lane.
+#[derive(Default)]
+struct Planes {
+    halo: usize,
+    stride: usize,
+    rows: Range<usize>,
+    position: Plane3,
+    normal: Plane3,
+    shading_normal: Plane3,
+    weight: Plane3,
+    /// The photon radiance over the hitpoint weight, per channel (0 where the weight is):
+    /// what a neighbour lends, remodulated by the pixel's own weight.
+    flat: Plane3,
+    material: Vec<u32>,
+    /// The photon-bounce budget, [`NO_VISIBLE_POINT`] without a visible point.
+    budget: Vec<u32>,
+}
+
+impl Planes {
+    /// Copies the visible points of `rows` for `sample`.
+    fn fill(
+        &mut self,
+        mapper: &PhotonMapper,
+        film: Film,
+        sample: usize,
+        rows: Range<usize>,
+        halo: usize,
+    ) {
+        self.halo = halo;
+        self.stride = film.width + 2 * halo + LANES;
+        let len = rows.len() * self.stride;
+        for plane in [
+            &mut self.position,
+            &mut self.normal,
+            &mut self.shading_normal,
+            &mut self.weight,
+            &mut self.flat,
+        ] {
+            plane.resize(len);
+        }
+        self.material.resize(len, 0);
+        self.budget.resize(len, 0);
+        let slots = &mapper.slots;
+        for (row, y) in rows.clone().enumerate() {
+            for col in 0..self.stride {
+                let at = row * self.stride + col;
+                let x = col.wrapping_sub(halo);
+                if x >= film.width {
+                    self.clear(at);
+                    continue;
+                }
+                let slot = film.slot(x, y, sample);
+                let budget = mapper.photon_bounces[slot];
+                if budget == NO_VISIBLE_POINT {
+                    self.clear(at);
+                    continue;
+                }
+                let weight = slots.weight()[slot];
+                let own = mapper.own_radiance(slot);
+                let flat = std::array::from_fn(|c| {
+                    if weight[c] > 0.0 {
+                        (own[c] / f64::from(weight[c])) as f32
+                    } else {
+                        0.0
+                    }
+                });
+                self.position.set(at, slots.position()[slot].to_array());
+                self.normal
+                    .set(at, slots.geometric_normal()[slot].to_array());
+                self.shading_normal
+                    .set(at, slots.shading_normal()[slot].to_array());
+                self.weight.set(at, weight.to_array());
+                self.flat.set(at, flat);
+                self.material[at] = slots.material_idx()[slot];
+                self.budget[at] = u32::from(budget);
+            }
+        }
+        self.rows = rows;
+    }
+
+    /// A column without a visible point (finite zeros everywhere, so that masked lanes stay 0).
+    fn clear(&mut self, at: usize) {
+        for plane in [
+            &mut self.position,
+            &mut self.normal,
+            &mut self.shading_normal,
+            &mut self.weight,
+            &mut self.flat,
+        ] {
+            plane.set(at, [0.0; 3]);
+        }
+        self.material[at] = 0;
+        self.budget[at] = u32::from(NO_VISIBLE_POINT);
+    }
+
+    /// Where pixel (x, y) of the film is.
+    #[inline]
+    fn index(&self, x: usize, y: usize) -> usize {
+        (y - self.rows.start) * self.stride + x + self.halo
+    }
+
+    /// Where the pixels `(dx, dy)` beside (x0, y) and its seven successors are, if their row is
+    /// on the film (columns off the film read the halo's empty columns).
+    #[inline]
+    fn neighbour(&self, x0: usize, y: usize, dx: i32, dy: i32) -> Option<usize> {
+        let qy = y.checked_add_signed(dy as isize)?;
+        if !self.rows.contains(&qy) {
+            return None;
+        }
+        Some((self.index(x0, qy) as isize + dx as isize) as usize)
+    }
+}
+
+/// Three vectors: a 3D quantity of eight pixels.
+#[derive(Clone, Copy)]
+struct V3 {
+    x: f32x8,
+    y: f32x8,
+    z: f32x8,
+}
+
+impl V3 {
+    #[inline]
+    fn dot(self, other: Self) -> f32x8 {
+        self.x * other.x + self.y * other.y + self.z * other.z
+    }
+
+    fn to_arrays(self) -> [[f32; LANES]; 3] {
+        [self.x.to_array(), self.y.to_array(), self.z.to_array()]
+    }
+
+    /// Two tangents completing each unit vector to an orthonormal basis (Duff et al. 2017, as
+    /// glam's `any_orthonormal_pair`).
+    fn orthonormal_pair(self) -> (Self, Self) {
+        let sign = self.z.simd_lt(f32x8::ZERO).select(-f32x8::ONE, f32x8::ONE);
+        let a = -f32x8::ONE / (sign + self.z);
+        let b = self.x * self.y * a;
+        (
+            V3 {
+                x: f32x8::ONE + sign * self.x * self.x * a,
+                y: sign * b,
+                z: -sign * self.x,
+            },
+            V3 {
+                x: b,
+                y: sign + self.y * self.y * a,
+                z: -self.y,
+            },
+        )
+    }
+}
+
+impl Sub for V3 {
+    type Output = Self;
+    #[inline]
+    fn sub(self, other: Self) -> Self {
+        V3 {
+            x: self.x - other.x,
+            y: self.y - other.y,
+            z: self.z - other.z,
+        }
+    }
+}
+
+/// Eight pixels' visible points as the surface tests read them.
+struct Centre {
+    position: V3,
+    normal: V3,
+    shading_normal: V3,
+    weight: V3,
+    flat: V3,
+    material: u32x8,
+    budget: u32x8,
+    /// Lanes with a visible point.
+    valid: f32x8,
+}
+
+impl Centre {
+    #[inline]
+    fn load(planes: &Planes, at: usize) -> Self {
+        let budget = load_u32(&planes.budget, at);
+        let none = u32x8::splat(u32::from(NO_VISIBLE_POINT));
+        Self {
+            position: planes.position.load(at),
+            normal: planes.normal.load(at),
+            shading_normal: planes.shading_normal.load(at),
+            weight: planes.weight.load(at),
+            flat: planes.flat.load(at),
+            material: load_u32(&planes.material, at),
+            budget,
+            valid: !mask(budget.simd_eq(none)),
+        }
+    }
+
+    /// The lanes whose neighbour at `at` (`offset` away, at squared distance `d2`) lies on the
+    /// pixel's surface: a visible point of the same material and photon-bounce budget, both
+    /// normals within about 25°, close to the pixel's tangent plane, and hitpoint weights within
+    /// 10 % per channel.
+    #[inline]
+    fn on_surface(&self, planes: &Planes, at: usize, offset: V3, d2: f32x8) -> f32x8 {
+        let same = mask(load_u32(&planes.material, at).simd_eq(self.material))
+            & mask(load_u32(&planes.budget, at).simd_eq(self.budget))
+            & self.valid;
+        let cos = f32x8::splat(NORMAL_COS);
+        let normals = self.normal.dot(planes.normal.load(at)).simd_ge(cos)
+            & self
+                .shading_normal
+                .dot(planes.shading_normal.load(at))
+                .simd_ge(cos);
+        let height = self.normal.dot(offset);
+        let plane = (height * height).simd_le(f32x8::splat(PLANE_SLOPE * PLANE_SLOPE) * d2);
+        same & normals & plane & weights_agree(self.weight, planes.weight.load(at))
+    }
+}
+
+#[inline]
+fn load_u32(plane: &[u32], at: usize) -> u32x8 {
+    u32x8::from(&plane[at..at + LANES])
+}
+
+/// An integer mask as a float mask.
+#[inline]
+fn mask(m: u32x8) -> f32x8 {
+    f32x8::from_bits(m)
+}
+
+/// The lanes where two hitpoint weights agree within [`WEIGHT_TOLERANCE`] in every channel.
+#[inline]
+fn weights_agree(a: V3, b: V3) -> f32x8 {
+    let tolerance = f32x8::splat(WEIGHT_TOLERANCE);
+    let agree = |a: f32x8, b: f32x8| (a - b).abs().simd_le(a.max(b) * tolerance);
+    agree(a.x, b.x) & agree(a.y, b.y) & agree(a.z, b.z)
+}
+
+/// The moments of eight weighted least-squares plane fits, in units of the pooling width, with
+/// the pixels' own values at weight 1 at (0, 0).
+struct Fit {
+    /// Σk·[1, u, v, uu, uv, vv].
+    moments: [f32x8; 6],
+    /// Σk·L·[1, u, v] per channel.
+    values: [[f32x8; 3]; 3],
+}
+
+impl Fit {
+    fn new(own: V3) -> Self {
+        let zero = [f32x8::ZERO; 3];
+        let mut moments = [f32x8::ZERO; 6];
+        moments[0] = f32x8::ONE;
+        Self {
+            moments,
+            values: [[own.x, own.y, own.z], zero, zero],
+        }
+    }
+
+    #[inline]
+    fn add(&mut self, k: f32x8, u: f32x8, v: f32x8, value: [f32x8; 3]) {
+        let (ku, kv) = (k * u, k * v);
+        let m = &mut self.moments;
+        m[0] += k;
+        m[1] += ku;
+        m[2] += kv;
+        m[3] += ku * u;
+        m[4] += ku * v;
+        m[5] += kv * v;
+        for (c, value) in value.into_iter().enumerate() {
+            self.values[0][c] += k * value;
+            self.values[1][c] += ku * value;
+            self.values[2][c] += kv * value;
+        }
+    }
+
+    /// Each lane's fit.
+    fn lanes(&self) -> [LinearFit; LANES] {
+        let moments = self.moments.map(f32x8::to_array);
+        let values = self.values.map(|v| v.map(f32x8::to_array));
+        std::array::from_fn(|lane| LinearFit {
+            moments: moments.map(|m| f64::from(m[lane])),
+            values: values.map(|v| v.map(|v| f64::from(v[lane]))),
+        })
+    }
+}
+
+/// The moments of one weighted least-squares plane fit through a pixel's neighbourhood.
 struct LinearFit {
     /// Σk·[1, u, v, uu, uv, vv].
     moments: [f64; 6],
@@ -294,29 +686,6 @@ struct LinearFit {
 }
 
 impl LinearFit {
-    /// The fit with the centre's own value, weight 1 at (0, 0).
-    fn new(own: [f64; 3]) -> Self {
-        Self {
-            moments: [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-            values: [own, [0.0; 3], [0.0; 3]],
-        }
-    }
-
-    fn add(&mut self, k: f64, u: f64, v: f64, value: [f64; 3]) {
-        let m = &mut self.moments;
-        m[0] += k;
-        m[1] += k * u;
-        m[2] += k * v;
-        m[3] += k * u * u;
-        m[4] += k * u * v;
-        m[5] += k * v * v;
-        for (c, &value) in value.iter().enumerate() {
-            self.values[0][c] += k * value;
-            self.values[1][c] += k * u * value;
-            self.values[2][c] += k * v * value;
-        }
-    }
-
     /// The plane's value at the centre, or the weighted mean where the neighbours do not
     /// span the plane (all on one line) well enough to fit a gradient.
     fn centre(&self) -> [f64; 3] {
@@ -340,46 +709,6 @@ impl LinearFit {
     }
 }
 
-/// A slot's visible point as the surface tests read it.
-#[derive(Clone, Copy, Debug)]
-struct Guide {
-    position: Vec3,
-    normal: Vec3,
-    shading_normal: Vec3,
-    weight: Vec3,
-    material: u32,
-    /// The photon-bounce budget, [`NO_VISIBLE_POINT`] without a visible point.
-    budget: u16,
-}
-
-impl Guide {
-    fn is_valid(&self) -> bool {
-        self.budget != NO_VISIBLE_POINT
-    }
-}
-
-/// Whether the visible point `q` lies on the surface of `p`'s, as pooling requires (`p` valid).
-fn same_surface(p: &Guide, q: &Guide) -> bool {
-    if !q.is_valid() || p.material != q.material || p.budget != q.budget {
-        return false;
-    }
-    if p.normal.dot(q.normal) < NORMAL_COS || p.shading_normal.dot(q.shading_normal) < NORMAL_COS {
-        return false;
-    }
-    let offset = q.position - p.position;
-    if p.normal.dot(offset).abs() > PLANE_SLOPE * offset.length() {
-        return false;
-    }
-    weights_agree(p.weight, q.weight)
-}
-
-/// Whether two hitpoint weights agree within [`WEIGHT_TOLERANCE`] in every channel.
-fn weights_agree(a: Vec3, b: Vec3) -> bool {
-    let diff = (a - b).abs();
-    let scale = a.max(b);
-    diff.cmple(scale * WEIGHT_TOLERANCE).all()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -390,7 +719,7 @@ mod tests {
         // sparse ring's rounding.
         for radius in [1u32, 2, 4, 8, 16] {
             let taps = taps(radius);
-            let area: f64 = taps.iter().map(|t| t.area).sum();
+            let area: f64 = taps.iter().map(|t| f64::from(t.area)).sum();
             let disc = std::f64::consts::PI * f64::from(radius * radius);
             assert!(
                 (area + 1.0 - disc).abs() <= 0.15 * disc + 4.0,
@@ -407,11 +736,53 @@ mod tests {
 
     #[test]
     fn weights_agree_within_the_tolerance() {
-        let a = Vec3::new(0.5, 0.4, 0.3);
-        assert!(weights_agree(a, a));
-        assert!(weights_agree(a, a * 1.05));
-        assert!(!weights_agree(a, a * 1.2));
-        assert!(!weights_agree(a, Vec3::new(0.5, 0.4, 0.0)));
-        assert!(weights_agree(Vec3::ZERO, Vec3::ZERO));
+        let splat = |w: [f32; 3]| V3 {
+            x: f32x8::splat(w[0]),
+            y: f32x8::splat(w[1]),
+            z: f32x8::splat(w[2]),
+        };
+        let agree = |a: [f32; 3], b: [f32; 3]| {
+            let m = weights_agree(splat(a), splat(b));
+            assert!(m.all() || m.none(), "lanes disagree");
+            m.all()
+        };
+        let a = [0.5, 0.4, 0.3];
+        assert!(agree(a, a));
+        assert!(agree(a, a.map(|c| c * 1.05)));
+        assert!(!agree(a, a.map(|c| c * 1.2)));
+        assert!(!agree(a, [0.5, 0.4, 0.0]));
+        assert!(agree([0.0; 3], [0.0; 3]));
+    }
+
+    #[test]
+    fn tangent_pairs_are_orthonormal() {
+        let normals = [
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+            [1.0, 0.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.6, 0.0, -0.8],
+            [0.48, 0.6, 0.64],
+            [-0.36, 0.48, -0.8],
+            [0.0, 0.6, 0.8],
+        ];
+        let lanes = |c: usize| f32x8::new(std::array::from_fn(|i| normals[i][c]));
+        let n = V3 {
+            x: lanes(0),
+            y: lanes(1),
+            z: lanes(2),
+        };
+        let (t, b) = n.orthonormal_pair();
+        for (name, value, expected) in [
+            ("t·t", t.dot(t), 1.0),
+            ("b·b", b.dot(b), 1.0),
+            ("t·b", t.dot(b), 0.0),
+            ("t·n", t.dot(n), 0.0),
+            ("b·n", b.dot(n), 0.0),
+        ] {
+            for v in value.to_array() {
+                assert!((v - expected).abs() < 1e-5, "{name} = {v}");
+            }
+        }
     }
 }

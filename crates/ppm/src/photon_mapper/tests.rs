@@ -104,3 +104,173 @@ fn block_discs_recomputed_mid_epoch_are_those_of_the_epoch_start() {
         .all(|(x, y)| x.map(f32::to_bits) == y.map(f32::to_bits));
     assert!(same, "the image differs");
 }
+
+/// The vectorised pooling (eight pixels a time, bands of rows, f32 sums) gives what a plain
+/// per-pixel loop of the same rule gives: on a film whose width is not a multiple of eight, with
+/// two samples per pixel and a window that reaches over band edges.
+#[test]
+fn pooling_matches_a_per_pixel_reference() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/scenes/cornell_box/CornellBox-Sphere.obj");
+    let mut description = import::load(&path).unwrap();
+    description.film = scene::Film {
+        width: 45,
+        height: 70,
+    };
+    let scene = Arc::new(Scene::new(description).unwrap());
+    let mut params = RenderParams::preview();
+    params.method = Method::FreqSppm;
+    params.budget.photons_per_pass = 20_000;
+    params.film.samples_per_pixel = 2;
+    params.pool.mode = crate::PoolMode::Geometry;
+    params.pool.max_pixels = 5;
+    let mut mapper = PhotonMapper::new(Arc::clone(&scene), params).unwrap();
+    for _ in 0..3 {
+        mapper.iterate();
+    }
+    let pooled = mapper.pooled();
+    let reference = reference_pooling(&mapper);
+    let mut pooled_slots = 0;
+    for (slot, (got, want)) in pooled.radiance.iter().zip(&reference.0).enumerate() {
+        let (s_got, s_want) = (pooled.width[slot], reference.1[slot]);
+        assert!(
+            (s_got - s_want).abs() <= 1e-4 * s_want,
+            "slot {slot}: width {s_got} against {s_want}"
+        );
+        pooled_slots += usize::from(s_want > 0.0);
+        for c in 0..3 {
+            let scale = want[c]
+                .abs()
+                .max(1e-3 * want.iter().copied().fold(0.0, f64::max));
+            assert!(
+                (got[c] - want[c]).abs() <= 2e-4 * scale + 1e-12,
+                "slot {slot} channel {c}: {} against {}",
+                got[c],
+                want[c]
+            );
+        }
+    }
+    assert!(
+        pooled_slots * 2 > reference.1.len(),
+        "{pooled_slots} pooled"
+    );
+}
+
+/// The pooling of `pool.rs`, one pixel at a time in f64 (its rule restated, not its code).
+fn reference_pooling(m: &PhotonMapper) -> (Vec<[f64; 3]>, Vec<f32>) {
+    use glam::Vec3;
+    let s = &m.slots;
+    let (w, h) = (m.setup.width as i32, m.setup.height as i32);
+    let spp = m.setup.params.film.samples_per_pixel as usize;
+    let n = s.len();
+    let own: Vec<[f64; 3]> = (0..n).map(|i| m.own_radiance(i)).collect();
+    let valid = |i: usize| m.photon_bounces[i] != super::NO_VISIBLE_POINT;
+    let same = |p: usize, q: usize| {
+        let off = s.position()[q] - s.position()[p];
+        let agree = |a: Vec3, b: Vec3| (0..3).all(|c| (a[c] - b[c]).abs() <= 0.1 * a[c].max(b[c]));
+        valid(q)
+            && s.material_idx()[p] == s.material_idx()[q]
+            && m.photon_bounces[p] == m.photon_bounces[q]
+            && s.geometric_normal()[p].dot(s.geometric_normal()[q]) >= 0.9
+            && s.shading_normal()[p].dot(s.shading_normal()[q]) >= 0.9
+            && s.geometric_normal()[p].dot(off).abs() <= 0.1 * off.length()
+            && agree(s.weight()[p], s.weight()[q])
+    };
+    let at = |i: usize, dx: i32, dy: i32| {
+        let pixel = (i / spp) as i32;
+        let (x, y) = (pixel % w + dx, pixel / w + dy);
+        (x >= 0 && y >= 0 && x < w && y < h).then(|| (y * w + x) as usize * spp + i % spp)
+    };
+    let max = m.setup.params.pool.max_pixels as i32;
+    let mut radiance = own.clone();
+    let mut widths = vec![0.0f32; n];
+    for p in 0..n {
+        if !valid(p) {
+            continue;
+        }
+        let near: Vec<f64> = [(1, 0), (-1, 0), (0, 1), (0, -1)]
+            .into_iter()
+            .filter_map(|(dx, dy)| at(p, dx, dy))
+            .filter(|&q| same(p, q))
+            .map(|q| f64::from(s.position()[p].distance(s.position()[q])))
+            .collect();
+        let footprint = near.iter().sum::<f64>() / near.len() as f64;
+        if near.is_empty() || footprint <= 0.0 {
+            continue;
+        }
+        // Geometry mode: half the window, under the clear disc's bound.
+        let mut width = 0.5 * f64::from(max) * footprint;
+        let freq = s.freq()[p];
+        if freq.clear_level() != 0
+            && let Some(clear) = freq.clear_radius(m.setup.kernel_max())
+        {
+            width = width.min(0.5 * clear);
+        }
+        if width < 0.25 * footprint {
+            continue;
+        }
+        widths[p] = width as f32;
+        let width = f64::from(width as f32);
+        let normal = s.geometric_normal()[p];
+        let (t, b) = normal.any_orthonormal_pair();
+        // Σk·[1, u, v, uu, uv, vv] and Σk·L·[1, u, v], L demodulated by the weights.
+        let mut mo = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        let wp = s.weight()[p];
+        let flat = |q: usize| -> [f64; 3] {
+            std::array::from_fn(|c| {
+                let wq = f64::from(s.weight()[q][c]);
+                if wq > 0.0 { own[q][c] / wq } else { 0.0 }
+            })
+        };
+        let mut va = [flat(p), [0.0; 3], [0.0; 3]];
+        for dy in -max..=max {
+            for dx in -max..=max {
+                let ring = dx.abs().max(dy.abs()) > 2;
+                if (dx == 0 && dy == 0)
+                    || dx * dx + dy * dy > max * max
+                    || (ring && (dx % 2 != 0 || dy % 2 != 0))
+                {
+                    continue;
+                }
+                let Some(q) = at(p, dx, dy) else { continue };
+                let off = s.position()[q] - s.position()[p];
+                let d2 = f64::from(off.length_squared());
+                if d2 > 9.0 * width * width || !same(p, q) {
+                    continue;
+                }
+                let area = if ring { 4.0 } else { 1.0 };
+                let k = area * (-d2 / (2.0 * width * width)).exp();
+                let (u, v) = (f64::from(off.dot(t)) / width, f64::from(off.dot(b)) / width);
+                for (j, x) in [1.0, u, v, u * u, u * v, v * v].into_iter().enumerate() {
+                    mo[j] += k * x;
+                }
+                let l = flat(q);
+                for c in 0..3 {
+                    va[0][c] += k * l[c];
+                    va[1][c] += k * u * l[c];
+                    va[2][c] += k * v * l[c];
+                }
+            }
+        }
+        let [m0, mu, mv, muu, muv, mvv] = mo;
+        let (cu, cv) = (mu / m0, mv / m0);
+        let (suu, suv, svv) = (muu / m0 - cu * cu, muv / m0 - cu * cv, mvv / m0 - cv * cv);
+        let det = suu * svv - suv * suv;
+        for c in 0..3 {
+            let mean = va[0][c] / m0;
+            let value = if det.is_nan() || det <= 1e-3 {
+                mean
+            } else {
+                let lu = va[1][c] / m0 - cu * mean;
+                let lv = va[2][c] / m0 - cv * mean;
+                let gu = (svv * lu - suv * lv) / det;
+                let gv = (suu * lv - suv * lu) / det;
+                mean - gu * cu - gv * cv
+            };
+            if wp[c] > 0.0 {
+                radiance[p][c] = f64::from(wp[c]) * value;
+            }
+        }
+    }
+    (radiance, widths)
+}
