@@ -392,7 +392,7 @@ impl LiveArgs {
             preview => {
                 self.preview = preview;
                 crate::usage!(
-                    "fppm render needs a scene file (fppm alone renders the built-in default scene)"
+                    "fppm render needs a SCENE file (fppm alone renders the built-in default scene)"
                 )
             }
         }

@@ -638,5 +638,5 @@ fn a_scene_after_a_bare_preview_flag_is_the_scene() {
     );
     assert!(dir.join("fppm.exr").exists());
     fppm(&dir, &["render", "--preview", "127.0.0.1:0"])
-        .fails(2, &["fppm render needs a scene file"]);
+        .fails(2, &["fppm render needs a SCENE file"]);
 }
