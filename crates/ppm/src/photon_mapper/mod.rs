@@ -278,8 +278,14 @@ impl PhotonMapper {
         if matches!(aov, Aov::FreqRadius | Aov::FreqHeld) && !params.method.uses_frequency() {
             return None;
         }
-        let pool_width =
-            (aov == Aov::PoolWidth && !self.slots.is_empty()).then(|| self.pooled().width);
+        let pool_width = (aov == Aov::PoolWidth && !self.slots.is_empty()).then(|| {
+            let mut widths = vec![0.0f32; self.slots.len()];
+            let per_row = self.setup.width as usize * params.film.samples_per_pixel as usize;
+            self.pool_bands(&mut widths, per_row, |_, out, _, width| {
+                out.copy_from_slice(width);
+            });
+            widths
+        });
         let spp = params.film.samples_per_pixel as usize;
         let n_pixels = self.setup.width as usize * self.setup.height as usize;
         let slots = &self.slots;
@@ -359,17 +365,22 @@ impl Integrator for PhotonMapper {
         if self.slots.is_empty() {
             return image;
         }
-        let photons = self.pooled().radiance;
         let camera_passes = f64::from(self.camera_passes.max(1));
-        image.par_iter_mut().enumerate().for_each(|(pixel, out)| {
-            let mut sum = [0.0f64; 3];
-            let slots = pixel * spp..(pixel + 1) * spp;
-            for (photons, direct) in photons[slots.clone()].iter().zip(&self.direct[slots]) {
-                for c in 0..3 {
-                    sum[c] += photons[c] + direct[c] / camera_passes;
+        let width = self.setup.width as usize;
+        // Band by band, each pixel's slots summed in f64: the image is the only image-sized
+        // buffer a read-out writes.
+        self.pool_bands(&mut image, width, |first_slot, band, photons, _| {
+            let direct = &self.direct[first_slot..];
+            for (pixel, out) in band.iter_mut().enumerate() {
+                let slots = pixel * spp..(pixel + 1) * spp;
+                let mut sum = [0.0f64; 3];
+                for (photons, direct) in photons[slots.clone()].iter().zip(&direct[slots]) {
+                    for c in 0..3 {
+                        sum[c] += photons[c] + direct[c] / camera_passes;
+                    }
                 }
+                *out = sum.map(|v| v as f32);
             }
-            *out = sum.map(|v| v as f32);
         });
         image
     }

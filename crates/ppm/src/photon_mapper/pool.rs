@@ -59,7 +59,8 @@ const BAND_ROWS: usize = 32;
 thread_local! {
     /// Each worker thread's planes, kept from band to band and from read-out to read-out: a
     /// band's planes are megabytes at 1920 pixels a row, and their first touch cost more than
-    /// the pooling itself. Nothing is carried over: `Planes::fill` writes every entry it reads.
+    /// the pooling itself. Nothing is carried over: `Planes::fill` writes every entry it reads, and a band's
+    /// results are cleared before it is pooled.
     static PLANES: std::cell::RefCell<Planes> = std::cell::RefCell::default();
 }
 
@@ -91,7 +92,9 @@ fn taps(radius: u32) -> Vec<Tap> {
     taps
 }
 
-/// A slot's photon radiance after pooling, and the width it pooled with.
+/// Every slot's photon radiance after pooling, and the width it pooled with (what the tests
+/// hold to a per-pixel reference).
+#[cfg(test)]
 pub(super) struct Pooled {
     /// Photon radiance per slot (τ/(πR²N) pooled), in slot order.
     pub(super) radiance: Vec<[f64; 3]>,
@@ -125,66 +128,96 @@ impl PhotonMapper {
     }
 
     /// The photon radiance of every slot, pooled as the parameters say (or each slot's own
-    /// where this render does not pool).
-    ///
-    /// The film is pooled in bands of rows, each task copying the visible points of its band
-    /// and of the window's rows around it into planes (`Planes`), eight pixels of a row at a
-    /// time: the cost is the taps' arithmetic, not page faults on image-sized buffers or
-    /// scattered loads.
+    /// where this render does not pool), and the widths.
+    #[cfg(test)]
     pub(super) fn pooled(&self) -> Pooled {
         let n = self.slots.len();
-        if !self.pools() || n == 0 {
-            let radiance = (0..n)
-                .into_par_iter()
-                .map(|slot| self.own_radiance(slot))
-                .collect();
-            return Pooled {
-                radiance,
-                width: vec![0.0; n],
-            };
-        }
+        let per_row = self.setup.width as usize * self.setup.params.film.samples_per_pixel as usize;
+        let mut out = vec![([0.0; 3], 0.0f32); n];
+        self.pool_bands(&mut out, per_row, |_, out, radiance, width| {
+            for ((o, l), s) in out.iter_mut().zip(radiance).zip(width) {
+                *o = (*l, *s);
+            }
+        });
+        let (radiance, width) = out.into_iter().unzip();
+        Pooled { radiance, width }
+    }
+
+    /// Pools the film in bands of [`BAND_ROWS`] rows, in parallel, and hands `emit` each band's
+    /// first slot, its share of `out` (`per_row` entries per row of the film), and its pooled
+    /// radiance and widths in slot order from that first slot.
+    ///
+    /// Each task copies the visible points of its band and of the window's rows around it into
+    /// planes (`Planes`) and pools eight pixels of a row at a time; the band's results live in
+    /// per-thread buffers, so a read-out touches no image-sized memory but what `emit` writes:
+    /// the cost is the taps' arithmetic, not page faults or scattered loads.
+    pub(super) fn pool_bands<T: Send>(
+        &self,
+        out: &mut [T],
+        per_row: usize,
+        emit: impl Fn(usize, &mut [T], &[[f64; 3]], &[f32]) + Sync,
+    ) {
         let film = Film {
             width: self.setup.width as usize,
             height: self.setup.height as usize,
             spp: self.setup.params.film.samples_per_pixel as usize,
         };
+        if self.slots.is_empty() || per_row == 0 {
+            return;
+        }
+        let pools = self.pools();
         let rule = WidthRule::new(self);
         let taps = taps(self.setup.params.pool.max_pixels);
         // The window's rows and columns, and at least the footprint's neighbours.
         let halo = (self.setup.params.pool.max_pixels as usize).max(1);
-        let mut radiance = vec![[0.0; 3]; n];
-        let mut width = vec![0.0f32; n];
-        let band_slots = BAND_ROWS * film.width * film.spp;
-        radiance
-            .par_chunks_mut(band_slots)
-            .zip(width.par_chunks_mut(band_slots))
+        out.par_chunks_mut(BAND_ROWS * per_row)
             .enumerate()
-            .for_each(|(band, (radiance, width))| {
+            .for_each(|(band, out)| {
                 PLANES.with_borrow_mut(|planes| {
                     let rows = band * BAND_ROWS..((band + 1) * BAND_ROWS).min(film.height);
                     let first_slot = rows.start * film.width * film.spp;
-                    for sample in 0..film.spp {
-                        let plane_rows =
-                            rows.start.saturating_sub(halo)..(rows.end + halo).min(film.height);
-                        planes.fill(self, film, sample, plane_rows, halo);
-                        for y in rows.clone() {
-                            for x0 in (0..film.width).step_by(LANES) {
-                                let out =
-                                    self.pool_group(planes, &rule, &taps, film, (x0, y), sample);
-                                for (lane, (l, s)) in out.into_iter().enumerate() {
-                                    let x = x0 + lane;
-                                    if x < film.width {
-                                        let slot = film.slot(x, y, sample) - first_slot;
-                                        radiance[slot] = l;
-                                        width[slot] = s;
+                    let slots = rows.len() * film.width * film.spp;
+                    // Taken out of the planes while `pool_group` reads them.
+                    let (mut radiance, mut width) = std::mem::take(&mut planes.band);
+                    radiance.clear();
+                    radiance.resize(slots, [0.0; 3]);
+                    width.clear();
+                    width.resize(slots, 0.0);
+                    if pools {
+                        for sample in 0..film.spp {
+                            let plane_rows =
+                                rows.start.saturating_sub(halo)..(rows.end + halo).min(film.height);
+                            planes.fill(self, film, sample, plane_rows, halo);
+                            for y in rows.clone() {
+                                for x0 in (0..film.width).step_by(LANES) {
+                                    let group = self.pool_group(
+                                        planes,
+                                        &rule,
+                                        &taps,
+                                        film,
+                                        (x0, y),
+                                        sample,
+                                    );
+                                    for (lane, (l, s)) in group.into_iter().enumerate() {
+                                        let x = x0 + lane;
+                                        if x < film.width {
+                                            let slot = film.slot(x, y, sample) - first_slot;
+                                            radiance[slot] = l;
+                                            width[slot] = s;
+                                        }
                                     }
                                 }
                             }
                         }
+                    } else {
+                        for (i, l) in radiance.iter_mut().enumerate() {
+                            *l = self.own_radiance(first_slot + i);
+                        }
                     }
+                    emit(first_slot, out, &radiance, &width);
+                    planes.band = (radiance, width);
                 });
             });
-        Pooled { radiance, width }
     }
 
     /// The pooled photon radiance and the width of the eight pixels of row `y` from `x0` on
@@ -411,6 +444,8 @@ struct Planes {
     material: Vec<u32>,
     /// The photon-bounce budget, [`NO_VISIBLE_POINT`] without a visible point.
     budget: Vec<u32>,
+    /// The band's results, in slot order: pooled radiance and width.
+    band: (Vec<[f64; 3]>, Vec<f32>),
 }
 
 impl Planes {
