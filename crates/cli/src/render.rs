@@ -248,6 +248,9 @@ fn drive(job: &Job, mut renderer: Renderer, live: Live) -> anyhow::Result<Outcom
     })
 }
 
+/// The read period over what an image read costs: the reads take at most 1/96 of the time.
+const READ_COST_RATIO: u32 = 96;
+
 /// What watches the render besides the progress line: the error trend and the live views.
 /// The image is read from the renderer at most once a pass, and only when one of them needs
 /// it: a snapshot of the trend is due, the trend is older than [`Live::PERIOD`] (every pass
@@ -259,8 +262,10 @@ struct Watch {
     trend_shown: bool,
     last_trend: Option<Instant>,
     /// What the last image read took: the views and the trend read one at most every
-    /// [`Live::PERIOD`], and no more often than keeps the reads under about 3 % of the time
-    /// (a pooled read-out of a large film takes a large part of a second).
+    /// [`Live::PERIOD`], and no more often than keeps the reads near 1 % of the time (a pooled
+    /// read-out of a large film takes a large part of a second; the page's decoding and the
+    /// PNG encoding of each image cost about as much again, and a live view may cost 3 % of a
+    /// render in all: docs/notes/preview-overhead.md).
     read_cost: Duration,
     status: Status,
 }
@@ -314,7 +319,7 @@ impl Watch {
         elapsed: Duration,
     ) -> Option<f64> {
         let passes = renderer.passes();
-        let period = Live::PERIOD.max(self.read_cost * 32);
+        let period = Live::PERIOD.max(self.read_cost * READ_COST_RATIO);
         let live_image = self.live.wants_image(period);
         let trend_due = self.trend_shown
             && (self.trend.wants(passes)

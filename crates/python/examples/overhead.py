@@ -5,7 +5,7 @@
    command (`fppm --passes N --json`, per-pass times from its `elapsed_seconds`) and then the
    module for the same passes, alternating which goes first, and compares the median pass of
    each;
-2. `Renderer.image()` of a 1920 x 1080 film (median of repeated calls).
+2. `Renderer.image()` of a 1920 x 1080 film (median of repeated calls), pooled (the default) and not.
 
     python crates/python/examples/overhead.py [--pairs 6] [--passes 16] [--fppm target/release/fppm]
 """
@@ -89,20 +89,24 @@ def main() -> None:
     for who, values in OUTSIDE.items():
         print(f"time of a pass outside its phases, {who}: median {statistics.median(values) * 1e3:.2f} ms")
 
-    big = fppm.Renderer(fppm.default_scene(width=1920, height=1080), photons_per_pass="100k")
-    big.iterate(2)
-    big.image()  # warm
-    times = []
-    for _ in range(args.image_calls):
-        start = time.perf_counter()
-        image = big.image()
-        times.append(time.perf_counter() - start)
-    assert image.shape == (1080, 1920, 3)
-    print(
-        f"image() 1920x1080 ({big.method}): median {statistics.median(times) * 1e3:.1f} ms, "
-        f"min {min(times) * 1e3:.1f} ms, max {max(times) * 1e3:.1f} ms over {args.image_calls} calls"
-    )
-
+    # The default read-out pools neighbouring pixels (`pool`, docs/integrators.md), whose cost
+    # grows with the film; `pool="off"` is the read-out of the pixels' own estimates.
+    for pool in ("freq", "off"):
+        big = fppm.Renderer(
+            fppm.default_scene(width=1920, height=1080), photons_per_pass="100k", pool=pool
+        )
+        big.iterate(2)
+        big.image()  # warm
+        times = []
+        for _ in range(args.image_calls):
+            start = time.perf_counter()
+            image = big.image()
+            times.append(time.perf_counter() - start)
+        assert image.shape == (1080, 1920, 3)
+        print(
+            f"image() 1920x1080 ({big.method}, pool {pool}): median {statistics.median(times) * 1e3:.1f} ms, "
+            f"min {min(times) * 1e3:.1f} ms, max {max(times) * 1e3:.1f} ms over {args.image_calls} calls"
+        )
 
 if __name__ == "__main__":
     main()
