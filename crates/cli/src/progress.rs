@@ -55,6 +55,8 @@ pub(crate) struct Progress {
     pub(crate) non_finite: u64,
     /// The latest error trend (`trend.rs`), shown until the next one.
     trend: Option<f64>,
+    /// The passes after which it was measured.
+    trend_pass: Option<u32>,
 }
 
 impl Progress {
@@ -79,13 +81,8 @@ impl Progress {
             first_pass,
             non_finite: 0,
             trend: None,
+            trend_pass: None,
         }
-    }
-
-    /// Whether every pass needs the error trend (the JSON lines carry it), rather than the
-    /// latest one at most every half second.
-    pub(crate) fn trend_every_pass(&self) -> bool {
-        self.json
     }
 
     /// The outlook after `passes` passes, `elapsed` into this run.
@@ -105,6 +102,7 @@ impl Progress {
         self.non_finite += stats.non_finite;
         if trend.is_some() {
             self.trend = trend;
+            self.trend_pass = Some(passes);
         }
         if self.json {
             let line = serde_json::json!({
@@ -134,7 +132,10 @@ impl Progress {
                 },
                 "photons_emitted": renderer.photons_emitted(),
                 "elapsed_seconds": elapsed.as_secs_f64(),
-                "error_trend": trend,
+                // The latest trend and the passes it was measured after: measuring it reads
+                // the image, which costs too much to do after every pass (`Watch::after_pass`).
+                "error_trend": self.trend,
+                "error_trend_pass": self.trend_pass,
             });
             // A closed stdout is not worth stopping the render for.
             let _ = crate::print_stdout(&format!("{line}\n"));

@@ -253,8 +253,8 @@ const READ_COST_RATIO: u32 = 96;
 
 /// What watches the render besides the progress line: the error trend and the live views.
 /// The image is read from the renderer at most once a pass, and only when one of them needs
-/// it: a snapshot of the trend is due, the trend is older than [`Live::PERIOD`] (every pass
-/// with --json), or a live view wants an image.
+/// it: a snapshot of the trend is due, the trend is older than the read period (at least
+/// [`Live::PERIOD`], longer where a read is costly), or a live view wants an image.
 struct Watch {
     live: Live,
     trend: Trend,
@@ -322,9 +322,7 @@ impl Watch {
         let period = Live::PERIOD.max(self.read_cost * READ_COST_RATIO);
         let live_image = self.live.wants_image(period);
         let trend_due = self.trend_shown
-            && (self.trend.wants(passes)
-                || progress.trend_every_pass()
-                || self.last_trend.is_none_or(|t| t.elapsed() >= period));
+            && (self.trend.wants(passes) || self.last_trend.is_none_or(|t| t.elapsed() >= period));
         if !live_image && !trend_due {
             self.status(renderer, progress, elapsed);
             self.live.publish(&self.status, None);

@@ -252,25 +252,41 @@ fn live_views_leave_the_image_bit_identical() {
     );
 }
 
-/// `--json` carries the error trend on every pass from the second on, and it falls.
+/// `--json` carries the latest error trend on every pass from the second on, with the passes
+/// it was measured after: every snapshot pass (2, 4, 8, 16) at least, and it falls.
 #[test]
 fn json_carries_the_error_trend() {
     let dir = temp_dir("live-trend");
     let run = render_cornell(&dir, &["--passes", "16", "--json"]).ok();
-    let trends: Vec<Option<f64>> = run
+    let trends: Vec<(Option<f64>, Option<u64>)> = run
         .stdout
         .lines()
         .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
         .filter(|v| v["event"] == "pass")
-        .map(|v| v["error_trend"].as_f64())
+        .map(|v| (v["error_trend"].as_f64(), v["error_trend_pass"].as_u64()))
         .collect();
     assert_eq!(trends.len(), 16);
-    assert_eq!(trends[0], None);
-    let values: Vec<f64> = trends[1..].iter().map(|t| t.expect("a trend")).collect();
-    assert!(values.iter().all(|&t| t > 0.0 && t < 10.0), "{values:?}");
-    assert!(values[14] < values[0], "{values:?}");
+    assert_eq!(trends[0], (None, None));
+    let mut measured = Vec::new();
+    for (i, &(trend, at)) in trends.iter().enumerate().skip(1) {
+        let passes = i as u64 + 1;
+        let (trend, at) = (trend.expect("a trend"), at.expect("its pass"));
+        assert!(trend > 0.0 && trend < 10.0, "{trends:?}");
+        assert!(at <= passes, "{trends:?}");
+        if at == passes {
+            measured.push((passes, trend));
+        } else {
+            // Carried from the pass it was measured after.
+            assert_eq!(Some(trend), trends[at as usize - 1].0, "{trends:?}");
+        }
+    }
+    for snapshot in [2, 4, 8, 16] {
+        assert!(measured.iter().any(|&(p, _)| p == snapshot), "{measured:?}");
+    }
+    let (first, last) = (measured[0].1, measured[measured.len() - 1].1);
+    assert!(last < first, "{measured:?}");
     let done: serde_json::Value = serde_json::from_str(run.stdout.lines().last().unwrap()).unwrap();
-    assert_eq!(done["error_trend"].as_f64(), Some(values[14]));
+    assert_eq!(done["error_trend"].as_f64(), Some(last));
 }
 
 #[test]
