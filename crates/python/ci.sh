@@ -3,7 +3,7 @@
 # (crates/python/tests) against it and against the fppm command of this checkout, which it builds
 # too (the bit-identity tests compare the two). `.ci/run` calls it; it also works alone.
 #
-# The venv (target/python-venv) is made if missing, with maturin, pytest and numpy from PyPI;
+# The venv (target/python-venv) is made if missing, with maturin, pytest, numpy and mypy from PyPI;
 # `FPPM_PYTHON` names the interpreter to make it with (default python3, which must be 3.11 or
 # later). Fails when a test fails.
 set -euo pipefail
@@ -19,7 +19,7 @@ if [[ ! -x "$venv/bin/python" ]]; then
 fi
 export PATH="$PWD/$venv/bin:$PATH" VIRTUAL_ENV="$PWD/$venv"
 # Quick when they are there: pip does not ask the registry about what is installed.
-"$venv/bin/python" -m pip install --quiet --disable-pip-version-check maturin pytest numpy
+"$venv/bin/python" -m pip install --quiet --disable-pip-version-check maturin pytest numpy mypy
 
 echo "== cargo build --release -p cli (the command the tests compare with)"
 cargo build --release -p cli
@@ -33,3 +33,6 @@ echo "== pip install ./crates/python (maturin, release)"
 
 echo "== pytest crates/python/tests"
 "$venv/bin/python" -m pytest -q crates/python/tests
+
+echo "== mypy stubtest fppm (the type stubs against the built module)"
+"$venv/bin/python" -m mypy.stubtest fppm --allowlist crates/python/stubtest-allowlist.txt

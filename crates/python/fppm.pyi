@@ -7,10 +7,27 @@ compare EXR files. The render parameters are those of the `fppm` command and of 
 """
 
 import os
-from typing import Any, Literal, Mapping, Sequence, TypedDict
+from typing import Any, Literal, Mapping, Sequence, TypedDict, final
 
 import numpy as np
 import numpy.typing as npt
+
+__all__ = [
+    "SceneError",
+    "InternalError",
+    "__version__",
+    "AOVS",
+    "Scene",
+    "Renderer",
+    "load",
+    "load_string",
+    "default_scene",
+    "parameters",
+    "write_exr",
+    "read_exr",
+    "diff",
+    "_internal_error_for_tests",
+]
 
 __version__: str
 
@@ -82,6 +99,7 @@ class ParameterInfo(TypedDict):
     choices: list[str]
     switch: bool
 
+@final
 class Scene:
     """A loaded scene, ready to render; immutable, shareable between renderers."""
 
@@ -142,6 +160,7 @@ def default_scene(*, width: int | None = None, height: int | None = None) -> Sce
 def parameters() -> dict[str, ParameterInfo]:
     """Every render parameter by name: help, default, choices, whether it is a switch."""
 
+@final
 class Renderer:
     """A progressive render: `iterate`/`render` passes, read `image`/`aov` at any time.
 
@@ -153,15 +172,15 @@ class Renderer:
     the command's one-line message, TypeError (a value not str/int/float/bool).
     """
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         scene: Scene,
         method: Method | str | None = None,
         *,
         threads: int | None = None,
         max_memory: int | Literal["none"] | None = None,
         **params: ParamValue,
-    ) -> None: ...
+    ) -> Renderer: ...
     @staticmethod
     def restore(scene: Scene, data: bytes, *, threads: int | None = None) -> Renderer:
         """A renderer from `save_state()` bytes or an `fppm render --checkpoint` file's bytes;
@@ -184,7 +203,7 @@ class Renderer:
         """The exact state, in the format of `fppm render --checkpoint`."""
     def params(self) -> dict[str, str]:
         """Every render parameter of this render by name, as text."""
-    def write_exr(self, path: StrPath, aovs: Sequence[str] = ()) -> None:
+    def write_exr(self, path: StrPath, aovs: Sequence[str] = ...) -> None:
         """Writes the image as `fppm render -o` does (AOV channels, parameters as metadata)."""
     def _internal_error_for_tests(self) -> None: ...
     @property
