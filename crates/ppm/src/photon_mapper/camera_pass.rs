@@ -99,7 +99,12 @@ impl PhotonMapper {
             self.slots = HitPoints::with_capacity(n_slots);
             self.direct = vec![[0.0; 3]; n_slots];
             self.photon_bounces = vec![NO_VISIBLE_POINT; n_slots];
+            self.mean_weight = vec![Vec3::ZERO; n_slots];
+            self.weight_passes = 0;
         }
+        self.weight_passes += 1;
+        // Running means, exact in any order of passes: m += (w − m)/n.
+        let inv_passes = 1.0 / self.weight_passes as f32;
         let mut non_finite = 0;
         for (slot, sample) in traced.into_iter().enumerate() {
             non_finite += sample.non_finite;
@@ -118,6 +123,8 @@ impl PhotonMapper {
                 bounces: 0,
             });
             // Visible points have bounces < max_depth ≤ 1024 (`trace_camera_path`).
+            let mean = &mut self.mean_weight[slot];
+            *mean += (point.weight - *mean) * inv_passes;
             let budget = (setup.params.budget.max_depth - 1).saturating_sub(point.bounces);
             self.photon_bounces[slot] = match sample.visible {
                 Some(_) => u16::try_from(budget).unwrap_or(NO_VISIBLE_POINT - 1),

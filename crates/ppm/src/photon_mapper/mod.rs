@@ -77,6 +77,13 @@ pub(crate) struct PhotonMapper {
     /// Per slot: sum of directly seen emission (and direct lighting) over camera passes.
     direct: Vec<[f64; 3]>,
     camera_passes: u32,
+    /// Per slot: the mean of its visible points' weights over the camera passes that placed
+    /// them (zero for a pass without one). The photon radiance τ/(πR²N) is the mean over those
+    /// passes of weight × irradiance, so this, not the last pass's weight, is what the pooling
+    /// divides it by and multiplies it back with (`pool.rs`).
+    mean_weight: Vec<glam::Vec3>,
+    /// The camera passes that placed visible points (every pass for SPPM, the first for PPM).
+    weight_passes: u32,
     /// Phase 2's grid.
     index: Index,
     /// Phase 3's buffers, and M and Φ of the last pass for phase 4.
@@ -148,6 +155,8 @@ impl PhotonMapper {
             photon_bounces: Vec::new(),
             direct: Vec::new(),
             camera_passes: 0,
+            mean_weight: Vec::new(),
+            weight_passes: 0,
             index: Index::default(),
             photons: PhotonPass::default(),
             frequency: FrequencyDeposits::default(),

@@ -15,8 +15,10 @@
 //! Neighbours count only on the same surface: a valid visible point of the same material and
 //! photon-bounce budget, normals within about 25°, close to the pixel's tangent plane, and a
 //! hitpoint weight (the texture and the specular throughput that lead to it) within 10 % per
-//! channel; their radiance is demodulated by that weight (L_q·w_p/w_q), so a texture is not
-//! blurred. Where the pixel's gather disc is not clear of other surfaces (a probed clear
+//! channel; their radiance is demodulated by that weight (L_q·w̄_p/w̄_q), so a texture is not
+//! blurred. The weights are each slot's mean over the passes' visible points (`mean_weight`),
+//! not the last pass's: τ sums the passes' weight × irradiance, and the last weight (one texel
+//! of the pixel, one throughput through glass) would scale the pooled value by a single sample. Where the pixel's gather disc is not clear of other surfaces (a probed clear
 //! radius below the largest kernel), the width is at most half that radius.
 //!
 //! Consistency: beyond n₀ = 10⁷ photons counted the width shrinks as (n₀/n)^decay, so the image
@@ -487,7 +489,8 @@ impl Planes {
                     self.clear(at);
                     continue;
                 }
-                let weight = slots.weight()[slot];
+                // The mean weight of the passes, which the radiance carries (not the last one's).
+                let weight = mapper.mean_weight[slot];
                 let own = mapper.own_radiance(slot);
                 let flat = std::array::from_fn(|c| {
                     if weight[c] > 0.0 {

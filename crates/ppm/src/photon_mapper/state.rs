@@ -1,5 +1,6 @@
 //! What a checkpoint keeps of a photon mapper: every hitpoint slot's record, its photon-bounce
-//! budget and directly seen emission, and the photon and camera-pass counts.
+//! budget, directly seen emission and mean visible-point weight, and the photon and camera-pass
+//! counts.
 
 use glam::Vec3;
 use photon::{HitPoints, NewHitPoint};
@@ -10,11 +11,11 @@ use super::{MAX_PHOTON_BUDGET, NO_VISIBLE_POINT, PhotonMapper};
 use crate::checkpoint::codec::{Reader, StateError, Writer};
 
 /// Bytes of a slot's record in [`PhotonMapper::write_state`], with a spectrum.
-const SLOT_RECORD_MAX: usize = 5 * 12 + 4 + 4 + 8 + 8 + 24 + 4 + 4 + 4 + 4 + 32 + 4 + 4 + 24;
+const SLOT_RECORD_MAX: usize = 5 * 12 + 4 + 4 + 8 + 8 + 24 + 4 + 4 + 4 + 4 + 32 + 4 + 4 + 24 + 12;
 
 /// The most bytes [`PhotonMapper::write_state`] writes for `n_slots` slots.
 pub(super) fn bound(n_slots: usize) -> usize {
-    8 + 4 + 8 + n_slots.saturating_mul(SLOT_RECORD_MAX)
+    8 + 4 + 4 + 8 + n_slots.saturating_mul(SLOT_RECORD_MAX)
 }
 
 impl PhotonMapper {
@@ -25,6 +26,7 @@ impl PhotonMapper {
         let p = self;
         w.u64(p.n_emitted);
         w.u32(p.camera_passes);
+        w.u32(p.weight_passes);
         let s = &p.slots;
         let spp = p.setup.params.film.samples_per_pixel as usize;
         w.u64(s.len() as u64);
@@ -66,6 +68,7 @@ impl PhotonMapper {
                 p.setup.params.budget.max_depth - 1
             });
             p.direct[i].iter().for_each(|&c| w.f64(c));
+            p.mean_weight[i].to_array().iter().for_each(|&c| w.f32(c));
         }
     }
 
@@ -74,10 +77,12 @@ impl PhotonMapper {
         let p = self;
         let n_emitted = r.u64()?;
         let camera_passes = r.u32()?;
+        let weight_passes = r.u32()?;
         // Every pass emits `photons_per_pass` and runs at most one camera pass; the photon indices
         // of the next pass start at `n_emitted`.
         if n_emitted != u64::from(passes) * u64::from(p.setup.params.budget.photons_per_pass)
             || camera_passes > passes
+            || weight_passes > camera_passes
         {
             return Err(StateError::Corrupt);
         }
@@ -90,6 +95,7 @@ impl PhotonMapper {
         let mut stats = Vec::with_capacity(n);
         let mut photon_budget = Vec::with_capacity(n);
         let mut direct = Vec::with_capacity(n);
+        let mut mean_weight = Vec::with_capacity(n);
         for i in 0..n {
             let mut v = [Vec3::ZERO; 5];
             for item in &mut v {
@@ -127,6 +133,7 @@ impl PhotonMapper {
                 .ok_or(StateError::Corrupt)?;
             photon_budget.push(if valid { budget } else { NO_VISIBLE_POINT });
             direct.push([r.f64()?, r.f64()?, r.f64()?]);
+            mean_weight.push(Vec3::new(r.f32()?, r.f32()?, r.f32()?));
             slots.push(NewHitPoint {
                 position: v[0],
                 shading_normal: v[1],
@@ -155,6 +162,8 @@ impl PhotonMapper {
         p.slots = slots;
         p.photon_bounces = photon_budget;
         p.direct = direct;
+        p.mean_weight = mean_weight;
+        p.weight_passes = weight_passes;
         Ok(())
     }
 }

@@ -174,7 +174,7 @@ fn reference_pooling(m: &PhotonMapper) -> (Vec<[f64; 3]>, Vec<f32>) {
             && s.geometric_normal()[p].dot(s.geometric_normal()[q]) >= 0.9
             && s.shading_normal()[p].dot(s.shading_normal()[q]) >= 0.9
             && s.geometric_normal()[p].dot(off).abs() <= 0.1 * off.length()
-            && agree(s.weight()[p], s.weight()[q])
+            && agree(m.mean_weight[p], m.mean_weight[q])
     };
     let at = |i: usize, dx: i32, dy: i32| {
         let pixel = (i / spp) as i32;
@@ -215,10 +215,10 @@ fn reference_pooling(m: &PhotonMapper) -> (Vec<[f64; 3]>, Vec<f32>) {
         let (t, b) = normal.any_orthonormal_pair();
         // Σk·[1, u, v, uu, uv, vv] and Σk·L·[1, u, v], L demodulated by the weights.
         let mut mo = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
-        let wp = s.weight()[p];
+        let wp = m.mean_weight[p];
         let flat = |q: usize| -> [f64; 3] {
             std::array::from_fn(|c| {
-                let wq = f64::from(s.weight()[q][c]);
+                let wq = f64::from(m.mean_weight[q][c]);
                 if wq > 0.0 { own[q][c] / wq } else { 0.0 }
             })
         };
@@ -273,4 +273,54 @@ fn reference_pooling(m: &PhotonMapper) -> (Vec<[f64; 3]>, Vec<f32>) {
         }
     }
     (radiance, widths)
+}
+
+/// The pooling divides each slot's photon radiance by the mean of its visible points' weights
+/// over the passes (which its τ carries) rather than by the last pass's: that running mean is
+/// the plain mean of the weights the passes placed, recorded here pass by pass, on a textured
+/// floor whose texel under a pixel changes with each pass's jitter.
+#[test]
+fn mean_weight_is_the_mean_of_the_passes_weights() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes/peers/textured-room.toml");
+    let mut description = import::load(&path).unwrap();
+    description.film = scene::Film {
+        width: 32,
+        height: 32,
+    };
+    let scene = Arc::new(Scene::new(description).unwrap());
+    let mut params = RenderParams::preview();
+    params.method = Method::FreqSppm;
+    params.budget.photons_per_pass = 5_000;
+    let mut mapper = PhotonMapper::new(scene, params).unwrap();
+    let passes = 6;
+    let mut seen: Vec<Vec<glam::Vec3>> = Vec::new();
+    for _ in 0..passes {
+        mapper.iterate();
+        seen.push(mapper.slots.weight().to_vec());
+    }
+    let n = mapper.slots.len();
+    let mut varied = 0;
+    for slot in 0..n {
+        let weights: Vec<glam::Vec3> = seen.iter().map(|w| w[slot]).collect();
+        let mean: [f64; 3] = std::array::from_fn(|c| {
+            weights.iter().map(|w| f64::from(w[c])).sum::<f64>() / f64::from(passes)
+        });
+        for (c, &mean) in mean.iter().enumerate() {
+            let kept = f64::from(mapper.mean_weight[slot][c]);
+            assert!(
+                (kept - mean).abs() <= 1e-5 * mean.max(1e-3),
+                "slot {slot}: {kept} against {mean}"
+            );
+        }
+        let (lo, hi) = weights.iter().fold((f32::INFINITY, 0.0f32), |(lo, hi), w| {
+            (lo.min(w.x), hi.max(w.x))
+        });
+        varied += usize::from(lo > 0.0 && hi > 1.05 * lo);
+    }
+    // The check means something: the weights of many slots change from pass to pass.
+    assert!(
+        varied > n / 20,
+        "{varied} of {n} slots have varying weights"
+    );
 }
