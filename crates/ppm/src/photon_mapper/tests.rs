@@ -28,16 +28,19 @@ fn tags_pack_chunk_and_record_indices_when_they_fit() {
     assert!(last < UNTAGGED);
 }
 
+/// The scene file at `path` (relative to this crate) with a film of `width` × `height`.
+fn scene_at(path: &str, width: u32, height: u32) -> Arc<Scene> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+    let mut description = import::load(&path).unwrap();
+    description.film = scene::Film { width, height };
+    Arc::new(Scene::new(description).unwrap())
+}
+
+const CORNELL_SPHERE: &str = "../../../shared/scenes/cornell_box/CornellBox-Sphere.obj";
+
 /// The shared CornellBox-Sphere at 24 × 24.
 fn cornell_sphere_24() -> Arc<Scene> {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/scenes/cornell_box/CornellBox-Sphere.obj");
-    let mut description = import::load(&path).unwrap();
-    description.film = scene::Film {
-        width: 24,
-        height: 24,
-    };
-    Arc::new(Scene::new(description).unwrap())
+    scene_at(CORNELL_SPHERE, 24, 24)
 }
 
 #[test]
@@ -110,14 +113,7 @@ fn block_discs_recomputed_mid_epoch_are_those_of_the_epoch_start() {
 /// two samples per pixel and a window that reaches over band edges.
 #[test]
 fn pooling_matches_a_per_pixel_reference() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/scenes/cornell_box/CornellBox-Sphere.obj");
-    let mut description = import::load(&path).unwrap();
-    description.film = scene::Film {
-        width: 45,
-        height: 70,
-    };
-    let scene = Arc::new(Scene::new(description).unwrap());
+    let scene = scene_at(CORNELL_SPHERE, 45, 70);
     let mut params = RenderParams::preview();
     params.method = Method::FreqSppm;
     params.budget.photons_per_pass = 20_000;
@@ -281,14 +277,7 @@ fn reference_pooling(m: &PhotonMapper) -> (Vec<[f64; 3]>, Vec<f32>) {
 /// floor whose texel under a pixel changes with each pass's jitter.
 #[test]
 fn mean_weight_is_the_mean_of_the_passes_weights() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenes/peers/textured-room.toml");
-    let mut description = import::load(&path).unwrap();
-    description.film = scene::Film {
-        width: 32,
-        height: 32,
-    };
-    let scene = Arc::new(Scene::new(description).unwrap());
+    let scene = scene_at("../../scenes/peers/textured-room.toml", 32, 32);
     let mut params = RenderParams::preview();
     params.method = Method::FreqSppm;
     params.budget.photons_per_pass = 5_000;
