@@ -22,6 +22,7 @@ pub(crate) const HELP: &str = "\
 cargo xtask peers [--scenes a,b,...] [--seconds 60] [--film WxH] [--threads 2]
                   [--methods freq-sppm,sppm,freq,ppm] [--peers path,ptracer]
                   [--reference-seconds 1200] [--out DIR] [--fppm-args \"...\"] [--paths N]
+                  [--fppm FILE]
 
 Renders every scene of scenes/peers/ (or those named: a name of scenes/peers/ or the path of any
 scene file fppm reads, e.g. ../shared/scenes/cornell_box/CornellBox-Water.obj) with each fppm method and each Mitsuba 3
@@ -39,7 +40,11 @@ mitsuba drjit numpy; the llvm_ad_rgb variant needs Debian's libllvm19).
 --paths N (e.g. 117M) compares at an equal path count instead of equal time: each fppm method
 traces N light paths (--passes and --photons-per-pass, at most 10^6 per pass) and each Mitsuba
 integrator renders N / (width x height) samples per pixel (for `ptracer`, N light paths); use it
-with --methods light --peers ptracer to compare the two light tracers' variance.";
+with --methods light --peers ptracer to compare the two light tracers' variance.
+
+--fppm FILE runs that fppm binary instead of building this checkout's: another build scored
+against the same references (copy DIR/SCENE/ of the first run into the second's --out to reuse
+them).";
 
 /// The scenes of the comparison, in `scenes/peers/`.
 const SCENES: [&str; 4] = [
@@ -61,6 +66,8 @@ struct Flags {
     fppm_args: Vec<String>,
     /// Light paths per renderer, instead of equal time.
     paths: Option<u64>,
+    /// Another fppm binary to run instead of this checkout's.
+    fppm: Option<PathBuf>,
 }
 
 impl Flags {
@@ -78,6 +85,7 @@ impl Flags {
             out: None,
             fppm_args: Vec::new(),
             paths: None,
+            fppm: None,
         };
         let mut it = args.iter();
         while let Some(flag) = it.next() {
@@ -109,6 +117,7 @@ impl Flags {
                     flags.fppm_args = value()?.split_whitespace().map(str::to_owned).collect();
                 }
                 "--paths" => flags.paths = Some(parse_count(&value()?)?),
+                "--fppm" => flags.fppm = Some(PathBuf::from(value()?)),
                 other => bail!("unknown flag {other} (see cargo xtask peers --help)"),
             }
         }
@@ -183,7 +192,10 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     let python = ensure_venv(root)?;
     let script = root.join("xtask/peers/render_mitsuba.py");
-    let fppm = build_fppm(root)?;
+    let fppm = match &flags.fppm {
+        Some(path) => path.clone(),
+        None => build_fppm(root)?,
+    };
 
     let mut rows = Vec::new();
     let mut noise_lines = Vec::new();
