@@ -108,5 +108,6 @@ def main() -> None:
             f"min {min(times) * 1e3:.1f} ms, max {max(times) * 1e3:.1f} ms over {args.image_calls} calls"
         )
 
+
 if __name__ == "__main__":
     main()

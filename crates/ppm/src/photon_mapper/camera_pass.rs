@@ -103,7 +103,8 @@ impl PhotonMapper {
             self.weight_passes = 0;
         }
         self.weight_passes += 1;
-        // Running means, exact in any order of passes: m += (w − m)/n.
+        // Each slot's running mean of its weights, m += (w − m)/n: the same passes give the same
+        // bits, whatever the thread count (this loop is serial).
         let inv_passes = 1.0 / self.weight_passes as f32;
         let mut non_finite = 0;
         for (slot, sample) in traced.into_iter().enumerate() {
@@ -122,9 +123,9 @@ impl PhotonMapper {
                 mu_o: 1.0,
                 bounces: 0,
             });
-            // Visible points have bounces < max_depth ≤ 1024 (`trace_camera_path`).
             let mean = &mut self.mean_weight[slot];
             *mean += (point.weight - *mean) * inv_passes;
+            // Visible points have bounces < max_depth ≤ 1024 (`trace_camera_path`).
             let budget = (setup.params.budget.max_depth - 1).saturating_sub(point.bounces);
             self.photon_bounces[slot] = match sample.visible {
                 Some(_) => u16::try_from(budget).unwrap_or(NO_VISIBLE_POINT - 1),

@@ -28,8 +28,8 @@ const CHECKPOINT_BYTES_PER_SLOT: u64 = 272;
 /// Memory per hitpoint slot of the photon mappers' fixed columns: the hitpoint record
 /// (`photon::HitPoints` with the frequency state) plus the renderer's per-slot photon-bounce
 /// budget (which also says whether the slot is valid), direct-emission sum and mean visible-point
-/// weight. The hash grid
-/// and its slot map come on top; [`crate::Renderer::memory`] measures everything.
+/// weight. The hash grid and its slot map come on top; [`crate::Renderer::memory`] measures
+/// everything.
 #[must_use]
 pub fn bytes_per_hitpoint() -> usize {
     HitPoints::<SlotFrequency>::bytes_per_hitpoint()

@@ -18,8 +18,9 @@
 //! channel; their radiance is demodulated by that weight (L_q·w̄_p/w̄_q), so a texture is not
 //! blurred. The weights are each slot's mean over the passes' visible points (`mean_weight`),
 //! not the last pass's: τ sums the passes' weight × irradiance, and the last weight (one texel
-//! of the pixel, one throughput through glass) would scale the pooled value by a single sample. Where the pixel's gather disc is not clear of other surfaces (a probed clear
-//! radius below the largest kernel), the width is at most half that radius.
+//! of the pixel, one throughput through glass) would scale the pooled value by a single sample.
+//! Where the pixel's gather disc is not clear of other surfaces (a probed clear radius below
+//! the largest kernel), the width is at most half that radius.
 //!
 //! Consistency: beyond n₀ = 10⁷ photons counted the width shrinks as (n₀/n)^decay, so the image
 //! converges to the unpooled estimator's limit; with decay = 1/6 the pooled area shrinks as
@@ -61,8 +62,8 @@ const BAND_ROWS: usize = 32;
 thread_local! {
     /// Each worker thread's planes, kept from band to band and from read-out to read-out: a
     /// band's planes are megabytes at 1920 pixels a row, and their first touch cost more than
-    /// the pooling itself. Nothing is carried over: `Planes::fill` writes every entry it reads, and a band's
-    /// results are cleared before it is pooled.
+    /// the pooling itself. Nothing is carried over: `Planes::fill` writes every entry it reads,
+    /// and a band's results are cleared before it is pooled.
     static PLANES: std::cell::RefCell<Planes> = std::cell::RefCell::default();
 }
 
