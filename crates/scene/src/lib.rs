@@ -55,12 +55,12 @@ pub use description::{
 };
 pub use frame::Frame;
 pub use light::{
-    EmissionSample, EmitterShape, Environment, EnvironmentMap, EnvironmentRadiance, LightSample,
-    LightSampler,
+    EmissionPdf, EmissionSample, EmitterShape, Environment, EnvironmentMap, EnvironmentRadiance,
+    LightSample, LightSampler,
 };
 pub use material::{
-    Bsdf, BsdfSample, Dielectric, Diffuse, Glossy, Lobe, MaterialKind, MaterialParam, Mirror,
-    TransportMode, fresnel_dielectric, luminance,
+    Bsdf, BsdfPdfs, BsdfSample, Dielectric, Diffuse, Glossy, Lobe, MaterialKind, MaterialParam,
+    Mirror, TransportMode, fresnel_dielectric, luminance,
 };
 pub use ray::{Hit, Primitive, Ray};
 pub use scene::{Scene, SceneError};

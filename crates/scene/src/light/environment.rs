@@ -431,6 +431,12 @@ impl EnvironmentLight {
         self.power
     }
 
+    /// Area density of a photon's start on its disc, uniform over π r².
+    #[inline]
+    pub(crate) fn disc_pdf(&self) -> f32 {
+        1.0 / (PI * self.radius * self.radius)
+    }
+
     /// Radiance arriving from the world direction `direction` (unit).
     #[inline]
     pub(crate) fn eval(&self, direction: Vec3) -> Rgb {

@@ -12,6 +12,9 @@
 //!
 //! Spot falloff (pbrt-v4): intensity × smoothstep(cos θ; cos θ_cone, cos θ_start), i.e. full inside
 //! `falloff_start`, zero outside `cone_angle`, a smoothstep in cos θ between.
+//!
+//! `densities.rs` gives the densities of both samplers per kind of emitter ([`EmissionPdf`]), which
+//! the multiple importance sampling weights of bidirectional methods need.
 
 use std::f32::consts::PI;
 
@@ -26,12 +29,14 @@ use crate::{
     },
 };
 
+mod densities;
 mod emitters;
 mod environment;
 #[cfg(test)]
 mod tests;
 mod textured;
 
+pub use densities::EmissionPdf;
 use emitters::Emitter;
 pub(crate) use emitters::{Emitters, Powered, powered};
 

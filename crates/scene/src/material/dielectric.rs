@@ -47,6 +47,22 @@ impl Model for Dielectric {
         Some(self.ior)
     }
 
+    /// Fresnel's R seen from the side of `wo` for reflection, 1 − R for refraction, which is
+    /// zero under total internal reflection: the choice [`Model::sample_local`] makes, by the
+    /// same expressions.
+    #[inline]
+    fn delta_probability(&self, s: &Shading, wo: Vec3, transmission: bool) -> f32 {
+        let eta = if wo.z > 0.0 { s.eta } else { 1.0 / s.eta };
+        let r = fresnel_dielectric(wo.z.abs(), eta);
+        if !transmission {
+            r
+        } else if refract(wo, eta).is_some() {
+            1.0 - r
+        } else {
+            0.0
+        }
+    }
+
     fn sample_local(
         &self,
         s: &Shading,

@@ -35,6 +35,17 @@ impl Model for Mirror {
         Rgb::ONE
     }
 
+    /// One for the reflection of a mirror that reflects anything (its samples' `pdf`), zero for
+    /// a black one, which samples nothing, and for refraction.
+    #[inline]
+    fn delta_probability(&self, _: &Shading, _: Vec3, transmission: bool) -> f32 {
+        if transmission || self.reflectance == Rgb::ZERO {
+            0.0
+        } else {
+            1.0
+        }
+    }
+
     #[inline]
     fn sample_local(
         &self,

@@ -14,12 +14,16 @@
 //! the surface; `outgoing` points back along the path being traced (toward the camera for camera
 //! paths, toward the light for photon paths). [`Bsdf::eval`] returns f without the cosine.
 //! All materials scatter on both sides: a reflection needs `outgoing` and `incoming` on the same
-//! side of the shading normal, whichever side that is.
+//! side of the shading normal, whichever side that is. [`Bsdf::pdfs`] and
+//! [`Bsdf::sample_with_pdfs`] give the densities of an event in both directions ([`BsdfPdfs`]),
+//! for bidirectional methods.
 
 mod dielectric;
 mod diffuse;
 mod glossy;
 mod mirror;
+#[cfg(test)]
+mod pdf_tests;
 #[cfg(test)]
 mod tests;
 
@@ -71,6 +75,33 @@ pub struct BsdfSample {
     pub is_specular: bool,
     /// Whether `incoming` is on the other side of the surface than `outgoing`.
     pub is_transmission: bool,
+}
+
+/// The densities of one scattering event traced both ways, for the multiple importance sampling
+/// weights of bidirectional methods (Veach 1997, §10.2; the forward and reverse densities of
+/// Georgiev's "Implementing Vertex Connection and Merging", 2012, and of pbrt-v4's BDPT).
+///
+/// For a surface point with `outgoing` and `incoming`, `forward` is the density with which
+/// [`Bsdf::sample`] from `outgoing` draws `incoming`, and `reverse` the density with which it
+/// draws `outgoing` from `incoming`: the same event as the path from the other end samples it.
+/// - Lobes of finite density (diffuse, glossy): both are solid-angle densities (sr⁻¹), and
+///   `reverse` is `forward` with the two directions swapped ([`Bsdf::pdf`] of each order).
+/// - Delta lobes (`is_specular`: a mirror, a smooth dielectric): both are the discrete probability
+///   of choosing the lobe, from the side each direction arrives on, and the Dirac factor that
+///   both directions share is left out, as in [`BsdfSample::pdf`], SmallVCM and pbrt: one for a
+///   mirror; for a dielectric Fresnel's R seen from that side for reflection and 1 − R for
+///   refraction (equal both ways, by the reciprocity of Fresnel's equations).
+///
+/// No density depends on the [`TransportMode`]: the models choose their lobes by Fresnel and
+/// albedo, never by the mode's scaled weight, so camera and light paths sample alike.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfPdfs {
+    /// Density of drawing `incoming` from `outgoing`.
+    pub forward: f32,
+    /// Density of drawing `outgoing` from `incoming`.
+    pub reverse: f32,
+    /// Whether the event is a delta lobe's: the densities are then discrete probabilities.
+    pub is_specular: bool,
 }
 
 /// The scattering models of scene format version 1 (and its extensions): each variant holds
@@ -180,6 +211,13 @@ pub(crate) trait Model: Copy {
             "{} needs pdf_local",
             Self::NAME
         );
+        0.0
+    }
+    /// The probability that [`Model::sample_local`] from the local `wo` (either side, finite,
+    /// z ≠ 0) picks its delta refraction if `transmission`, else its delta reflection: the `pdf`
+    /// of such a sample. The default is zero, for a model without delta lobes.
+    #[inline]
+    fn delta_probability(&self, _s: &Shading, _wo: Vec3, _transmission: bool) -> f32 {
         0.0
     }
     /// Draws `incoming` for the local `wo` (either side, finite, z ≠ 0).
@@ -380,6 +418,66 @@ impl Bsdf {
             return None;
         }
         with_model!(self.kind, m => m.sample_local(&self.shading, &frame, wo, u_lobe, u, mode))
+    }
+
+    /// The densities of the lobes of finite density for the pair (see [`BsdfPdfs`]): `forward`
+    /// is [`Bsdf::pdf`]`(outgoing, incoming)` and `reverse` is `pdf(incoming, outgoing)`, bit for
+    /// bit; both zero from delta lobes, which a given pair of directions almost never meets (a
+    /// sampled delta event's probabilities come with [`Bsdf::sample_with_pdfs`]).
+    pub fn pdfs(&self, outgoing: Vec3, incoming: Vec3) -> BsdfPdfs {
+        let frame = self.frame();
+        let (wo, wi) = (frame.to_local(outgoing), frame.to_local(incoming));
+        let (forward, reverse) = if wo.z * wi.z <= 0.0 {
+            (0.0, 0.0)
+        } else {
+            // The flip of `pdf`, which mirrors both directions whichever comes first.
+            let (wo, wi) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
+            with_model!(self.kind, m => (m.pdf_local(wo, wi), m.pdf_local(wi, wo)))
+        };
+        BsdfPdfs {
+            forward,
+            reverse,
+            is_specular: false,
+        }
+    }
+
+    /// [`Bsdf::sample`] with the densities of the event it drew (see [`BsdfPdfs`]): the same
+    /// sample for the same arguments, bit for bit; `forward` is its `pdf`, `reverse` the density
+    /// of drawing `outgoing` from its `incoming`: [`Bsdf::pdf`]`(incoming, outgoing)` for a lobe of
+    /// finite density, [`Bsdf::specular_probability`]`(incoming, …)` of the same lobe for a delta
+    /// one.
+    pub fn sample_with_pdfs(
+        &self,
+        outgoing: Vec3,
+        u_lobe: f32,
+        u: Vec2,
+        mode: TransportMode,
+    ) -> Option<(BsdfSample, BsdfPdfs)> {
+        let sample = self.sample(outgoing, u_lobe, u, mode)?;
+        let reverse = if sample.is_specular {
+            self.specular_probability(sample.incoming, sample.is_transmission)
+        } else {
+            self.pdf(sample.incoming, outgoing)
+        };
+        let pdfs = BsdfPdfs {
+            forward: sample.pdf,
+            reverse,
+            is_specular: sample.is_specular,
+        };
+        Some((sample, pdfs))
+    }
+
+    /// The probability that [`Bsdf::sample`] from `outgoing` picks a delta lobe: its refraction if
+    /// `transmission`, else its reflection. It is the `pdf` of such a sample, computed the same
+    /// way: one for a mirror (zero if it is black), Fresnel's R or 1 − R seen from the side of
+    /// `outgoing` for a dielectric (1 − R is zero under total internal reflection), zero for
+    /// models without delta lobes and for an `outgoing` in the tangent plane.
+    pub fn specular_probability(&self, outgoing: Vec3, transmission: bool) -> f32 {
+        let wo = self.frame().to_local(outgoing);
+        if wo.z == 0.0 || !wo.is_finite() {
+            return 0.0;
+        }
+        with_model!(self.kind, m => m.delta_probability(&self.shading, wo, transmission))
     }
 }
 
