@@ -181,7 +181,10 @@ pub(crate) fn next_event(
     u_light: f32,
     u: Vec2,
 ) -> Rgb {
-    let Some(sample) = scene.lights().sample_direct(hit.position, u_light, u) else {
+    let Some(sample) = scene
+        .lights()
+        .sample_direct(hit.position, hit.geometric_normal, u_light, u)
+    else {
         return Rgb::ZERO;
     };
     if sample.pdf.is_nan() || sample.pdf <= 0.0 || !scene.light_visible(hit, &sample) {
@@ -215,7 +218,7 @@ pub(crate) fn bsdf_emission_weight(
     }
     let lights = scene.lights();
     let light_pdf = match next {
-        Some(next) => lights.pdf_direct(hit.position, next),
+        Some(next) => lights.pdf_direct(hit.position, hit.geometric_normal, next),
         None => lights.pdf_environment(ray.direction),
     };
     power_heuristic(sample.pdf, light_pdf)

@@ -430,6 +430,20 @@ pub const PARAMS: &[Param] = &[
         },
     },
     Param {
+        name: "direct_samples",
+        flag: "direct-samples",
+        help: "Photon mappers with direct lighting: light and BSDF sample pairs per visible point and pass, in [1, 64] [default: 4]",
+        kind: ParamKind::Value {
+            value_name: "N",
+            choices: &[],
+        },
+        get: |p| p.connections.direct_samples.to_string(),
+        set: |p, v| {
+            p.connections.direct_samples = parse_small(v)?;
+            Ok(())
+        },
+    },
+    Param {
         name: "pool",
         flag: "pool",
         help: "Photon mappers: pool the estimates of neighbouring pixels on the same surface when the image is read [default: freq]",
@@ -632,6 +646,7 @@ mod tests {
         params.frequency.floor = FrequencyFloor::Clamp;
         params.frequency.geometry = false;
         params.connections.direct_lighting = true;
+        params.connections.direct_samples = 6;
         params.kernel.alpha = 2.0 / 3.0;
         params.frequency.grow = 2.5;
         params.frequency.hold_alpha = 1.0;

@@ -170,8 +170,12 @@ impl Setup {
             if self.params.connections.direct_lighting
                 && let Some(bsdf) = self.scene.bsdf(hit)
             {
-                direct += end.throughput
-                    * self.direct_lighting(hit, &bsdf, end.outgoing, &mut end.sampler);
+                let n = self.params.connections.direct_samples.max(1);
+                let mut sum = Rgb::ZERO;
+                for _ in 0..n {
+                    sum += self.direct_lighting(hit, &bsdf, end.outgoing, &mut end.sampler);
+                }
+                direct += end.throughput * sum * (1.0 / n as f32);
             }
             // A NaN or infinite weight would spread into every photon this point gathers.
             if !end.throughput.is_finite() {

@@ -47,9 +47,15 @@ use crate::{Hit, Primitive};
 /// this convention: the Dirac factor is left out, as in SmallVCM and pbrt.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EmissionPdf {
-    /// Probability that the sampler picks the emitter: the same in
-    /// [`LightSampler::sample_emission`] and [`LightSampler::sample_direct`], by power.
+    /// The emitter's index among the sampler's (for [`LightSampler::pick_direct`]).
+    pub emitter: u32,
+    /// Probability that [`LightSampler::sample_emission`] picks the emitter, by power.
     pub pick: f32,
+    /// Probability that [`LightSampler::sample_direct`] picks the emitter from the receiving
+    /// point (by its importance there, `tree.rs`): the point that `sample_direct_with_pdf`
+    /// sampled for, the `receiver` of [`LightSampler::pdf_emission`]; zero from
+    /// `sample_emission_with_pdf`, whose receiver (the photon's next vertex) is not known yet.
+    pub pick_direct: f32,
     /// Area density (m⁻²) of the photon's start on the emitter (on the disc facing the scene for a
     /// directional or environment light); one for the delta position of a point or spot light.
     pub position: f32,
@@ -81,13 +87,13 @@ impl EmissionPdf {
         self.pick * self.position * self.direction
     }
 
-    /// pick · direct: the density of next-event estimation choosing the point, SmallVCM's
+    /// pick_direct · direct: the density of next-event estimation choosing the point, SmallVCM's
     /// `directPdfA` (`directPdfW` for an infinite light) times the probability of picking the
     /// emitter.
     #[inline]
     #[must_use]
     pub fn direct_with_pick(&self) -> f32 {
-        self.pick * self.direct
+        self.pick_direct * self.direct
     }
 }
 
@@ -103,7 +109,7 @@ impl LightSampler {
     ) -> Option<(EmissionSample, EmissionPdf)> {
         let sample = self.sample_emission(u_light, u_pos, u_dir)?;
         let (idx, _) = self.distribution.sample(u_light);
-        let mut pdf = self.emitter_pdf(idx, sample.normal, sample.direction);
+        let mut pdf = self.emitter_pdf(idx, sample.normal, sample.direction, None);
         match sample.emitter {
             // The cosine of the local direction the sampler drew, rather than that of its
             // world-space image.
@@ -129,17 +135,18 @@ impl LightSampler {
     pub fn sample_direct_with_pdf(
         &self,
         point: Vec3,
+        normal: Vec3,
         u_light: f32,
         u: Vec2,
     ) -> Option<(LightSample, EmissionPdf)> {
-        let sample = self.sample_direct(point, u_light, u)?;
-        let (idx, _) = self.distribution.sample(u_light);
+        let sample = self.sample_direct(point, normal, u_light, u)?;
+        let (idx, _) = self.direct.sample(point, normal, u_light)?;
         let normal = match self.emitters[idx] {
             // The normal at the point the sampler drew, by the same expression.
             Emitter::Sphere { .. } => uniform_sphere(u),
             _ => Vec3::ZERO,
         };
-        let mut pdf = self.emitter_pdf(idx, normal, -sample.incoming);
+        let mut pdf = self.emitter_pdf(idx, normal, -sample.incoming, Some((point, normal)));
         if let Emitter::Environment = self.emitters[idx] {
             let sky = self.sky_pdf(u)?;
             pdf.direction = sky;
@@ -149,11 +156,17 @@ impl LightSampler {
     }
 
     /// The densities with which the light sampler produces the point of `hit` on an emitter and
-    /// the unit direction `outgoing` leaving it (toward where the ray that found it came from):
-    /// what a camera path that reaches an emitter needs of the light paths (SmallVCM's
-    /// `GetRadiance`). `None` unless `hit` is on an emitting front face; the direction density is
-    /// zero for an `outgoing` behind the surface.
-    pub fn pdf_emission(&self, hit: &Hit, outgoing: Vec3) -> Option<EmissionPdf> {
+    /// the unit direction `outgoing` leaving it toward `receiver` (position and unit normal, zero
+    /// off a surface: where the ray that found it came from), and next-event estimation from
+    /// there picks it: what a camera path that reaches an emitter needs of the light paths
+    /// (SmallVCM's `GetRadiance`). `None` unless `hit` is on an emitting front face; the
+    /// direction density is zero for an `outgoing` behind the surface.
+    pub fn pdf_emission(
+        &self,
+        hit: &Hit,
+        outgoing: Vec3,
+        receiver: (Vec3, Vec3),
+    ) -> Option<EmissionPdf> {
         if !hit.front_face {
             return None;
         }
@@ -165,7 +178,7 @@ impl LightSampler {
         let &idx = idx.filter(|&&i| i != u32::MAX)?;
         // A front face's geometric normal faces the outside of a sphere, the front of a triangle
         // (whose emitter keeps its own).
-        Some(self.emitter_pdf(idx as usize, hit.geometric_normal, outgoing))
+        Some(self.emitter_pdf(idx as usize, hit.geometric_normal, outgoing, Some(receiver)))
     }
 
     /// The densities with which the light sampler produces a photon from the environment that
@@ -174,18 +187,29 @@ impl LightSampler {
     /// `direction`. `None` without an environment.
     pub fn pdf_emission_environment(&self, direction: Vec3) -> Option<EmissionPdf> {
         let (_, idx) = self.environment.as_ref()?;
-        Some(self.emitter_pdf(*idx, Vec3::ZERO, -direction))
+        // The infinite lights' share of next-event estimation does not depend on the point.
+        Some(self.emitter_pdf(*idx, Vec3::ZERO, -direction, Some((Vec3::ZERO, Vec3::ZERO))))
     }
 
     /// The densities of emitter `idx` for a start with the unit `normal` (used by a sphere only:
     /// a triangle keeps its normal, the other lights have none) and the unit direction of travel
-    /// `direction`.
-    pub(super) fn emitter_pdf(&self, idx: usize, normal: Vec3, direction: Vec3) -> EmissionPdf {
+    /// `direction`, next-event estimation's pick from `receiver` (position and normal; none: 0).
+    pub(super) fn emitter_pdf(
+        &self,
+        idx: usize,
+        normal: Vec3,
+        direction: Vec3,
+        receiver: Option<(Vec3, Vec3)>,
+    ) -> EmissionPdf {
         let pick = self.distribution.pmf(idx);
+        let pick_direct = receiver.map_or(0.0, |(p, n)| self.pick_direct(idx, p, n));
+        let emitter = idx as u32;
         let surface = |normal: Vec3, area: f32| {
             let cos = direction.dot(normal).max(0.0);
             EmissionPdf {
+                emitter,
                 pick,
+                pick_direct,
                 position: 1.0 / area,
                 direction: cos * FRAC_1_PI,
                 direct: 1.0 / area,
@@ -195,7 +219,9 @@ impl LightSampler {
             }
         };
         let delta_position = |direction: f32| EmissionPdf {
+            emitter,
             pick,
+            pick_direct,
             position: 1.0,
             direction,
             direct: 1.0,
@@ -217,7 +243,9 @@ impl LightSampler {
                 delta_position(if inside { cone } else { 0.0 })
             }
             Emitter::Directional { radius, .. } => EmissionPdf {
+                emitter,
                 pick,
+                pick_direct,
                 position: 1.0 / (PI * radius * radius),
                 direction: 1.0,
                 direct: 1.0,
@@ -230,7 +258,9 @@ impl LightSampler {
                     (light.disc_pdf(), light.pdf(-direction))
                 });
                 EmissionPdf {
+                    emitter,
                     pick,
+                    pick_direct,
                     position,
                     direction: sky,
                     direct: sky,
@@ -240,6 +270,12 @@ impl LightSampler {
                 }
             }
         }
+    }
+
+    /// The probability that [`LightSampler::sample_direct`] from `point` on a surface of unit
+    /// `normal` (zero: none) picks emitter `emitter`.
+    pub fn pick_direct(&self, emitter: usize, point: Vec3, normal: Vec3) -> f32 {
+        self.direct.pmf(point, normal, emitter)
     }
 
     /// The solid-angle density of the sky direction that the environment's sampler draws for

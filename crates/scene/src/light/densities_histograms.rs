@@ -183,7 +183,9 @@ fn triangle_emission_follows_its_densities() {
     ] {
         let lights = scene.lights();
         let position = quad_integrals(&scene, |hit| {
-            let pdf = lights.pdf_emission(hit, -Vec3::Y).unwrap();
+            let pdf = lights
+                .pdf_emission(hit, -Vec3::Y, (Vec3::ZERO, Vec3::ZERO))
+                .unwrap();
             f64::from(pdf.pick * pdf.position)
         });
         assert_one(&position, 1e-5, name);
@@ -195,11 +197,21 @@ fn triangle_emission_follows_its_densities() {
         let hit = hit_at(&scene, centre - Vec3::Y, centre).unwrap();
         let bins = DirectionBins::new(-Vec3::Y, 0.0);
         let direction = bins.integrals(4, |w| {
-            f64::from(lights.pdf_emission(&hit, w).unwrap().direction)
+            f64::from(
+                lights
+                    .pdf_emission(&hit, w, (Vec3::ZERO, Vec3::ZERO))
+                    .unwrap()
+                    .direction,
+            )
         });
         assert_one(&direction, 1e-5, name);
         let behind = DirectionBins::new(Vec3::Y, 0.0).integrals(2, |w| {
-            f64::from(lights.pdf_emission(&hit, w).unwrap().direction)
+            f64::from(
+                lights
+                    .pdf_emission(&hit, w, (Vec3::ZERO, Vec3::ZERO))
+                    .unwrap()
+                    .direction,
+            )
         });
         assert_eq!(behind.iter().sum::<f64>(), 0.0, "{name}");
         let observed = emission_histogram(&scene, bins.len(), 3, |s, _| bins.index(s.direction));
@@ -210,7 +222,12 @@ fn triangle_emission_follows_its_densities() {
         );
         // The back of the lamp does not emit.
         let back = hit_at(&scene, centre + Vec3::Y, centre).unwrap();
-        assert!(!back.front_face && lights.pdf_emission(&back, Vec3::Y).is_none());
+        assert!(
+            !back.front_face
+                && lights
+                    .pdf_emission(&back, Vec3::Y, (Vec3::ZERO, Vec3::ZERO))
+                    .is_none()
+        );
     }
 }
 
@@ -230,7 +247,9 @@ fn sphere_emission_follows_its_densities() {
     let area = f64::from(SPHERE_RADIUS * SPHERE_RADIUS);
     let position = normals.integrals(3, |n| {
         let hit = sphere_hit(&scene, n);
-        let pdf = lights.pdf_emission(&hit, n).unwrap();
+        let pdf = lights
+            .pdf_emission(&hit, n, (Vec3::ZERO, Vec3::ZERO))
+            .unwrap();
         // dA = R² dω on the sphere.
         f64::from(pdf.pick * pdf.position) * area
     });
@@ -246,7 +265,12 @@ fn sphere_emission_follows_its_densities() {
     let direction = bins.integrals(4, |w| {
         // The local direction w (about +z) at the top, whose normal is +y.
         let world = top_frame.to_world(w);
-        f64::from(lights.pdf_emission(&top, world).unwrap().direction)
+        f64::from(
+            lights
+                .pdf_emission(&top, world, (Vec3::ZERO, Vec3::ZERO))
+                .unwrap()
+                .direction,
+        )
     });
     assert_one(&direction, 1e-5, "sphere directions");
     let observed = emission_histogram(&scene, bins.len(), 5, |s, _| {
@@ -265,7 +289,7 @@ fn point_and_spot_emission_follow_their_densities() {
     ] {
         let scene = light_scene(light);
         let lights = scene.lights();
-        let density = |w: Vec3| f64::from(lights.emitter_pdf(0, Vec3::ZERO, w).direction);
+        let density = |w: Vec3| f64::from(lights.emitter_pdf(0, Vec3::ZERO, w, None).direction);
         // One over the sphere, all of it inside a spot's cone: the bins' edge is the cone's.
         let bins = DirectionBins::new(axis, cos_min);
         let direction = bins.integrals(4, density);
@@ -282,7 +306,7 @@ fn point_and_spot_emission_follow_their_densities() {
         };
         let observed = emission_histogram(&scene, bins.len(), 6, |s, pdf| {
             assert_eq!(s.origin, position);
-            assert_eq!(*pdf, lights.emitter_pdf(0, Vec3::ZERO, s.direction));
+            assert_eq!(*pdf, lights.emitter_pdf(0, Vec3::ZERO, s.direction, None));
             bins.index(s.direction)
         });
         assert_chi_square(&observed, &scaled(&direction), &format!("{light:?}"));
@@ -349,9 +373,10 @@ fn direct_samples_follow_the_direct_density() {
         let mut observed = vec![0.0; n_bins];
         let mut rng = Rng::new(10);
         for _ in 0..N {
-            if let Some((s, _)) = scene
-                .lights()
-                .sample_direct_with_pdf(x, rng.f32(), rng.vec2())
+            if let Some((s, _)) =
+                scene
+                    .lights()
+                    .sample_direct_with_pdf(x, Vec3::ZERO, rng.f32(), rng.vec2())
             {
                 let b = bin(s.incoming, s.distance).expect("a binned sample");
                 observed[b] += 1.0;
@@ -365,7 +390,7 @@ fn direct_samples_follow_the_direct_density() {
         let direct = quad_integrals(&scene, |hit| {
             f64::from(
                 lights
-                    .pdf_emission(hit, -Vec3::Y)
+                    .pdf_emission(hit, -Vec3::Y, (x, Vec3::ZERO))
                     .unwrap()
                     .direct_with_pick(),
             )
@@ -385,14 +410,24 @@ fn direct_samples_follow_the_direct_density() {
     let area = f64::from(SPHERE_RADIUS * SPHERE_RADIUS);
     let direct = bins.integrals(4, |n| {
         let hit = sphere_hit(&scene, n);
-        f64::from(lights.pdf_emission(&hit, n).unwrap().direct_with_pick()) * area
+        f64::from(
+            lights
+                .pdf_emission(&hit, n, (x, Vec3::ZERO))
+                .unwrap()
+                .direct_with_pick(),
+        ) * area
     });
     let visible: f64 = direct.iter().sum();
     let want = (1.0 - cap) / 2.0;
     assert!((visible - want).abs() < 1e-4, "{visible} vs {want}");
     let whole = DirectionBins::new(Vec3::Y, -1.0).integrals(3, |n| {
         let hit = sphere_hit(&scene, n);
-        f64::from(lights.pdf_emission(&hit, n).unwrap().direct_with_pick()) * area
+        f64::from(
+            lights
+                .pdf_emission(&hit, n, (x, Vec3::ZERO))
+                .unwrap()
+                .direct_with_pick(),
+        ) * area
     });
     assert_one(&whole, 1e-4, "sphere direct");
     let observed = histogram(&scene, bins.len(), &|w, d| {

@@ -35,12 +35,14 @@ mod environment;
 #[cfg(test)]
 mod tests;
 mod textured;
+mod tree;
 
 pub use densities::EmissionPdf;
 use emitters::Emitter;
 pub(crate) use emitters::{Emitters, Powered, powered};
 
 use textured::TexturedTriangle;
+use tree::DirectChoice;
 
 use environment::EnvironmentLight;
 pub use environment::{Environment, EnvironmentMap, EnvironmentRadiance};
@@ -123,12 +125,14 @@ impl EmissionSample {
     }
 }
 
-/// All emitters of a scene and the distribution that picks them by power.
+/// All emitters of a scene, the distribution that picks them by power for photons, and the
+/// choice that picks them by their importance at a point for next-event estimation (`tree.rs`).
 #[derive(Clone, Debug)]
 pub struct LightSampler {
     emitters: Vec<Emitter>,
     powers: Vec<Rgb>,
     distribution: Distribution1D,
+    direct: DirectChoice,
     /// Emitter index per triangle (`u32::MAX` for none); empty if no triangle emits.
     triangle_emitter: Vec<u32>,
     /// Emitter index per sphere (`u32::MAX` for none); empty if no sphere emits.
@@ -143,6 +147,8 @@ impl LightSampler {
     /// The sampler over emitters that [`powered`] found to carry power: it
     /// cannot fail, the validation has built the distribution.
     pub(crate) fn new(powered: Powered) -> Self {
+        let (emitters, distribution) = powered.into_parts();
+        let direct = DirectChoice::new(&emitters.emitters, &emitters.weights());
         let (
             Emitters {
                 emitters,
@@ -153,11 +159,12 @@ impl LightSampler {
                 environment,
             },
             distribution,
-        ) = powered.into_parts();
+        ) = (emitters, distribution);
         Self {
             emitters,
             powers,
             distribution,
+            direct,
             triangle_emitter,
             sphere_emitter,
             textured,
@@ -186,7 +193,10 @@ impl LightSampler {
     /// zero without an environment.
     pub fn pdf_environment(&self, direction: Vec3) -> f32 {
         match &self.environment {
-            Some((light, idx)) => self.distribution.pmf(*idx) * light.pdf(direction),
+            // The infinite lights' share does not depend on the point.
+            Some((light, idx)) => {
+                self.direct.pmf(Vec3::ZERO, Vec3::ZERO, *idx) * light.pdf(direction)
+            }
             None => 0.0,
         }
     }
@@ -206,11 +216,19 @@ impl LightSampler {
         self.powers.iter().copied().sum()
     }
 
-    /// Samples a direction toward a light as seen from `point`: `u_light` ∈ [0, 1) picks the emitter
-    /// by power, `u` ∈ [0, 1)² the point on it. `None` when the sample carries nothing (outside a spot
-    /// cone, behind a one-sided emitter).
-    pub fn sample_direct(&self, point: Vec3, u_light: f32, u: Vec2) -> Option<LightSample> {
-        let (idx, p_light) = self.distribution.sample(u_light);
+    /// Samples a direction toward a light as seen from `point` on a surface of unit `normal`
+    /// (zero where there is no surface): `u_light` ∈ [0, 1) picks the emitter (an infinite light
+    /// by its share of the power, the others by their importance at the point, `tree.rs`), `u` ∈
+    /// [0, 1)² the point on it. `None` when the sample carries nothing (outside a spot cone,
+    /// behind a one-sided emitter, no emitter facing the point).
+    pub fn sample_direct(
+        &self,
+        point: Vec3,
+        normal: Vec3,
+        u_light: f32,
+        u: Vec2,
+    ) -> Option<LightSample> {
+        let (idx, p_light) = self.direct.sample(point, normal, u_light)?;
         let (target, radiance, pdf_area_to_solid) = match self.emitters[idx] {
             Emitter::Point {
                 position,
@@ -319,9 +337,10 @@ impl LightSampler {
         })
     }
 
-    /// Solid-angle density with which [`LightSampler::sample_direct`] at `point` draws the point of
-    /// `hit` on an emitter (for multiple importance sampling); zero if `hit` is not on an emitting front face.
-    pub fn pdf_direct(&self, point: Vec3, hit: &Hit) -> f32 {
+    /// Solid-angle density with which [`LightSampler::sample_direct`] at `point` with `normal`
+    /// draws the point of `hit` on an emitter (for multiple importance sampling); zero if `hit` is
+    /// not on an emitting front face.
+    pub fn pdf_direct(&self, point: Vec3, normal: Vec3, hit: &Hit) -> f32 {
         if !hit.front_face {
             return 0.0;
         }
@@ -344,7 +363,7 @@ impl LightSampler {
         if cos_light.is_nan() || cos_light <= 0.0 {
             return 0.0;
         }
-        self.distribution.pmf(idx as usize) * d2 / (cos_light * area)
+        self.direct.pmf(point, normal, idx as usize) * d2 / (cos_light * area)
     }
 
     /// Samples a photon: `u_light` ∈ [0, 1) picks the emitter by power, `u_pos` ∈ [0, 1)² the point

@@ -49,7 +49,7 @@ fn quad_irradiance_matches_lambert_formula() {
         let n_samples = 200_000;
         let mut sum = 0.0f64;
         for _ in 0..n_samples {
-            if let Some(s) = lights.sample_direct(x, rng.f32(), rng.vec2()) {
+            if let Some(s) = lights.sample_direct(x, Vec3::ZERO, rng.f32(), rng.vec2()) {
                 assert!(!s.is_delta);
                 sum += f64::from(s.radiance.x * s.incoming.dot(n).max(0.0) / s.pdf);
             }
@@ -63,7 +63,7 @@ fn quad_irradiance_matches_lambert_formula() {
     // From behind the one-sided emitter there is nothing.
     assert!(
         lights
-            .sample_direct(Vec3::new(0.0, 2.0, 0.0), 0.5, Vec2::splat(0.5))
+            .sample_direct(Vec3::new(0.0, 2.0, 0.0), Vec3::ZERO, 0.5, Vec2::splat(0.5))
             .is_none()
     );
 }
@@ -76,11 +76,11 @@ fn pdf_direct_matches_sample_direct() {
     for _ in 0..500 {
         let s = scene
             .lights()
-            .sample_direct(x, rng.f32(), rng.vec2())
+            .sample_direct(x, Vec3::ZERO, rng.f32(), rng.vec2())
             .unwrap();
         let hit = scene.intersect(&Ray::infinite(x, s.incoming)).unwrap();
         assert!((hit.t - s.distance).abs() < 1e-4);
-        let pdf = scene.lights().pdf_direct(x, &hit);
+        let pdf = scene.lights().pdf_direct(x, Vec3::ZERO, &hit);
         assert!((pdf - s.pdf).abs() < 1e-3 * s.pdf, "{pdf} vs {}", s.pdf);
         assert_eq!(scene.emitted(&hit), Rgb::ONE);
     }
@@ -107,7 +107,7 @@ fn point_light_gives_inverse_square_cosine() {
     for _ in 0..n_samples {
         let s = scene
             .lights()
-            .sample_direct(x, rng.f32(), rng.vec2())
+            .sample_direct(x, Vec3::ZERO, rng.f32(), rng.vec2())
             .unwrap();
         assert!(s.is_delta);
         sum += f64::from(s.radiance.x * s.incoming.dot(n).max(0.0) / s.pdf);
@@ -187,7 +187,10 @@ fn sphere_emitter_power() {
     let mut sum = 0.0f64;
     let n = 200_000;
     for _ in 0..n {
-        if let Some(s) = scene.lights().sample_direct(x, rng.f32(), rng.vec2()) {
+        if let Some(s) = scene
+            .lights()
+            .sample_direct(x, Vec3::ZERO, rng.f32(), rng.vec2())
+        {
             // Silhouette samples may graze past the sphere.
             let Some(hit) = scene.intersect(&Ray::infinite(x, s.incoming)) else {
                 continue;
@@ -232,7 +235,10 @@ fn spot_light_energy() {
     let mut sum = 0.0f64;
     for _ in 0..n {
         let x = crate::sampling::uniform_sphere(rng.vec2());
-        if let Some(s) = scene.lights().sample_direct(x, rng.f32(), rng.vec2()) {
+        if let Some(s) = scene
+            .lights()
+            .sample_direct(x, Vec3::ZERO, rng.f32(), rng.vec2())
+        {
             // radiance = I(ω)/d² with d = 1.
             sum += f64::from(s.radiance.x / s.pdf);
         }
@@ -245,13 +251,13 @@ fn spot_light_energy() {
     // Full inside falloff_start, zero outside the cone.
     let inside = scene
         .lights()
-        .sample_direct(Vec3::new(0.1, -1.0, 0.0), 0.5, Vec2::ZERO)
+        .sample_direct(Vec3::new(0.1, -1.0, 0.0), Vec3::ZERO, 0.5, Vec2::ZERO)
         .unwrap();
     assert!((inside.radiance.x * inside.distance * inside.distance - 2.0).abs() < 1e-4);
     assert!(
         scene
             .lights()
-            .sample_direct(Vec3::new(1.0, -1.0, 0.0), 0.5, Vec2::ZERO)
+            .sample_direct(Vec3::new(1.0, -1.0, 0.0), Vec3::ZERO, 0.5, Vec2::ZERO)
             .is_none()
     );
 }
@@ -289,7 +295,7 @@ fn directional_light_covers_the_scene() {
     );
     let s = scene
         .lights()
-        .sample_direct(Vec3::ZERO, 0.3, Vec2::ZERO)
+        .sample_direct(Vec3::ZERO, Vec3::ZERO, 0.3, Vec2::ZERO)
         .unwrap();
     assert!(s.is_delta && s.distance.is_infinite());
     assert!(

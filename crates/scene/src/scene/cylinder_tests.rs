@@ -657,6 +657,6 @@ fn cylinder_only_scene_has_bounds_and_light_sampling() {
     let h = scene
         .intersect(&Ray::infinite(Vec3::new(0.0, 1.0, -5.0), Vec3::Z))
         .unwrap();
-    assert_eq!(scene.lights().pdf_direct(Vec3::ZERO, &h), 0.0);
+    assert_eq!(scene.lights().pdf_direct(Vec3::ZERO, Vec3::ZERO, &h), 0.0);
     assert_eq!(scene.emitted(&h), Vec3::ZERO);
 }
