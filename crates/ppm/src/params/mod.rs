@@ -185,8 +185,9 @@ pub struct Connections {
     /// Estimate the light arriving straight from emitters at the photon mappers' visible points
     /// by a light sample and a BSDF sample per camera pass, combined by multiple importance
     /// sampling, instead of gathering (and connecting) the photons that arrive straight from an
-    /// emitter. Off by default: it wins at equal time on eleven scenes of docs/convergence.md
-    /// but reads 13 times the error on one lit by emitters close to what they light.
+    /// emitter. Off by default: with the light tree and 4 sample pairs it wins or ties at equal
+    /// time on twelve scenes of docs/convergence.md but reads 1.7 times the error on one lit by
+    /// emitters close to what they light.
     pub direct_lighting: bool,
     /// With `direct_lighting`: light and BSDF sample pairs per visible point and camera pass,
     /// averaged. More pays where next-event estimation is noisy (many emitters, emitters close
