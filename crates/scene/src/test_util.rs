@@ -131,3 +131,29 @@ pub(crate) fn closed_box(lo: Vec3, hi: Vec3, material: u32) -> Vec<Triangle> {
     t.extend(quad(lo + z, y, x, material)); // z = hi, front -z
     t
 }
+
+/// Pearson χ² of `observed` against `expected` counts, pooling the bins that expect fewer than
+/// five (as pbrt's and Mitsuba's χ² tests do); returns (χ², degrees of freedom). Fails where 50
+/// or more samples fell in a bin whose expectation is zero: `what` names the check.
+#[track_caller]
+pub(crate) fn pearson_chi_square(observed: &[f64], expected: &[f64], what: &str) -> (f64, usize) {
+    let (mut chi2, mut dof, mut pooled_o, mut pooled_e) = (0.0, 0usize, 0.0, 0.0);
+    for (o, e) in observed.iter().zip(expected) {
+        if *e < 5.0 {
+            pooled_o += o;
+            pooled_e += e;
+            assert!(
+                *o < 50.0 || *e > 0.0,
+                "{what}: {o} samples where the density is zero"
+            );
+        } else {
+            chi2 += (o - e) * (o - e) / e;
+            dof += 1;
+        }
+    }
+    if pooled_e >= 5.0 {
+        chi2 += (pooled_o - pooled_e) * (pooled_o - pooled_e) / pooled_e;
+        dof += 1;
+    }
+    (chi2, dof.saturating_sub(1))
+}

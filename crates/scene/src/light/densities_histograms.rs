@@ -6,30 +6,14 @@ use std::f64::consts::PI as PI64;
 
 use super::*;
 use crate::Frame;
+use crate::test_util::pearson_chi_square;
 
 /// Pearson χ² of `observed` against `expected` counts, pooling the bins that expect fewer than
 /// five; fails if it exceeds its mean by five standard deviations.
 #[track_caller]
 fn assert_chi_square(observed: &[f64], expected: &[f64], what: &str) {
-    let (mut chi2, mut dof, mut pooled_o, mut pooled_e) = (0.0, 0usize, 0.0, 0.0);
-    for (o, e) in observed.iter().zip(expected) {
-        if *e < 5.0 {
-            pooled_o += o;
-            pooled_e += e;
-            assert!(
-                *o < 50.0 || *e > 0.0,
-                "{what}: {o} samples where the density is zero"
-            );
-        } else {
-            chi2 += (o - e) * (o - e) / e;
-            dof += 1;
-        }
-    }
-    if pooled_e >= 5.0 {
-        chi2 += (pooled_o - pooled_e) * (pooled_o - pooled_e) / pooled_e;
-        dof += 1;
-    }
-    let dof = dof.saturating_sub(1) as f64;
+    let (chi2, dof) = pearson_chi_square(observed, expected, what);
+    let dof = dof as f64;
     assert!(dof >= 10.0, "{what}: only {dof} degrees of freedom");
     let limit = dof + 5.0 * (2.0 * dof).sqrt();
     assert!(chi2 < limit, "{what}: χ² {chi2:.1} with {dof} dof");

@@ -77,45 +77,43 @@ pub(super) struct LightBounds {
     cos_emit: f32,
     /// The luminance of their power.
     phi: f32,
-    /// Derived once ([`LightBounds::derive`]): the centre of `lo..hi`, half its diagonal, and
-    /// the sine of the normal cone's half-angle.
+    /// Derived once ([`LightBounds::new`]): the centre of `lo..hi`, half its diagonal, and the
+    /// sine of the normal cone's half-angle.
     centre: Vec3,
     radius: f32,
     sin_o: f32,
 }
 
 impl LightBounds {
-    /// A one-sided surface emitter (a triangle) of power `phi`, facing `normal`.
-    pub(super) fn surface(lo: Vec3, hi: Vec3, normal: Vec3, phi: f32) -> Self {
+    /// Bounds with their derived quantities: the centre of `lo..hi`, half its diagonal, and the
+    /// sine of the normal cone's half-angle.
+    fn new(lo: Vec3, hi: Vec3, normals: Cone, cos_emit: f32, phi: f32) -> Self {
         Self {
             lo,
             hi,
-            normals: Cone {
-                w: normal,
-                cos_theta: 1.0,
-            },
-            cos_emit: 0.0,
+            normals,
+            cos_emit,
             phi,
-            centre: Vec3::ZERO,
-            radius: 0.0,
-            sin_o: 0.0,
+            centre: 0.5 * (lo + hi),
+            radius: 0.5 * (hi - lo).length(),
+            sin_o: (1.0 - normals.cos_theta * normals.cos_theta)
+                .max(0.0)
+                .sqrt(),
         }
-        .derive()
+    }
+
+    /// A one-sided surface emitter (a triangle) of power `phi`, facing `normal`.
+    pub(super) fn surface(lo: Vec3, hi: Vec3, normal: Vec3, phi: f32) -> Self {
+        let normals = Cone {
+            w: normal,
+            cos_theta: 1.0,
+        };
+        Self::new(lo, hi, normals, 0.0, phi)
     }
 
     /// An emitter that sends light every way from within `lo..hi` (a sphere, a point light).
     pub(super) fn omni(lo: Vec3, hi: Vec3, phi: f32) -> Self {
-        Self {
-            lo,
-            hi,
-            normals: Cone::SPHERE,
-            cos_emit: 0.0,
-            phi,
-            centre: Vec3::ZERO,
-            radius: 0.0,
-            sin_o: 0.0,
-        }
-        .derive()
+        Self::new(lo, hi, Cone::SPHERE, 0.0, phi)
     }
 
     /// A spot light at `position` along `axis`, full within `cos_start`, dark beyond `cos_cone`.
@@ -128,43 +126,22 @@ impl LightBounds {
     ) -> Self {
         let theta_start = cos_start.clamp(-1.0, 1.0).acos();
         let theta_cone = cos_cone.clamp(-1.0, 1.0).acos();
-        Self {
-            lo: position,
-            hi: position,
-            normals: Cone {
-                w: axis,
-                cos_theta: cos_start,
-            },
-            cos_emit: (theta_cone - theta_start).max(0.0).cos(),
-            phi,
-            centre: Vec3::ZERO,
-            radius: 0.0,
-            sin_o: 0.0,
-        }
-        .derive()
-    }
-
-    fn derive(mut self) -> Self {
-        self.centre = 0.5 * (self.lo + self.hi);
-        self.radius = 0.5 * (self.hi - self.lo).length();
-        self.sin_o = (1.0 - self.normals.cos_theta * self.normals.cos_theta)
-            .max(0.0)
-            .sqrt();
-        self
+        let normals = Cone {
+            w: axis,
+            cos_theta: cos_start,
+        };
+        let cos_emit = (theta_cone - theta_start).max(0.0).cos();
+        Self::new(position, position, normals, cos_emit, phi)
     }
 
     fn union(&self, other: &Self) -> Self {
-        Self {
-            lo: self.lo.min(other.lo),
-            hi: self.hi.max(other.hi),
-            normals: Cone::union(self.normals, other.normals),
-            cos_emit: self.cos_emit.min(other.cos_emit),
-            phi: self.phi + other.phi,
-            centre: Vec3::ZERO,
-            radius: 0.0,
-            sin_o: 0.0,
-        }
-        .derive()
+        Self::new(
+            self.lo.min(other.lo),
+            self.hi.max(other.hi),
+            Cone::union(self.normals, other.normals),
+            self.cos_emit.min(other.cos_emit),
+            self.phi + other.phi,
+        )
     }
 
     fn centroid(&self) -> Vec3 {

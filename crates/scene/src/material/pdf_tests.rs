@@ -8,7 +8,7 @@ use std::f64::consts::PI as PI64;
 use glam::{Vec2, Vec3};
 
 use super::{Bsdf, BsdfPdfs, TransportMode};
-use crate::test_util::Rng;
+use crate::test_util::{Rng, pearson_chi_square};
 use crate::{Frame, MaterialKind, Rgb};
 
 /// A tilted normal, so that the local frame is not the world frame.
@@ -224,25 +224,8 @@ fn chi_square(
             expected[i * N_PHI + j] = sum * cell * f64::from(N);
         }
     }
-    let (mut chi2, mut dof, mut pooled_o, mut pooled_e) = (0.0, 0usize, 0.0, 0.0);
-    for (o, e) in observed.iter().zip(&expected) {
-        if *e < 5.0 {
-            pooled_o += o;
-            pooled_e += e;
-            assert!(
-                *o < 50.0 || *e > 0.0,
-                "{o} samples where the density is zero"
-            );
-        } else {
-            chi2 += (o - e) * (o - e) / e;
-            dof += 1;
-        }
-    }
-    if pooled_e >= 5.0 {
-        chi2 += (pooled_o - pooled_e) * (pooled_o - pooled_e) / pooled_e;
-        dof += 1;
-    }
-    (chi2, dof.saturating_sub(1) as f64)
+    let (chi2, dof) = pearson_chi_square(&observed, &expected, "sampled directions");
+    (chi2, dof as f64)
 }
 
 /// (a) and (b): directions sampled from a fixed direction follow the forward density from it,

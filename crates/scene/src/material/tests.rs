@@ -3,7 +3,7 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 use super::{Bsdf, Lobe, TransportMode, fresnel_dielectric};
-use crate::test_util::Rng;
+use crate::test_util::{Rng, pearson_chi_square};
 use crate::{MaterialKind, Rgb};
 
 fn bsdf(kind: MaterialKind) -> Bsdf {
@@ -315,23 +315,7 @@ fn chi_square(b: &Bsdf, wo: Vec3) -> (f64, usize) {
             expected[c * N_PHI + p] = sum / f64::from(sub * sub) * area * N as f64;
         }
     }
-    // Pool low-expectation bins (as in pbrt's and Mitsuba's χ² tests).
-    let (mut chi2, mut dof, mut pooled_o, mut pooled_e) = (0.0, 0usize, 0.0, 0.0);
-    for (o, e) in observed.iter().zip(&expected) {
-        if *e < 5.0 {
-            pooled_o += o;
-            pooled_e += e;
-            assert!(*o < 50.0 || *e > 0.0, "samples where pdf() is zero");
-        } else {
-            chi2 += (o - e) * (o - e) / e;
-            dof += 1;
-        }
-    }
-    if pooled_e >= 5.0 {
-        chi2 += (pooled_o - pooled_e) * (pooled_o - pooled_e) / pooled_e;
-        dof += 1;
-    }
-    (chi2, dof.saturating_sub(1))
+    pearson_chi_square(&observed, &expected, "samples of pdf()")
 }
 
 #[test]
