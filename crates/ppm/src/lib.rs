@@ -53,6 +53,7 @@ mod renderer;
 mod rng;
 mod stats;
 mod update;
+mod vcm;
 
 pub use crate::aov::Aov;
 #[doc(hidden)]

@@ -13,6 +13,7 @@ use crate::params::{Method, ParamError, RenderParams};
 use crate::path::{self, PathTracer};
 use crate::photon_mapper::{self, PhotonMapper};
 use crate::stats::{FILM_BYTES_PER_PIXEL, MemoryEstimate};
+use crate::vcm::{self, Vcm};
 
 /// Starts a render of a scene with parameters whose method is this one.
 type Build = fn(Arc<Scene>, RenderParams) -> Result<Box<dyn Integrator>, ParamError>;
@@ -43,6 +44,10 @@ fn entry(method: Method) -> Entry {
         Method::Light => Entry {
             build: |scene, params| Ok(Box::new(LightTracer::new(scene, params))),
             estimate: light_tracer::estimate,
+        },
+        Method::Vcm | Method::Bdpt => Entry {
+            build: |scene, params| Ok(Box::new(Vcm::new(scene, params))),
+            estimate: vcm::estimate,
         },
     }
 }

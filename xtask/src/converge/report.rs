@@ -13,6 +13,8 @@ pub(super) fn colour(method: ppm::Method) -> (u8, u8, u8) {
         ppm::Method::Appm => (148, 103, 189),
         ppm::Method::Path => (100, 100, 100),
         ppm::Method::Light => (23, 190, 207),
+        ppm::Method::Vcm => (188, 189, 34),
+        ppm::Method::Bdpt => (227, 119, 194),
     }
 }
 

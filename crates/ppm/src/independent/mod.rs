@@ -53,7 +53,7 @@ struct Independent {
 
 /// g² of pass `pass` (0-based): the product of (k + α)/(k + 1) for k = 1 … pass, taken in that
 /// order so that every machine gets the same bits.
-fn schedule_squared(pass: u64, alpha: f64) -> f64 {
+pub(crate) fn schedule_squared(pass: u64, alpha: f64) -> f64 {
     let mut g2 = 1.0;
     for k in 1..=pass {
         let k = k as f64;

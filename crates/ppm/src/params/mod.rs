@@ -32,11 +32,16 @@ pub enum Method {
     /// Light tracing (Mitsuba's `ptracer`): light paths connected to the lens at every
     /// non-specular vertex, no merging; blind to what is seen only through specular surfaces.
     Light,
+    /// Vertex connection and merging (Georgiev, Křivánek, Davidovič & Slusallek 2012): light
+    /// and camera subpaths, connected and merged at every camera vertex, weighted by MIS.
+    Vcm,
+    /// Bidirectional path tracing: `Vcm`'s connections without merging.
+    Bdpt,
 }
 
 impl Method {
     /// Every method, in the order reports list them.
-    pub const ALL: [Method; 7] = [
+    pub const ALL: [Method; 9] = [
         Method::Ppm,
         Method::Sppm,
         Method::FreqPpm,
@@ -44,6 +49,8 @@ impl Method {
         Method::Appm,
         Method::Path,
         Method::Light,
+        Method::Vcm,
+        Method::Bdpt,
     ];
 
     /// The name used on the command line and in scene files.
@@ -57,6 +64,8 @@ impl Method {
             Method::Appm => "appm",
             Method::Path => "path",
             Method::Light => "light",
+            Method::Vcm => "vcm",
+            Method::Bdpt => "bdpt",
         }
     }
 
@@ -72,14 +81,18 @@ impl Method {
         matches!(self, Method::FreqPpm | Method::FreqSppm)
     }
 
-    /// Whether this is a photon mapper (everything but the path tracer and the light tracer):
-    /// it has hitpoints with gather radii.
+    /// Whether this is a photon mapper (everything but the path tracer, the light tracer and
+    /// the bidirectional methods): it has hitpoints with gather radii.
     #[must_use]
     pub fn is_photon_mapper(self) -> bool {
-        !matches!(self, Method::Path | Method::Light)
+        !matches!(
+            self,
+            Method::Path | Method::Light | Method::Vcm | Method::Bdpt
+        )
     }
 
-    /// Whether it traces paths from the emitters (the photon mappers and the light tracer).
+    /// Whether it traces paths from the emitters (the photon mappers, the light tracer and the
+    /// bidirectional methods).
     #[must_use]
     pub fn traces_light_paths(self) -> bool {
         !matches!(self, Method::Path)
@@ -130,7 +143,8 @@ pub struct RenderParams {
 /// What a pass spends.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Budget {
-    /// Photons traced per pass (> 0).
+    /// Photons traced per pass (> 0); the light subpaths of a pass for the bidirectional
+    /// methods.
     pub photons_per_pass: u32,
     /// Maximum number of scattering events on a light path from the emitter to the camera
     /// (≥ 1), as pbrt's `maxdepth`: paths have at most `max_depth + 1` segments. Every method
@@ -148,7 +162,8 @@ pub struct Budget {
 /// How the film is sampled.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FilmSampling {
-    /// Hitpoint slots per pixel (jittered; ≥ 1); for the path tracer, paths per pixel per pass.
+    /// Hitpoint slots per pixel (jittered; ≥ 1); for the path tracer and the bidirectional
+    /// methods, camera paths per pixel per pass.
     pub samples_per_pixel: u32,
 }
 
@@ -156,7 +171,8 @@ pub struct FilmSampling {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Kernel {
     /// Radius reduction α ∈ (0, 1]: the fraction of new photons kept (0.7 in smallppm,
-    /// 2/3 in pbrt-v4).
+    /// 2/3 in pbrt-v4); `vcm` shrinks its merge radius by Knaus and Zwicker's schedule with
+    /// the same α.
     pub alpha: f64,
     /// Initial gather radius in scene units; `None` picks it from the scene (see
     /// [`crate::auto_initial_radius`]).

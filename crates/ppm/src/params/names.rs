@@ -85,6 +85,14 @@ pub const PARAMS: &[Param] = &[
                     "light",
                     "Light tracing (Mitsuba's ptracer): light paths connected to the lens, no merging; black where only mirrors or glass are seen",
                 ),
+                (
+                    "vcm",
+                    "Vertex connection and merging (Georgiev et al. 2012): bidirectional connections and merging at every camera vertex, MIS-weighted",
+                ),
+                (
+                    "bdpt",
+                    "Bidirectional path tracing: vcm's connections without merging",
+                ),
             ],
         },
         get: |p| p.method.name().to_owned(),
@@ -124,7 +132,7 @@ pub const PARAMS: &[Param] = &[
     Param {
         name: "alpha",
         flag: "alpha",
-        help: "Radius reduction α in (0, 1] [default: scene, else 0.7]",
+        help: "Radius reduction α in (0, 1] of the photon mappers' kernels and vcm's merge radius [default: scene, else 0.7]",
         kind: ParamKind::Value {
             value_name: "ALPHA",
             choices: &[],

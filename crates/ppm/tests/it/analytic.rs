@@ -71,7 +71,7 @@ fn furnace_sphere_gives_the_analytic_radiance_for_every_method() {
 /// j bounces bring Le·ρ^j, so a bound of k bounces gives L_k = Le·Σ_{j=0..k} ρ^j = 1 − 0.5^(k+1).
 /// Seen in the mirror, the walls lose one bounce to it: L_(k−1). (The ball, 0.1 across a cube
 /// of side 2, changes the walls' radiance by well under 1 %.)
-fn emissive_box(camera: &str) -> String {
+pub(crate) fn emissive_box(camera: &str) -> String {
     let mut toml = format!(
         "format = 1\n{camera}\n[film]\nwidth = 16\nheight = 16\n\
          [materials.wall]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\nemission = [0.5, 0.5, 0.5]\n\

@@ -22,3 +22,4 @@ mod non_finite;
 mod pooling;
 mod statistics;
 mod support;
+mod vcm;

@@ -1,0 +1,353 @@
+//! Vertex connection and merging (`vcm`; Georgiev, Křivánek, Davidovič & Slusallek 2012) and
+//! bidirectional path tracing (`bdpt`, the same code without merging).
+//!
+//! A pass traces `photons_per_pass` light subpaths (`light.rs`), keeping their non-specular
+//! vertices and connecting each to the lens, builds a hash grid over the kept vertices with the
+//! pass's merge radius, and traces `samples_per_pixel` camera subpaths per pixel
+//! (`camera.rs`), which at every vertex add the emission found there and, at non-specular ones,
+//! next-event estimation, connections to the vertices of one light subpath (camera path j with
+//! light subpath j mod n_L) and merges with every light vertex within the radius. Every
+//! contribution carries its balance-heuristic weight over all the strategies that could have
+//! sampled its path, computed recursively (`mis.rs`).
+//!
+//! The merge radius of pass i (0-based) is r₀·gᵢ with Knaus and Zwicker's schedule (that of
+//! `appm`, with α = `alpha`), so that merging is consistent: r₀ is `initial_radius` or the
+//! photon mappers' automatic radius. Nothing but the per-pixel sums carries from pass to pass.
+
+mod camera;
+mod light;
+pub(crate) mod mis;
+#[cfg(test)]
+mod tests;
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use glam::Vec3;
+use photon::{GridParams, HitPointGrid};
+use rayon::prelude::*;
+use scene::{Hit, Scene};
+
+use self::camera::{CameraPass, CameraSample};
+use self::light::{LightChunk, LightPass, LightVertex};
+use self::mis::{Mis, Strategies};
+use crate::checkpoint::codec::{Reader, StateError, Writer};
+use crate::independent::schedule_squared;
+use crate::integrator::Integrator;
+use crate::params::{Method, RenderParams};
+use crate::photon_mapper::auto_initial_radius;
+use crate::stats::{MemoryEstimate, MemoryUse, PassStats};
+
+/// Light subpaths per parallel work item; fixed so that the vertex order and the sums do not
+/// depend on the thread count.
+const PATH_CHUNK: u64 = 2048;
+/// Pixels per parallel work item of the camera subpaths.
+const PIXEL_CHUNK: usize = 64;
+/// Light vertices kept per light subpath, for the memory estimate: the photon mappers store 0.7
+/// to 4.8 photons per emitted one on the scenes measured (docs/reliability.md); the estimate
+/// takes 5.
+const VERTICES_PER_PATH: u64 = 5;
+/// Bytes per kept light vertex: the vertex, its position copy for the grid and the grid's
+/// entries (measured 35–40 per hitpoint for the photon mappers' grid).
+const BYTES_PER_VERTEX: u64 = std::mem::size_of::<LightVertex>() as u64 + 12 + 48;
+/// Bytes per light subpath of a pass besides its vertices: its end offset, its start in the
+/// pass's index, and up to five connections to the lens of 16 bytes.
+const BYTES_PER_PATH: u64 = 4 + 4 + 80;
+
+/// A vertex connection and merging render: per-pixel sums of the pass estimates.
+pub(crate) struct Vcm {
+    scene: Arc<Scene>,
+    params: RenderParams,
+    strategies: Strategies,
+    width: u32,
+    height: u32,
+    /// r₀, the merge radius of the first pass.
+    radius: f64,
+    passes: u32,
+    /// Per pixel: the sum over passes of each pass's estimate of the pixel's mean radiance.
+    sum: Vec<[f64; 3]>,
+    /// Per chunk of [`PATH_CHUNK`] light subpaths, what they produced; kept from pass to pass.
+    chunks: Vec<LightChunk>,
+    /// The pass's light vertices in subpath order, and where each subpath's start.
+    vertices: Vec<LightVertex>,
+    starts: Vec<u32>,
+    /// The grid of the last pass (kept for its memory report).
+    grid: Option<HitPointGrid>,
+}
+
+/// What a render will hold (the film aside): the per-pixel sums (and as much again while a
+/// checkpoint is written), and the light vertices, grid and connections of a pass.
+pub(crate) fn estimate(pixels: u64, params: &RenderParams) -> MemoryEstimate {
+    let sums = pixels.saturating_mul(24);
+    let paths = u64::from(params.budget.photons_per_pass);
+    let per_path = BYTES_PER_PATH + VERTICES_PER_PATH * BYTES_PER_VERTEX;
+    MemoryEstimate {
+        hitpoints: sums.saturating_mul(2),
+        photons: paths.saturating_mul(per_path),
+        film: 0,
+        checkpoint: sums,
+    }
+}
+
+/// |w·n_s| / |w·n_g| at `hit`: what the flux arriving along `w` per unit of geometric area
+/// brings to a BSDF evaluated against the shading normal (Veach 1997, §5.3).
+pub(crate) fn shading_ratio(hit: &Hit, w: Vec3) -> f32 {
+    shading_ratio_about(hit.shading_normal, hit.geometric_normal, w)
+}
+
+/// [`shading_ratio`] about a shading normal and a geometric normal.
+pub(crate) fn shading_ratio_about(shading: Vec3, geometric: Vec3, w: Vec3) -> f32 {
+    let (s, g) = (w.dot(shading).abs(), w.dot(geometric).abs());
+    if g > 0.0 { s / g } else { 0.0 }
+}
+
+impl Vcm {
+    /// A render of `scene` by `params.method` (`vcm` or `bdpt`).
+    pub(crate) fn new(scene: Arc<Scene>, params: RenderParams) -> Self {
+        let strategies = if params.method == Method::Bdpt {
+            Strategies::BDPT
+        } else {
+            Strategies::VCM
+        };
+        Self::with_strategies(scene, params, strategies)
+    }
+
+    /// A render that combines only `strategies` (for the tests of each strategy alone).
+    pub(crate) fn with_strategies(
+        scene: Arc<Scene>,
+        params: RenderParams,
+        strategies: Strategies,
+    ) -> Self {
+        let film = scene.description().film;
+        let radius = params
+            .kernel
+            .initial_radius
+            .unwrap_or_else(|| auto_initial_radius(&scene));
+        Self {
+            params,
+            strategies,
+            width: film.width,
+            height: film.height,
+            radius,
+            passes: 0,
+            sum: vec![[0.0; 3]; film.width as usize * film.height as usize],
+            chunks: Vec::new(),
+            vertices: Vec::new(),
+            starts: Vec::new(),
+            grid: None,
+            scene,
+        }
+    }
+
+    /// The merge radius of pass `pass` (0-based).
+    fn radius_of(&self, pass: u32) -> f64 {
+        self.radius * schedule_squared(u64::from(pass), self.params.kernel.alpha).sqrt()
+    }
+
+    /// Traces the pass's light subpaths into `chunks` (their connections to the lens stay
+    /// there) and gathers their vertices into `vertices` and `starts`.
+    fn light_pass(&mut self, mis: Mis, stats: &mut PassStats) {
+        let n = u64::from(self.params.budget.photons_per_pass);
+        let n_chunks = usize::try_from(n.div_ceil(PATH_CHUNK)).unwrap_or(usize::MAX);
+        let mut chunks = std::mem::take(&mut self.chunks);
+        chunks.resize_with(n_chunks, LightChunk::default);
+        let pass = LightPass {
+            scene: &self.scene,
+            mis,
+            seed: self.params.seed,
+            pass: self.passes,
+            max_depth: self.params.budget.max_depth,
+            rr_depth: self.params.budget.rr_depth,
+            film: (self.width, self.height),
+        };
+        // Light subpaths are numbered over the whole render, as photons are.
+        let first = u64::from(self.passes) * n;
+        chunks.par_iter_mut().enumerate().for_each(|(chunk, out)| {
+            out.clear();
+            let start = chunk as u64 * PATH_CHUNK;
+            for index in first + start..first + (start + PATH_CHUNK).min(n) {
+                pass.trace(index, out);
+            }
+        });
+        // In chunk order, whatever the thread count.
+        self.vertices.clear();
+        self.starts.clear();
+        self.starts.push(0);
+        for chunk in &chunks {
+            let offset = self.vertices.len() as u32;
+            self.starts
+                .extend(chunk.ends.iter().map(|&end| offset + end));
+            self.vertices.extend_from_slice(&chunk.vertices);
+            stats.non_finite += chunk.non_finite;
+            stats.light_connections += chunk.splats.len() as u64;
+        }
+        stats.photons_traced = n;
+        stats.photons_stored = self.vertices.len() as u64;
+        self.chunks = chunks;
+    }
+}
+
+impl Integrator for Vcm {
+    fn params(&self) -> &RenderParams {
+        &self.params
+    }
+
+    fn passes(&self) -> u32 {
+        self.passes
+    }
+
+    fn photons_emitted(&self) -> u64 {
+        u64::from(self.passes) * u64::from(self.params.budget.photons_per_pass)
+    }
+
+    fn iterate(&mut self) -> PassStats {
+        let pass = self.passes;
+        let mut stats = PassStats::empty(pass);
+        let radius = self.radius_of(pass);
+        let light_paths = u64::from(self.params.budget.photons_per_pass);
+        let spp = self.params.film.samples_per_pixel;
+        let mis = Mis::new(self.strategies, light_paths, spp, radius);
+
+        let trace_clock = Instant::now();
+        self.light_pass(mis, &mut stats);
+        stats.timings.trace = trace_clock.elapsed().as_secs_f64();
+
+        let index_clock = Instant::now();
+        self.grid = None;
+        if self.strategies.merging {
+            let positions: Vec<Vec3> = self.vertices.iter().map(|v| v.position).collect();
+            let radii = vec![radius; positions.len()];
+            self.grid = Some(HitPointGrid::build(&positions, &radii, GridParams::DEFAULT));
+            stats.mean_radius = radius;
+            stats.min_radius = radius;
+            stats.max_radius = radius;
+        }
+        stats.timings.index = index_clock.elapsed().as_secs_f64();
+
+        let camera_clock = Instant::now();
+        let camera = CameraPass {
+            scene: &self.scene,
+            mis,
+            seed: self.params.seed,
+            pass,
+            max_depth: self.params.budget.max_depth,
+            rr_depth: self.params.budget.rr_depth,
+            width: self.width,
+            samples_per_pixel: spp,
+            vertices: &self.vertices,
+            starts: &self.starts,
+            grid: self.grid.as_ref(),
+            merge_normalisation: (1.0
+                / (std::f64::consts::PI * radius * radius * light_paths as f64))
+                as f32,
+        };
+        let pixels: Vec<([f64; 3], u64, u64)> = (0..self.sum.len() as u32)
+            .into_par_iter()
+            .with_min_len(PIXEL_CHUNK)
+            .map(|pixel| {
+                let mut total = [0.0f64; 3];
+                let (mut merges, mut non_finite) = (0, 0);
+                for s in 0..spp {
+                    let CameraSample {
+                        radiance,
+                        merges: m,
+                    } = camera.trace(pixel, s);
+                    merges += m;
+                    // A NaN or infinite sample would stay in the pixel for ever.
+                    if !radiance.is_finite() {
+                        non_finite += 1;
+                        continue;
+                    }
+                    for c in 0..3 {
+                        total[c] += f64::from(radiance[c]);
+                    }
+                }
+                (total, merges, non_finite)
+            })
+            .collect();
+        stats.camera_paths = self.sum.len() as u64 * u64::from(spp);
+        stats.timings.camera = camera_clock.elapsed().as_secs_f64();
+
+        let gather_clock = Instant::now();
+        let per_sample = 1.0 / f64::from(spp);
+        let per_path = 1.0 / light_paths as f64;
+        // Each pass adds its estimate of every pixel: the camera subpaths' mean plus the light
+        // subpaths' connections to the lens (per subpath emitted), in chunk order.
+        let mut estimate: Vec<[f64; 3]> = pixels
+            .iter()
+            .map(|(total, merges, non_finite)| {
+                stats.photons_deposited += merges;
+                stats.non_finite += non_finite;
+                total.map(|v| v * per_sample)
+            })
+            .collect();
+        for chunk in &self.chunks {
+            for &(pixel, v) in &chunk.splats {
+                let e = &mut estimate[pixel as usize];
+                for c in 0..3 {
+                    e[c] += f64::from(v[c]) * per_path;
+                }
+            }
+        }
+        for (sum, e) in self.sum.iter_mut().zip(estimate) {
+            for c in 0..3 {
+                sum[c] += e[c];
+            }
+        }
+        stats.timings.gather = gather_clock.elapsed().as_secs_f64();
+        self.passes += 1;
+        stats
+    }
+
+    /// The mean of the pass estimates per pixel.
+    fn image(&self) -> Vec<[f32; 3]> {
+        let n = f64::from(self.passes.max(1));
+        self.sum.iter().map(|s| s.map(|v| (v / n) as f32)).collect()
+    }
+
+    fn memory(&self) -> Option<MemoryUse> {
+        use std::mem::size_of;
+        let chunks: usize = self
+            .chunks
+            .iter()
+            .map(|c| {
+                c.vertices.capacity() * size_of::<LightVertex>()
+                    + c.ends.capacity() * 4
+                    + c.splats.capacity() * size_of::<(u32, [f32; 3])>()
+            })
+            .sum();
+        Some(MemoryUse {
+            hitpoints: self.sum.len(),
+            records: self.sum.capacity() * size_of::<[f64; 3]>(),
+            slot_columns: 0,
+            grid: self.grid.as_ref().map_or(0, |g| g.stats().bytes),
+            pass_hitpoint_buffers: 0,
+            pass_photon_buffers: chunks
+                + self.vertices.capacity() * size_of::<LightVertex>()
+                + self.starts.capacity() * 4,
+        })
+    }
+
+    /// The per-pixel sums.
+    fn save(&self, w: &mut Writer) {
+        w.u64(self.sum.len() as u64);
+        for s in &self.sum {
+            s.iter().for_each(|&v| w.f64(v));
+        }
+    }
+
+    fn saved_bound(&self) -> usize {
+        8 + self.sum.len().saturating_mul(24)
+    }
+
+    fn restore(&mut self, r: &mut Reader<'_>, passes: u32) -> Result<(), StateError> {
+        if r.len()? != self.sum.len() {
+            return Err(StateError::Corrupt);
+        }
+        for s in &mut self.sum {
+            *s = [r.f64()?, r.f64()?, r.f64()?];
+        }
+        self.passes = passes;
+        Ok(())
+    }
+}
