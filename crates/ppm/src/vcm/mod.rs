@@ -47,9 +47,10 @@ const PIXEL_CHUNK: usize = 64;
 /// to 4.8 photons per emitted one on the scenes measured (docs/reliability.md); the estimate
 /// takes 5.
 const VERTICES_PER_PATH: u64 = 5;
-/// Bytes per kept light vertex: the vertex, its position copy for the grid and the grid's
-/// entries (measured 35–40 per hitpoint for the photon mappers' grid).
-const BYTES_PER_VERTEX: u64 = std::mem::size_of::<LightVertex>() as u64 + 12 + 48;
+/// Bytes per kept light vertex: the vertex twice (in its chunk and in the pass's list), its
+/// position copy for the grid and the grid's entries (measured 35–40 per hitpoint for the
+/// photon mappers' grid).
+const BYTES_PER_VERTEX: u64 = 2 * std::mem::size_of::<LightVertex>() as u64 + 12 + 48;
 /// Bytes per light subpath of a pass besides its vertices: its end offset, its start in the
 /// pass's index, and up to five connections to the lens of 16 bytes.
 const BYTES_PER_PATH: u64 = 4 + 4 + 80;
@@ -320,11 +321,13 @@ impl Integrator for Vcm {
             hitpoints: self.sum.len(),
             records: self.sum.capacity() * size_of::<[f64; 3]>(),
             slot_columns: 0,
-            grid: self.grid.as_ref().map_or(0, |g| g.stats().bytes),
+            // The grid is over the pass's light vertices: a photon buffer, not the slots'.
+            grid: 0,
             pass_hitpoint_buffers: 0,
             pass_photon_buffers: chunks
                 + self.vertices.capacity() * size_of::<LightVertex>()
-                + self.starts.capacity() * 4,
+                + self.starts.capacity() * 4
+                + self.grid.as_ref().map_or(0, |g| g.stats().bytes),
         })
     }
 

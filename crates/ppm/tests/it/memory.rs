@@ -26,10 +26,17 @@ fn the_estimate_covers_what_a_render_holds() {
         "peers/room-indirect.toml",
     ] {
         let scene = repo_scene(name, 48, 40);
-        let cases = [Method::Ppm, Method::Sppm, Method::FreqSppm, Method::Appm]
-            .into_iter()
-            .map(|m| (m, false))
-            .chain([(Method::Sppm, true), (Method::FreqSppm, true)]);
+        let cases = [
+            Method::Ppm,
+            Method::Sppm,
+            Method::FreqSppm,
+            Method::Appm,
+            Method::Vcm,
+            Method::Bdpt,
+        ]
+        .into_iter()
+        .map(|m| (m, false))
+        .chain([(Method::Sppm, true), (Method::FreqSppm, true)]);
         for (method, light_tracing) in cases {
             let mut params = params(method, 20_000);
             params.connections.light_tracing = light_tracing;
