@@ -7,7 +7,7 @@ use glam::{Vec2, Vec3};
 use photon::HitPointGrid;
 use scene::{Bsdf, Hit, Rgb, Scene, TransportMode};
 
-use super::light::LightVertex;
+use super::light::LightVertices;
 use super::mis::{Mis, Partial};
 use super::shading_ratio_about;
 use crate::rng::{CAMERA_STREAM, Sampler};
@@ -27,10 +27,10 @@ pub(crate) struct CameraPass<'a> {
     pub(crate) rr_depth: u32,
     pub(crate) width: u32,
     pub(crate) samples_per_pixel: u32,
-    /// The stored light vertices of the pass, subpath after subpath.
-    pub(crate) vertices: &'a [LightVertex],
-    /// Per light subpath `i`, its vertices are `starts[i]..starts[i + 1]`.
-    pub(crate) starts: &'a [u32],
+    /// The kept light vertices of the pass.
+    pub(crate) vertices: LightVertices<'a>,
+    /// Light subpaths in the pass.
+    pub(crate) light_paths: u64,
     /// The grid over the light vertices with the merge radius, if merging.
     pub(crate) grid: Option<&'a HitPointGrid>,
     /// 1/(π r² n_L): a merge's kernel and the light subpaths' count.
@@ -71,8 +71,7 @@ impl CameraPass<'_> {
         let cos = camera.forward().dot(ray.direction);
         let focal = camera.focal_pixels();
         let mut partial = self.mis.camera_start(focal * focal / (cos * cos * cos));
-        let light_path = self.starts.len().saturating_sub(1).max(1) as u64;
-        let light_path = (path % light_path) as usize;
+        let light_path = path % self.light_paths.max(1);
         let mut out = CameraSample::default();
         let mut beta = Rgb::ONE;
         let mut previous: Option<Hit> = None;
@@ -220,15 +219,10 @@ impl CameraPass<'_> {
     }
 
     /// The connections of `v` with the stored vertices of light subpath `light_path`.
-    fn connect(&self, v: &Vertex<'_>, light_path: usize) -> Rgb {
-        let (Some(&start), Some(&end)) =
-            (self.starts.get(light_path), self.starts.get(light_path + 1))
-        else {
-            return Rgb::ZERO;
-        };
+    fn connect(&self, v: &Vertex<'_>, light_path: u64) -> Rgb {
         let mut total = Rgb::ZERO;
         let hit = v.hit;
-        for y in &self.vertices[start as usize..end as usize] {
+        for y in self.vertices.path(light_path) {
             // The whole path scatters at the light vertices 1..=index and the camera vertices
             // 1..=v.index; the light subpath's vertices come in order.
             if y.index + v.index > self.max_depth {
@@ -281,7 +275,7 @@ impl CameraPass<'_> {
         let mut total = Rgb::ZERO;
         let mut count = 0;
         grid.for_each_containing(hit.position, |i| {
-            let y = &self.vertices[i as usize];
+            let y = self.vertices.get(i);
             // The merged path scatters at the light vertices 1..index − 1, at the merged vertex
             // and at the camera vertices 1..v.index − 1.
             if y.index + v.index > self.max_depth + 1

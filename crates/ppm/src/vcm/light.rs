@@ -52,6 +52,41 @@ impl LightChunk {
     }
 }
 
+/// Light subpaths per chunk (a parallel work item of the light pass); fixed so that the vertex
+/// order and the sums do not depend on the thread count.
+pub(crate) const PATH_CHUNK: u64 = 2048;
+
+/// The kept vertices of a pass, left in their chunks (a copy into one list would double the
+/// pass's largest buffer): numbered over the pass in chunk order, as the grid numbers them.
+#[derive(Clone, Copy)]
+pub(crate) struct LightVertices<'a> {
+    pub(crate) chunks: &'a [LightChunk],
+    /// Per chunk, the pass number of its first vertex; then their total.
+    pub(crate) offsets: &'a [u32],
+}
+
+impl<'a> LightVertices<'a> {
+    /// Vertex `i` of the pass.
+    pub(crate) fn get(&self, i: u32) -> &'a LightVertex {
+        let chunk = self.offsets.partition_point(|&o| o <= i) - 1;
+        &self.chunks[chunk].vertices[(i - self.offsets[chunk]) as usize]
+    }
+
+    /// The vertices of light subpath `path` of the pass (numbered from 0), in order; none for a
+    /// subpath whose chunk's vertices were not kept.
+    pub(crate) fn path(&self, path: u64) -> &'a [LightVertex] {
+        let Some(chunk) = self.chunks.get((path / PATH_CHUNK) as usize) else {
+            return &[];
+        };
+        let local = (path % PATH_CHUNK) as usize;
+        let start = if local == 0 { 0 } else { chunk.ends[local - 1] };
+        chunk
+            .vertices
+            .get(start as usize..chunk.ends[local] as usize)
+            .unwrap_or(&[])
+    }
+}
+
 /// What a light subpath needs of its pass.
 pub(crate) struct LightPass<'a> {
     pub(crate) scene: &'a Scene,

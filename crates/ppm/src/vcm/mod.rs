@@ -29,7 +29,7 @@ use rayon::prelude::*;
 use scene::{Hit, Scene};
 
 use self::camera::{CameraPass, CameraSample};
-use self::light::{LightChunk, LightPass, LightVertex};
+use self::light::{LightChunk, LightPass, LightVertex, LightVertices, PATH_CHUNK};
 use self::mis::{Mis, Strategies};
 use crate::checkpoint::codec::{Reader, StateError, Writer};
 use crate::independent::schedule_squared;
@@ -38,22 +38,18 @@ use crate::params::{Method, RenderParams};
 use crate::photon_mapper::auto_initial_radius;
 use crate::stats::{MemoryEstimate, MemoryUse, PassStats};
 
-/// Light subpaths per parallel work item; fixed so that the vertex order and the sums do not
-/// depend on the thread count.
-const PATH_CHUNK: u64 = 2048;
 /// Pixels per parallel work item of the camera subpaths.
 const PIXEL_CHUNK: usize = 64;
-/// Light vertices kept per light subpath, for the memory estimate: the photon mappers store 0.7
-/// to 4.8 photons per emitted one on the scenes measured (docs/reliability.md); the estimate
-/// takes 5.
+/// Light vertices kept per light subpath, for the memory estimate: 0.66 to 4.7 on the
+/// repository's scenes (docs/integrators.md); the estimate takes 5.
 const VERTICES_PER_PATH: u64 = 5;
-/// Bytes per kept light vertex: the vertex twice (in its chunk and in the pass's list), its
-/// position copy for the grid and the grid's entries (measured 35–40 per hitpoint for the
-/// photon mappers' grid).
+/// Bytes per kept light vertex: the vertex in its chunk's buffer (which may hold twice what it
+/// keeps, as it grows by doubling), its position copy for the grid and the grid's entries
+/// (measured 35–40 per hitpoint for the photon mappers' grid).
 const BYTES_PER_VERTEX: u64 = 2 * std::mem::size_of::<LightVertex>() as u64 + 12 + 48;
-/// Bytes per light subpath of a pass besides its vertices: its end offset, its start in the
-/// pass's index, and up to five connections to the lens of 16 bytes.
-const BYTES_PER_PATH: u64 = 4 + 4 + 80;
+/// Bytes per light subpath of a pass besides its vertices: its end offset (twice, for the
+/// doubling) and up to five connections to the lens of 16 bytes.
+const BYTES_PER_PATH: u64 = 8 + 80;
 
 /// A vertex connection and merging render: per-pixel sums of the pass estimates.
 pub(crate) struct Vcm {
@@ -69,9 +65,8 @@ pub(crate) struct Vcm {
     sum: Vec<[f64; 3]>,
     /// Per chunk of [`PATH_CHUNK`] light subpaths, what they produced; kept from pass to pass.
     chunks: Vec<LightChunk>,
-    /// The pass's light vertices in subpath order, and where each subpath's start.
-    vertices: Vec<LightVertex>,
-    starts: Vec<u32>,
+    /// Per chunk, the pass number of its first kept vertex; then their total.
+    offsets: Vec<u32>,
     /// The grid of the last pass (kept for its memory report).
     grid: Option<HitPointGrid>,
 }
@@ -133,8 +128,7 @@ impl Vcm {
             passes: 0,
             sum: vec![[0.0; 3]; film.width as usize * film.height as usize],
             chunks: Vec::new(),
-            vertices: Vec::new(),
-            starts: Vec::new(),
+            offsets: Vec::new(),
             grid: None,
             scene,
         }
@@ -145,8 +139,8 @@ impl Vcm {
         self.radius * schedule_squared(u64::from(pass), self.params.kernel.alpha).sqrt()
     }
 
-    /// Traces the pass's light subpaths into `chunks` (their connections to the lens stay
-    /// there) and gathers their vertices into `vertices` and `starts`.
+    /// Traces the pass's light subpaths into `chunks` (their kept vertices and connections to
+    /// the lens stay there) and numbers the kept vertices (`offsets`).
     fn light_pass(&mut self, mis: Mis, stats: &mut PassStats) {
         let n = u64::from(self.params.budget.photons_per_pass);
         let n_chunks = usize::try_from(n.div_ceil(PATH_CHUNK)).unwrap_or(usize::MAX);
@@ -171,19 +165,27 @@ impl Vcm {
             }
         });
         // In chunk order, whatever the thread count.
-        self.vertices.clear();
-        self.starts.clear();
-        self.starts.push(0);
-        for chunk in &chunks {
-            let offset = self.vertices.len() as u32;
-            self.starts
-                .extend(chunk.ends.iter().map(|&end| offset + end));
-            self.vertices.extend_from_slice(&chunk.vertices);
+        self.offsets.clear();
+        let mut kept = 0u32;
+        for chunk in &mut chunks {
+            self.offsets.push(kept);
+            // The grid numbers vertices in u32. A pass that keeps more (some 500 GB of
+            // vertices, far beyond any memory estimate a render starts with) keeps the first
+            // ones; the rest do not connect or merge.
+            let fits = u32::try_from(chunk.vertices.len())
+                .ok()
+                .and_then(|len| kept.checked_add(len))
+                .filter(|&total| total < u32::MAX);
+            match fits {
+                Some(total) => kept = total,
+                None => chunk.vertices.clear(),
+            }
             stats.non_finite += chunk.non_finite;
             stats.light_connections += chunk.splats.len() as u64;
         }
+        self.offsets.push(kept);
         stats.photons_traced = n;
-        stats.photons_stored = self.vertices.len() as u64;
+        stats.photons_stored = u64::from(kept);
         self.chunks = chunks;
     }
 }
@@ -216,7 +218,11 @@ impl Integrator for Vcm {
         let index_clock = Instant::now();
         self.grid = None;
         if self.strategies.merging {
-            let positions: Vec<Vec3> = self.vertices.iter().map(|v| v.position).collect();
+            let positions: Vec<Vec3> = self
+                .chunks
+                .iter()
+                .flat_map(|c| c.vertices.iter().map(|v| v.position))
+                .collect();
             let radii = vec![radius; positions.len()];
             self.grid = Some(HitPointGrid::build(&positions, &radii, GridParams::DEFAULT));
             stats.mean_radius = radius;
@@ -235,8 +241,11 @@ impl Integrator for Vcm {
             rr_depth: self.params.budget.rr_depth,
             width: self.width,
             samples_per_pixel: spp,
-            vertices: &self.vertices,
-            starts: &self.starts,
+            vertices: LightVertices {
+                chunks: &self.chunks,
+                offsets: &self.offsets,
+            },
+            light_paths,
             grid: self.grid.as_ref(),
             merge_normalisation: (1.0
                 / (std::f64::consts::PI * radius * radius * light_paths as f64))
@@ -325,8 +334,7 @@ impl Integrator for Vcm {
             grid: 0,
             pass_hitpoint_buffers: 0,
             pass_photon_buffers: chunks
-                + self.vertices.capacity() * size_of::<LightVertex>()
-                + self.starts.capacity() * 4
+                + self.offsets.capacity() * 4
                 + self.grid.as_ref().map_or(0, |g| g.stats().bytes),
         })
     }

@@ -65,9 +65,16 @@ fn the_estimate_covers_what_a_render_holds() {
             let total = held.total() as u64;
             let estimated = estimate.hitpoints + estimate.photons;
             // (Not with the tiny kernels of the light-tracing cases, which gather far fewer
-            // photon–hitpoint pairs than the estimate allows for.)
+            // photon–hitpoint pairs than the estimate allows for. The bidirectional methods
+            // keep 0.66 light vertices per subpath on the ring caustic and 4.7 in the room, and
+            // the estimate must cover the room.)
+            let factor = if matches!(method, Method::Vcm | Method::Bdpt) {
+                12
+            } else {
+                8
+            };
             assert!(
-                light_tracing || estimated <= 8 * total,
+                light_tracing || estimated <= factor * total,
                 "{name} {method}: estimated {estimated} B for {total} B held"
             );
         }
