@@ -36,7 +36,7 @@ AOVS: list[str]
 
 StrPath = str | os.PathLike[str]
 ParamValue = str | int | float | bool
-Method = Literal["freq-sppm", "sppm", "freq", "ppm", "appm", "path", "light"]
+Method = Literal["freq-sppm", "sppm", "freq", "ppm", "appm", "path", "light", "vcm", "bdpt"]
 Format = Literal["toml", "obj", "gltf", "xml", "pbrt"]
 
 class SceneError(Exception):

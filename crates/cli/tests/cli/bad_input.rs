@@ -119,9 +119,9 @@ fn negative_or_zero_photons() {
 fn unknown_method() {
     check(
         "unknown_method",
-        &["render", CORNELL, "--method", "bdpt"],
+        &["render", CORNELL, "--method", "mlt"],
         2,
-        &["--method", "bdpt", "ppm", "freq-sppm"],
+        &["--method", "mlt", "ppm", "freq-sppm", "vcm", "bdpt"],
     );
 }
 

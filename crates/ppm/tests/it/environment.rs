@@ -85,6 +85,13 @@ fn white_furnace_is_one_everywhere_for_every_method() {
     p.connections.direct_lighting = true;
     p.film.samples_per_pixel = 16;
     runs.push((Method::Sppm, render(&scene, p, 64)));
+    // The bidirectional methods: light subpaths from the sky's disc, camera subpaths that
+    // escape to it, next-event estimation of it, all weighted against each other.
+    for method in [Method::Bdpt, Method::Vcm] {
+        let mut p = params(method, 2_000);
+        p.film.samples_per_pixel = 4;
+        runs.push((method, render(&scene, p, 8)));
+    }
     for (method, image) in runs {
         let sphere = mean_where(&image, &on);
         assert!(
