@@ -238,11 +238,21 @@ impl PhotonMapper {
             // Whether the photon, which the grid reported for `slot` (so it lies within the
             // slot's radius: the grid's test is exactly that of `photon::accepts`), counts for
             // it: the light path they make has at most `max_depth` bounces, and the photon is
-            // on the hitpoint's side, with agreeing normals (see `photon::faces`).
+            // on the hitpoint's side, with agreeing normals (see `photon::faces`), or on the
+            // other side of a surface that transmits through a lobe of finite density (a rough
+            // dielectric), whose hitpoints see light from both sides.
+            let normal = slots.geometric_normal()[slot];
             let accepts = photon.bounces <= u32::from(photon_bounces[slot])
-                && photon::faces(photon, slots.geometric_normal()[slot], AcceptParams::COS_60);
+                && (photon::faces(photon, normal, AcceptParams::COS_60)
+                    || (photon::faces(photon, -normal, AcceptParams::COS_60)
+                        && setup
+                            .scene
+                            .material(slots.material_idx()[slot])
+                            .is_some_and(|m| m.kind.transmits())));
             accepts.then(|| {
                 let material = setup.scene.material(slots.material_idx()[slot])?;
+                // The shading normal faces the outside of a refracting material (the camera
+                // pass turns it so), as `eval_about` takes it.
                 let (normal, outgoing) = (slots.shading_normal()[slot], slots.outgoing()[slot]);
                 let f = Bsdf::eval_about(material.kind, normal, outgoing, photon.incoming);
                 let mut flux = f * photon.power * slots.weight()[slot];

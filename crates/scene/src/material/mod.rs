@@ -277,6 +277,18 @@ fn transmits<M: Model>(_: &M) -> bool {
 }
 
 impl MaterialKind {
+    /// A dielectric of index `ior` with GGX roughness `roughness` as the importers read it: the
+    /// smooth [`Dielectric`] below [`SMOOTH_ROUGHNESS`] (which it renders as anyway), else a
+    /// [`RoughDielectric`]. Neither value is checked here (validation does).
+    #[must_use]
+    pub fn dielectric(ior: f32, roughness: f32) -> Self {
+        if roughness < SMOOTH_ROUGHNESS {
+            Self::Dielectric(Dielectric { ior })
+        } else {
+            Self::RoughDielectric(RoughDielectric { ior, roughness })
+        }
+    }
+
     /// The model's name in scene files and summaries: `diffuse`, `mirror`, `dielectric`,
     /// `glossy`.
     #[must_use]
