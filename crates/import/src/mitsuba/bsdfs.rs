@@ -201,7 +201,7 @@ impl<'a> Importer<'a> {
                 }
                 let roughness = if ty == "roughdielectric" {
                     let alpha = self.alpha(node, &label)?;
-                    if !(alpha >= 0.0) {
+                    if alpha.is_nan() || alpha < 0.0 {
                         let p = prop(node, "alpha").unwrap_or(node);
                         return Err(self.err(p, format!("alpha must be ≥ 0, got {alpha}")));
                     }
@@ -209,7 +209,7 @@ impl<'a> Importer<'a> {
                 } else {
                     0.0
                 };
-                if !(int > 0.0 && ext > 0.0) {
+                if int.is_nan() || ext.is_nan() || int <= 0.0 || ext <= 0.0 {
                     return Err(self.err(
                         node,
                         format!("int_ior and ext_ior must be > 0, got {int} and {ext}"),

@@ -51,7 +51,7 @@ impl Converter<'_> {
                 // Zero (or absent) is the smooth dielectric; anything else must be a GGX α.
                 let roughness = match roughness {
                     None => 0.0,
-                    Some(r) if r == 0.0 => 0.0,
+                    Some(0.0) => 0.0,
                     Some(r) => self.positive(&key("roughness"), r)?,
                 };
                 (MaterialKind::dielectric(ior, roughness), emission)
