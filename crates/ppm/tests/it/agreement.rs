@@ -159,6 +159,9 @@ material = "lamp"
         let image = render(&scene, p, 16);
         let ratio = mean(&image) / reference;
         eprintln!("frosted glass {method}: mean ratio to the path tracer {ratio:.4}");
+        // Measured: 0.985 to 0.990 for the photon mappers, 0.980 for `light` (the reference's
+        // own spread between seeds is 0.3 %); without the photons from inside the slab the
+        // photon mappers read 0, with those of the slab's far face 1.39.
         assert!((ratio - 1.0).abs() < 0.03, "{method}: mean ratio {ratio}");
     }
 }
