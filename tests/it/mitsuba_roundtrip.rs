@@ -96,6 +96,9 @@ fn write_mitsuba(scene: &SceneDescription, dir: &Path) -> PathBuf {
             MaterialKind::Dielectric(scene::Dielectric { ior }) => format!(
                 "<bsdf type=\"dielectric\" id=\"m{i}\"><float name=\"int_ior\" value=\"{ior}\"/><float name=\"ext_ior\" value=\"1\"/></bsdf>"
             ),
+            MaterialKind::RoughDielectric(scene::RoughDielectric { ior, roughness }) => format!(
+                "<bsdf type=\"roughdielectric\" id=\"m{i}\"><float name=\"alpha\" value=\"{roughness}\"/><float name=\"int_ior\" value=\"{ior}\"/><float name=\"ext_ior\" value=\"1\"/></bsdf>"
+            ),
             MaterialKind::Glossy(scene::Glossy {
                 reflectance,
                 roughness,
@@ -264,6 +267,19 @@ fn close_kind(a: MaterialKind, b: MaterialKind, what: &str) {
             MaterialKind::Dielectric(scene::Dielectric { ior: x }),
             MaterialKind::Dielectric(scene::Dielectric { ior: y }),
         ) => close_f(x, y, what),
+        (
+            MaterialKind::RoughDielectric(scene::RoughDielectric {
+                ior: x,
+                roughness: a1,
+            }),
+            MaterialKind::RoughDielectric(scene::RoughDielectric {
+                ior: y,
+                roughness: a2,
+            }),
+        ) => {
+            close_f(x, y, what);
+            close_f(a1, a2, what);
+        }
         (
             MaterialKind::Glossy(scene::Glossy {
                 reflectance: r1,

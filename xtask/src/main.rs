@@ -15,6 +15,8 @@ mod docs_image;
 mod farm;
 mod fuzz;
 mod peers;
+#[cfg(test)]
+mod peers_tests;
 mod render_all;
 mod suite;
 #[cfg(test)]

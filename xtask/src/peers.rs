@@ -24,8 +24,9 @@ cargo xtask peers [--scenes a,b,...] [--seconds 60] [--film WxH] [--threads 2]
                   [--reference-seconds 1200] [--out DIR] [--fppm-args \"...\"] [--paths N]
                   [--fppm FILE]
 
-Renders every scene of scenes/peers/ (or those named: a name of scenes/peers/ or the path of any
-scene file fppm reads, e.g. ../shared/scenes/cornell_box/CornellBox-Water.obj) with each fppm method and each Mitsuba 3
+Renders every scene of scenes/peers/ (or those named: a name of scenes/peers/, `veach-mis` for
+../shared/scenes/pbrt-v4/veach-mis/veach-mis.pbrt, or the path of any scene file fppm reads,
+e.g. ../shared/scenes/cornell_box/CornellBox-Water.obj) with each fppm method and each Mitsuba 3
 integrator for the same wall-clock time, one renderer at a time, all with --threads threads,
 and scores them against a Mitsuba `path` reference (max_depth unlimited) rendered as two
 independent halves of --reference-seconds / 2 each (kept in DIR/SCENE/ and reused; delete them
@@ -131,6 +132,13 @@ impl Flags {
 /// A scene of the comparison: a name of `scenes/peers/`, or the path of any scene file fppm
 /// reads (named by its file stem in the table and the output folder).
 fn scene_file(root: &Path, arg: &str) -> (String, PathBuf) {
+    if arg == "veach-mis" {
+        // Veach's MIS plates, read in place from the shared pbrt-v4 scenes.
+        return (
+            arg.to_owned(),
+            root.join("../shared/scenes/pbrt-v4/veach-mis/veach-mis.pbrt"),
+        );
+    }
     if arg.contains('/') || arg.contains('.') {
         let path = root.join(arg);
         let stem = path
@@ -520,9 +528,11 @@ fn run_mitsuba(
 /// texture (with albedo 1) is a `bitmap` reflectance (sRGB-decoded by Mitsuba for 8-bit files,
 /// bilinear, with the same wrap mode), a cut-out a `mask` BSDF with the alpha as opacity
 /// (`raw`); the integrator is `$integrator` with unlimited depth; the environment is Mitsuba's
-/// `constant` or `envmap` ([`environment_emitter`]). Glossy materials and lights other than
-/// emissive surfaces, point lights and the environment are refused: the peer scenes do not use
-/// them.
+/// `constant` or `envmap` ([`environment_emitter`]); a rough dielectric is `roughdielectric`
+/// (GGX), a glossy conductor a two-sided `roughconductor` of the η whose exact Fresnel fppm's
+/// Schlick approximates, a glossy coat over a diffuse base a two-sided `roughplastic`. Lights
+/// other than emissive surfaces, point lights and the environment are refused: the peer scenes
+/// do not use them.
 pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -> Result<PathBuf> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut xml = String::new();
@@ -602,7 +612,42 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
             scene::MaterialKind::Dielectric(scene::Dielectric { ior }) => format!(
                 "<bsdf type=\"dielectric\"><float name=\"int_ior\" value=\"{ior}\"/><float name=\"ext_ior\" value=\"1.0\"/></bsdf>"
             ),
-            other => bail!("material {} ({other:?}) is not exported", m.name),
+            scene::MaterialKind::RoughDielectric(scene::RoughDielectric { ior, roughness }) => {
+                format!(
+                    "<bsdf type=\"roughdielectric\"><string name=\"distribution\" value=\"ggx\"/><float name=\"alpha\" value=\"{roughness}\"/><float name=\"int_ior\" value=\"{ior}\"/><float name=\"ext_ior\" value=\"1.0\"/></bsdf>"
+                )
+            }
+            // A conductor: fppm's Schlick Fresnel of F₀ = `reflectance` is the approximation of
+            // the exact Fresnel of an absorption-free boundary with η = (1 + √F₀)/(1 − √F₀),
+            // which Mitsuba's `roughconductor` evaluates given that η and k = 0.
+            scene::MaterialKind::Glossy(scene::Glossy {
+                reflectance,
+                roughness,
+                diffuse,
+            }) if diffuse == Vec3::ZERO => {
+                let eta = reflectance.to_array().map(|f0| {
+                    let r = f0.clamp(0.0, 0.998).sqrt();
+                    (1.0 + r) / (1.0 - r)
+                });
+                format!(
+                    "<bsdf type=\"twosided\"><bsdf type=\"roughconductor\"><string name=\"distribution\" value=\"ggx\"/><float name=\"alpha\" value=\"{roughness}\"/><rgb name=\"eta\" value=\"{}\"/><rgb name=\"k\" value=\"0, 0, 0\"/></bsdf></bsdf>",
+                    rgb(eta)
+                )
+            }
+            // A coat over a diffuse base: Mitsuba's `roughplastic` with the coat's ior 1.5
+            // (F₀ = 0.04), as the Mitsuba importer reads it back (`specular_reflectance`
+            // scales the coat's Fresnel, `diffuse_reflectance` is under it). Its base scatters
+            // inside the coat, fppm's is coupled by Ashikhmin and Shirley's factor: close, not
+            // equal.
+            scene::MaterialKind::Glossy(scene::Glossy {
+                reflectance,
+                roughness,
+                diffuse,
+            }) => format!(
+                "<bsdf type=\"twosided\"><bsdf type=\"roughplastic\"><string name=\"distribution\" value=\"ggx\"/><float name=\"int_ior\" value=\"1.5\"/><float name=\"ext_ior\" value=\"1.0\"/><float name=\"alpha\" value=\"{roughness}\"/><rgb name=\"specular_reflectance\" value=\"{}\"/><rgb name=\"diffuse_reflectance\" value=\"{}\"/></bsdf></bsdf>",
+                rgb((reflectance / 0.04).min(Vec3::ONE).to_array()),
+                rgb((diffuse / 0.96).min(Vec3::ONE).to_array())
+            ),
         };
         // A cut-out: Mitsuba's `mask` keeps the surface with probability = opacity (a stochastic
         // cut-out); fppm's `MASK` thresholds it, which agrees where the mask is 0 or 1.

@@ -60,7 +60,7 @@ pub use light::{
 };
 pub use material::{
     Bsdf, BsdfPdfs, BsdfSample, Dielectric, Diffuse, Glossy, Lobe, MaterialKind, MaterialParam,
-    Mirror, TransportMode, fresnel_dielectric, luminance,
+    Mirror, RoughDielectric, SMOOTH_ROUGHNESS, TransportMode, fresnel_dielectric, luminance,
 };
 pub use ray::{Hit, Primitive, Ray};
 pub use scene::{Scene, SceneError};

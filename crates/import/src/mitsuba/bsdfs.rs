@@ -191,9 +191,6 @@ impl<'a> Importer<'a> {
                     self.builder.warn(format!(
                         "{label}: a thin dielectric is rendered as a solid dielectric of the same ior (rays bend)"
                     ));
-                } else if ty == "roughdielectric" {
-                    self.builder
-                        .warn(format!("{label}: a rough dielectric is rendered smooth"));
                 }
                 if prop(node, "specular_reflectance").is_some()
                     || prop(node, "specular_transmittance").is_some()
@@ -202,7 +199,23 @@ impl<'a> Importer<'a> {
                         "{label}: specular_reflectance/transmittance are ignored (fppm's dielectric is clear)"
                     ));
                 }
-                MaterialKind::Dielectric(scene::Dielectric { ior: int / ext })
+                let roughness = if ty == "roughdielectric" {
+                    let alpha = self.alpha(node, &label)?;
+                    if alpha.is_nan() || alpha < 0.0 {
+                        let p = prop(node, "alpha").unwrap_or(node);
+                        return Err(self.err(p, format!("alpha must be ≥ 0, got {alpha}")));
+                    }
+                    alpha
+                } else {
+                    0.0
+                };
+                if int.is_nan() || ext.is_nan() || int <= 0.0 || ext <= 0.0 {
+                    return Err(self.err(
+                        node,
+                        format!("int_ior and ext_ior must be > 0, got {int} and {ext}"),
+                    ));
+                }
+                MaterialKind::dielectric(int / ext, roughness)
             }
             "plastic" | "roughplastic" => {
                 let int = self.ior(node, "int_ior", 1.49)?;

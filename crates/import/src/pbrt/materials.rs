@@ -123,6 +123,17 @@ impl Parser {
                 }
             }
         };
+        if r < 0.0 {
+            let p = [name.to_owned(), format!("u{name}"), format!("v{name}")]
+                .iter()
+                .find_map(|n| params.get(n));
+            if let Some(p) = p {
+                return Err(self.err(
+                    Self::loc_of_param(p),
+                    format!("parameter \"{}\" must be ≥ 0, got {r}", p.name),
+                ));
+            }
+        }
         let r = r.max(0.0) as f32;
         Ok(if remap { r.sqrt() } else { r })
     }
@@ -214,10 +225,8 @@ impl Parser {
                 if def.kind == "thindielectric" {
                     self.warn(format!("{label}: a thin dielectric is rendered as a solid dielectric of the same ior (rays bend)"));
                 }
-                if self.alpha(&p, "roughness", remap)? > 0.0 {
-                    self.warn(format!("{label}: a rough dielectric is rendered smooth"));
-                }
-                MaterialKind::Dielectric(scene::Dielectric { ior: eta })
+                let roughness = self.alpha(&p, "roughness", remap)?;
+                MaterialKind::dielectric(eta, roughness)
             }
             "coateddiffuse" => {
                 let (reflectance, texture) = self

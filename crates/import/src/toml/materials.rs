@@ -42,12 +42,20 @@ impl Converter<'_> {
                     emission,
                 )
             }
-            MaterialToml::Dielectric { ior, emission } => (
-                MaterialKind::Dielectric(scene::Dielectric {
-                    ior: self.positive(&key("ior"), ior)?,
-                }),
+            MaterialToml::Dielectric {
+                ior,
+                roughness,
                 emission,
-            ),
+            } => {
+                let ior = self.positive(&key("ior"), ior)?;
+                // Zero (or absent) is the smooth dielectric; anything else must be a GGX α.
+                let roughness = match roughness {
+                    None => 0.0,
+                    Some(0.0) => 0.0,
+                    Some(r) => self.positive(&key("roughness"), r)?,
+                };
+                (MaterialKind::dielectric(ior, roughness), emission)
+            }
             MaterialToml::Glossy {
                 reflectance,
                 roughness,

@@ -52,6 +52,8 @@ pub(super) enum MaterialToml {
     },
     Dielectric {
         ior: f32,
+        /// Extension: GGX α of a rough dielectric (`docs/scene-format-extensions.md`).
+        roughness: Option<f32>,
         emission: Option<ColorToml>,
     },
     Glossy {

@@ -10,6 +10,7 @@ mod import_textures;
 mod mitsuba;
 mod obj;
 mod pbrt;
+mod rough_dielectric;
 mod shared_scenes;
 mod toml_scene;
 

@@ -183,9 +183,22 @@ impl Setup {
                 return None;
             }
             let mu = end.outgoing.dot(hit.shading_normal).abs();
+            // The photon gather evaluates the BSDF about the stored normal as the outside's
+            // (`Bsdf::eval_about`): a refracting material seen from inside keeps its normal
+            // turned outward, so that η is the right way round. Every other model scatters
+            // alike on both sides.
+            let refracts = self
+                .scene
+                .material(hit.material)
+                .is_some_and(|m| m.kind.refractive_index().is_some());
+            let shading_normal = if refracts && !hit.front_face {
+                -hit.shading_normal
+            } else {
+                hit.shading_normal
+            };
             Some(VisiblePoint {
                 position: hit.position,
-                shading_normal: hit.shading_normal,
+                shading_normal,
                 geometric_normal: hit.geometric_normal,
                 outgoing: end.outgoing,
                 material: hit.material,

@@ -238,11 +238,30 @@ impl PhotonMapper {
             // Whether the photon, which the grid reported for `slot` (so it lies within the
             // slot's radius: the grid's test is exactly that of `photon::accepts`), counts for
             // it: the light path they make has at most `max_depth` bounces, and the photon is
-            // on the hitpoint's side, with agreeing normals (see `photon::faces`).
+            // on the hitpoint's side, with agreeing normals (see `photon::faces`), or on the
+            // other side of a surface that transmits through a lobe of finite density (a rough
+            // dielectric), whose hitpoints see light from both sides. A photon from the other
+            // side must lie on the hitpoint's surface, within a quarter of the radius of its
+            // tangent plane: the far face of a thin slab, whose photons have not crossed it
+            // yet, is rejected once the radius is below four times the slab's thickness
+            // (a curved surface keeps its own photons while R is below half its radius of
+            // curvature).
+            let normal = slots.geometric_normal()[slot];
+            let crossed = || {
+                let off_plane = (photon.position - slots.position()[slot]).dot(normal).abs();
+                f64::from(off_plane) <= 0.25 * slots.radius()[slot]
+                    && photon::faces(photon, -normal, AcceptParams::COS_60)
+                    && setup
+                        .scene
+                        .material(slots.material_idx()[slot])
+                        .is_some_and(|m| m.kind.transmits())
+            };
             let accepts = photon.bounces <= u32::from(photon_bounces[slot])
-                && photon::faces(photon, slots.geometric_normal()[slot], AcceptParams::COS_60);
+                && (photon::faces(photon, normal, AcceptParams::COS_60) || crossed());
             accepts.then(|| {
                 let material = setup.scene.material(slots.material_idx()[slot])?;
+                // The shading normal faces the outside of a refracting material (the camera
+                // pass turns it so), as `eval_about` takes it.
                 let (normal, outgoing) = (slots.shading_normal()[slot], slots.outgoing()[slot]);
                 let f = Bsdf::eval_about(material.kind, normal, outgoing, photon.incoming);
                 let mut flux = f * photon.power * slots.weight()[slot];

@@ -118,12 +118,19 @@ pub fn fresnel_dielectric(cos_theta_i: f32, eta: f32) -> f32 {
 /// η = η(far side)/η(side of `wo`); `None` under total internal reflection.
 fn refract(wo: Vec3, eta: f32) -> Option<Vec3> {
     let n = if wo.z > 0.0 { Vec3::Z } else { -Vec3::Z };
-    let cos_i = wo.z.abs();
+    refract_about(wo, n, eta)
+}
+
+/// Refraction of the unit `w` through a boundary of unit normal `n` on the side of `w`
+/// (`w·n` ≥ 0), with relative η = η(far side)/η(side of `w`); `None` under total internal
+/// reflection.
+pub(super) fn refract_about(w: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
+    let cos_i = w.dot(n).clamp(0.0, 1.0);
     let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
     let sin2_t = sin2_i / (eta * eta);
     if sin2_t >= 1.0 {
         return None;
     }
     let cos_t = (1.0 - sin2_t).sqrt();
-    Some((-wo / eta + (cos_i / eta - cos_t) * n).normalize())
+    Some((-w / eta + (cos_i / eta - cos_t) * n).normalize())
 }

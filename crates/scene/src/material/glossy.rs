@@ -143,7 +143,7 @@ fn specular_probability(reflectance: Rgb, diffuse: Rgb, cos_o: f32) -> f32 {
 }
 
 /// GGX normal distribution D(ωm) for roughness α.
-fn ggx_d(wm: Vec3, alpha: f32) -> f32 {
+pub(super) fn ggx_d(wm: Vec3, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
     let c2 = wm.z * wm.z;
     let denom = c2 * (a2 - 1.0) + 1.0;
@@ -151,7 +151,7 @@ fn ggx_d(wm: Vec3, alpha: f32) -> f32 {
 }
 
 /// Smith Λ(ω) for GGX.
-fn ggx_lambda(w: Vec3, alpha: f32) -> f32 {
+pub(super) fn ggx_lambda(w: Vec3, alpha: f32) -> f32 {
     let c2 = w.z * w.z;
     let s2 = (1.0 - c2).max(0.0);
     if c2 == 0.0 {
@@ -188,7 +188,7 @@ fn ggx_pdf(wo: Vec3, wi: Vec3, alpha: f32) -> f32 {
 
 /// Samples a microfacet normal from the distribution of normals visible from `wo` (Heitz 2018,
 /// "Sampling the GGX Distribution of Visible Normals"); `wo.z > 0`.
-fn ggx_sample_visible_normal(wo: Vec3, alpha: f32, u: Vec2) -> Vec3 {
+pub(super) fn ggx_sample_visible_normal(wo: Vec3, alpha: f32, u: Vec2) -> Vec3 {
     // Stretch to the hemisphere configuration.
     let vh = Vec3::new(alpha * wo.x, alpha * wo.y, wo.z).normalize();
     let len2 = vh.x * vh.x + vh.y * vh.y;

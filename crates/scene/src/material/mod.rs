@@ -3,7 +3,8 @@
 //! - `diffuse.rs`: Lambert;
 //! - `mirror.rs`: a perfect specular conductor of constant reflectance;
 //! - `dielectric.rs`: a smooth dielectric with exact unpolarised Fresnel;
-//! - `glossy.rs`: a GGX conductor over an optional Lambertian base.
+//! - `glossy.rs`: a GGX conductor over an optional Lambertian base;
+//! - `rough_dielectric.rs`: GGX microfacet reflection and refraction with exact Fresnel.
 //!
 //! [`MaterialKind`] is a material's model as a scene describes it, and [`Bsdf`] a model at one
 //! surface point. A new model is a module here implementing [`Model`], a variant of
@@ -17,6 +18,12 @@
 //! side of the shading normal, whichever side that is. [`Bsdf::pdfs`] and
 //! [`Bsdf::sample_with_pdfs`] give the densities of an event in both directions ([`BsdfPdfs`]),
 //! for bidirectional methods.
+//!
+//! [`Bsdf::eval`] is the BSDF that radiance sees ([`TransportMode::Radiance`]) with `outgoing`
+//! toward the camera end of the path, which is how every caller evaluates it (next-event
+//! estimation, a hitpoint's photon gather, a light vertex's connection to the lens); it differs
+//! from the light paths' adjoint only across a refraction of finite density (the rough
+//! dielectric), by the factor η′² that [`TransportMode`] describes.
 
 mod dielectric;
 mod diffuse;
@@ -24,6 +31,9 @@ mod glossy;
 mod mirror;
 #[cfg(test)]
 mod pdf_tests;
+mod rough_dielectric;
+#[cfg(test)]
+mod rough_dielectric_tests;
 #[cfg(test)]
 mod tests;
 
@@ -33,6 +43,7 @@ pub use self::dielectric::{Dielectric, fresnel_dielectric};
 pub use self::diffuse::Diffuse;
 pub use self::glossy::Glossy;
 pub use self::mirror::Mirror;
+pub use self::rough_dielectric::{RoughDielectric, SMOOTH_ROUGHNESS};
 use crate::{Frame, Hit, Material, Rgb};
 
 /// What a path carries, which matters for refraction (Veach 1997, §5.2; pbrt's `TransportMode`).
@@ -117,6 +128,9 @@ pub enum MaterialKind {
     /// Rough conductor with a GGX (Trowbridge–Reitz) distribution and Smith shadowing,
     /// optionally over a Lambertian base.
     Glossy(Glossy),
+    /// Rough dielectric: GGX microfacet reflection and refraction with exact unpolarised
+    /// Fresnel (the smooth dielectric below [`SMOOTH_ROUGHNESS`]).
+    RoughDielectric(RoughDielectric),
 }
 
 /// Evaluates `$body` with `$model` bound to the model inside `$kind`, whichever it is: the one
@@ -128,6 +142,7 @@ macro_rules! with_model {
             MaterialKind::Mirror($model) => $body,
             MaterialKind::Dielectric($model) => $body,
             MaterialKind::Glossy($model) => $body,
+            MaterialKind::RoughDielectric($model) => $body,
         }
     };
 }
@@ -160,6 +175,11 @@ pub(crate) struct Shading {
 pub(crate) trait Model: Copy {
     /// Its name in scene files and summaries.
     const NAME: &'static str;
+    /// Whether a lobe of finite density transmits: [`Bsdf`] then evaluates it through
+    /// [`Model::eval_through`] and [`Model::pdf_through`], which see both local directions as
+    /// they are (either side), instead of [`Model::eval_local`] and [`Model::pdf_local`], which
+    /// see a same-side pair mirrored into the upper hemisphere.
+    const TRANSMITS: bool = false;
     /// The lobe for the frequency operators.
     fn lobe(&self) -> Lobe;
     /// The reflectance it shows at normal incidence (the albedo AOV).
@@ -213,6 +233,18 @@ pub(crate) trait Model: Copy {
         );
         0.0
     }
+    /// f (for radiance) of a model that [`Model::TRANSMITS`], for local directions on either
+    /// side, the same or opposite ones.
+    #[inline]
+    fn eval_through(&self, _s: &Shading, _wo: Vec3, _wi: Vec3) -> Rgb {
+        Rgb::ZERO
+    }
+    /// The solid-angle density of [`Model::sample_local`] for a model that
+    /// [`Model::TRANSMITS`], for local directions on either side.
+    #[inline]
+    fn pdf_through(&self, _s: &Shading, _wo: Vec3, _wi: Vec3) -> f32 {
+        0.0
+    }
     /// The probability that [`Model::sample_local`] from the local `wo` (either side, finite,
     /// z ≠ 0) picks its delta refraction if `transmission`, else its delta reflection: the `pdf`
     /// of such a sample. The default is zero, for a model without delta lobes.
@@ -238,7 +270,25 @@ fn model_name<M: Model>(_: &M) -> &'static str {
     M::NAME
 }
 
+/// [`Model::TRANSMITS`] of the model behind a reference, for [`with_model!`].
+#[inline]
+fn transmits<M: Model>(_: &M) -> bool {
+    M::TRANSMITS
+}
+
 impl MaterialKind {
+    /// A dielectric of index `ior` with GGX roughness `roughness` as the importers read it: the
+    /// smooth [`Dielectric`] below [`SMOOTH_ROUGHNESS`] (which it renders as anyway), else a
+    /// [`RoughDielectric`]. Neither value is checked here (validation does).
+    #[must_use]
+    pub fn dielectric(ior: f32, roughness: f32) -> Self {
+        if roughness < SMOOTH_ROUGHNESS {
+            Self::Dielectric(Dielectric { ior })
+        } else {
+            Self::RoughDielectric(RoughDielectric { ior, roughness })
+        }
+    }
+
     /// The model's name in scene files and summaries: `diffuse`, `mirror`, `dielectric`,
     /// `glossy`.
     #[must_use]
@@ -289,6 +339,15 @@ impl MaterialKind {
     #[inline]
     pub fn refractive_index(&self) -> Option<f32> {
         with_model!(self, m => m.refractive_index())
+    }
+
+    /// Whether a lobe of finite density transmits (a rough dielectric that is not rendered
+    /// smooth): light arriving on either side of the surface leaves toward a viewer, so a
+    /// hitpoint there gathers photons from both sides.
+    #[must_use]
+    #[inline]
+    pub fn transmits(&self) -> bool {
+        with_model!(self, m => transmits(m)) && !self.is_specular()
     }
 }
 
@@ -382,6 +441,9 @@ impl Bsdf {
             }
             let frame = self.frame();
             let (wo, wi) = (frame.to_local(outgoing), frame.to_local(incoming));
+            if transmits(&m) {
+                return m.eval_through(s, wo, wi);
+            }
             if wo.z * wi.z <= 0.0 {
                 return Rgb::ZERO;
             }
@@ -395,11 +457,16 @@ impl Bsdf {
     pub fn pdf(&self, outgoing: Vec3, incoming: Vec3) -> f32 {
         let frame = self.frame();
         let (wo, wi) = (frame.to_local(outgoing), frame.to_local(incoming));
-        if wo.z * wi.z <= 0.0 {
-            return 0.0;
-        }
-        let (wo, wi) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
-        with_model!(self.kind, m => m.pdf_local(wo, wi))
+        with_model!(self.kind, m => {
+            if transmits(&m) {
+                return m.pdf_through(&self.shading, wo, wi);
+            }
+            if wo.z * wi.z <= 0.0 {
+                return 0.0;
+            }
+            let (wo, wi) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
+            m.pdf_local(wo, wi)
+        })
     }
 
     /// Draws `incoming` for `outgoing` with `u_lobe` ∈ [0, 1) choosing a lobe (Fresnel reflection vs
@@ -427,13 +494,18 @@ impl Bsdf {
     pub fn pdfs(&self, outgoing: Vec3, incoming: Vec3) -> BsdfPdfs {
         let frame = self.frame();
         let (wo, wi) = (frame.to_local(outgoing), frame.to_local(incoming));
-        let (forward, reverse) = if wo.z * wi.z <= 0.0 {
-            (0.0, 0.0)
-        } else {
-            // The flip of `pdf`, which mirrors both directions whichever comes first.
-            let (wo, wi) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
-            with_model!(self.kind, m => (m.pdf_local(wo, wi), m.pdf_local(wi, wo)))
-        };
+        let s = &self.shading;
+        let (forward, reverse) = with_model!(self.kind, m => {
+            if transmits(&m) {
+                (m.pdf_through(s, wo, wi), m.pdf_through(s, wi, wo))
+            } else if wo.z * wi.z <= 0.0 {
+                (0.0, 0.0)
+            } else {
+                // The flip of `pdf`, which mirrors both directions whichever comes first.
+                let (wo, wi) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
+                (m.pdf_local(wo, wi), m.pdf_local(wi, wo))
+            }
+        });
         BsdfPdfs {
             forward,
             reverse,

@@ -12,16 +12,16 @@ use crate::test_util::{Rng, pearson_chi_square};
 use crate::{Frame, MaterialKind, Rgb};
 
 /// A tilted normal, so that the local frame is not the world frame.
-fn normal() -> Vec3 {
+pub(super) fn normal() -> Vec3 {
     Vec3::new(0.3, -0.2, 0.9).normalize()
 }
 
-fn bsdf(kind: MaterialKind, front_face: bool) -> Bsdf {
+pub(super) fn bsdf(kind: MaterialKind, front_face: bool) -> Bsdf {
     Bsdf::from_normal(kind, normal(), front_face)
 }
 
 /// The direction at polar angle `theta_deg` from the normal, on the side `side` (±1).
-fn direction(b: &Bsdf, theta_deg: f32, side: f32) -> Vec3 {
+pub(super) fn direction(b: &Bsdf, theta_deg: f32, side: f32) -> Vec3 {
     let t = theta_deg.to_radians();
     side * b
         .frame()
@@ -29,7 +29,7 @@ fn direction(b: &Bsdf, theta_deg: f32, side: f32) -> Vec3 {
 }
 
 /// The models with lobes of finite density: Lambert, GGX from sharp to rough, GGX over a
-/// diffuse base.
+/// diffuse base, rough dielectrics.
 fn finite_models() -> Vec<MaterialKind> {
     let glossy = |roughness, reflectance, diffuse| {
         MaterialKind::Glossy(crate::Glossy {
@@ -46,6 +46,14 @@ fn finite_models() -> Vec<MaterialKind> {
         glossy(0.3, 0.5, 0.4),
         glossy(0.8, 0.6, 0.0),
         glossy(0.15, 0.04, 0.8),
+        MaterialKind::RoughDielectric(crate::RoughDielectric {
+            ior: 1.5,
+            roughness: 0.3,
+        }),
+        MaterialKind::RoughDielectric(crate::RoughDielectric {
+            ior: 1.33,
+            roughness: 0.7,
+        }),
     ]
 }
 
@@ -63,6 +71,12 @@ fn delta_models() -> Vec<(MaterialKind, bool)> {
             ));
         }
     }
+    // A rough dielectric below `SMOOTH_ROUGHNESS` is the smooth one.
+    let nearly_smooth = MaterialKind::RoughDielectric(crate::RoughDielectric {
+        ior: 1.5,
+        roughness: 5e-4,
+    });
+    models.extend([(nearly_smooth, true), (nearly_smooth, false)]);
     models
 }
 
@@ -70,14 +84,19 @@ fn delta_models() -> Vec<(MaterialKind, bool)> {
 const THETAS: [f32; 5] = [0.0, 30.0, 60.0, 85.0, 89.5];
 
 /// The mirror image of `w` about the normal: where a glossy lobe peaks.
-fn mirrored(w: Vec3) -> Vec3 {
+pub(super) fn mirrored(w: Vec3) -> Vec3 {
     2.0 * w.dot(normal()) * normal() - w
 }
 
 /// ∫ f dω over the sphere by the midpoint rule in (t, φ) about `axis`, with the polar angle
 /// θ = π t²: dω = 2π t sin(π t²) dt dφ, so the steps in θ are fine near the axis, where the
 /// sharp lobes are, and the rule is exact in φ for a lobe symmetric about the axis.
-fn integrate(axis: Vec3, n_t: usize, n_phi: usize, mut f: impl FnMut(Vec3) -> f64) -> f64 {
+pub(super) fn integrate(
+    axis: Vec3,
+    n_t: usize,
+    n_phi: usize,
+    mut f: impl FnMut(Vec3) -> f64,
+) -> f64 {
     let frame = Frame::from_normal(axis);
     let mut sum = 0.0;
     for i in 0..n_t {
@@ -95,7 +114,7 @@ fn integrate(axis: Vec3, n_t: usize, n_phi: usize, mut f: impl FnMut(Vec3) -> f6
 }
 
 /// The world direction of (t, φ) about the frame's normal (θ = π t²).
-fn warped(frame: &Frame, t: f64, phi: f64) -> Vec3 {
+pub(super) fn warped(frame: &Frame, t: f64, phi: f64) -> Vec3 {
     let theta = PI64 * t * t;
     let (s, c) = theta.sin_cos();
     let local = Vec3::new((s * phi.cos()) as f32, (s * phi.sin()) as f32, c as f32);
@@ -179,7 +198,7 @@ fn densities_integrate_to_the_share_of_finite_samples() {
 /// Pearson χ² of the directions `sample` draws from `from` against `density`, over bins of
 /// (t, φ) about `axis` (θ = π t²) whose expectations integrate `density` by a midpoint rule;
 /// bins expecting fewer than 5 samples are pooled. Returns (χ², degrees of freedom).
-fn chi_square(
+pub(super) fn chi_square(
     b: &Bsdf,
     from: Vec3,
     axis: Vec3,

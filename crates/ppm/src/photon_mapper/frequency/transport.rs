@@ -287,7 +287,20 @@ pub(crate) fn scatter_spectrum(
         } else {
             (ior, 1.0)
         };
-        return spectrum.refract_axes(eta_i, eta_t, mu_i, mu_o, curvature, caps);
+        let refracted = spectrum.refract_axes(eta_i, eta_t, mu_i, mu_o, curvature, caps);
+        return match bsdf.lobe() {
+            // A rough refraction blurs the refracted angle by the microfacets' tilt σh times
+            // 1 − s, s = ηi·μi/(ηt·μt) (design §7; σh² = α²/4 for GGX).
+            MaterialLobe::Ggx { alpha } if !sample.is_specular => {
+                let s = eta_i * mu_i.max(1e-6) / (eta_t * mu_o.max(1e-6));
+                let sigma_h2 = f64::from(alpha) * f64::from(alpha) / 4.0;
+                let lobe = Lobe::Gaussian {
+                    variance: (1.0 - s) * (1.0 - s) * sigma_h2,
+                };
+                refracted.map(|axis| axis.bandlimit(lobe, caps))
+            }
+            _ => refracted,
+        };
     }
     let lobe = if sample.is_specular {
         Lobe::Mirror
