@@ -104,10 +104,11 @@ impl Method {
         matches!(self, Method::Sppm | Method::FreqSppm | Method::Appm)
     }
 
-    /// Whether passes are independent images, summed exactly (`appm`).
+    /// Whether passes are independent images, summed exactly (`appm`, `vcm`, `bdpt`), so
+    /// that a render can be cut into work units.
     #[must_use]
     pub fn is_pass_independent(self) -> bool {
-        matches!(self, Method::Appm)
+        matches!(self, Method::Appm | Method::Vcm | Method::Bdpt)
     }
 }
 
@@ -333,7 +334,7 @@ pub enum ParamError {
         problem: String,
     },
     /// Kernels were given to a method whose passes are not independent.
-    #[error("{method} does not render independent passes (only appm does)")]
+    #[error("{method} does not render independent passes (only appm, vcm and bdpt do)")]
     NotPassIndependent {
         /// The method asked for.
         method: Method,

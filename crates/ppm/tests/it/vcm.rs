@@ -234,3 +234,47 @@ fn resumed_render_is_bit_identical() {
         assert_eq!(straight.photons_emitted(), resumed.photons_emitted());
     }
 }
+
+/// Work units: renders of disjoint ranges of passes (started at their first pass) whose exact
+/// sums, added in any order, are those of one render of all the passes, bit for bit; a unit's
+/// image is the mean of its own passes.
+#[test]
+fn units_of_passes_merge_into_the_single_render_bit_for_bit() {
+    let scene = glass_mirror_box(12, |t| t);
+    for method in BIDIRECTIONAL {
+        let p = params(method, 1_500);
+        let mut single = Renderer::new(Arc::clone(&scene), p).unwrap();
+        for _ in 0..5 {
+            single.iterate();
+        }
+        let whole = single.pass_sums().unwrap().clone();
+        assert_eq!(whole.passes, 5);
+        assert!(Renderer::pass_independent_kernels(Arc::clone(&scene), p)
+            .unwrap()
+            .is_empty());
+        let unit = |first: u32, count: u32| {
+            let mut r = Renderer::with_kernels(Arc::clone(&scene), p, Vec::new(), first).unwrap();
+            for _ in 0..count {
+                r.iterate();
+            }
+            assert_eq!(r.passes(), first + count);
+            r.pass_sums().unwrap().clone()
+        };
+        let mut merged = ppm::PassSums::new(whole.sums.len());
+        for (first, count) in [(3, 2), (0, 1), (1, 2)] {
+            assert!(merged.add(&unit(first, count)));
+        }
+        assert_eq!(merged, whole, "{method}: merged sums differ");
+        let bits = |image: Vec<[f32; 3]>| {
+            image
+                .iter()
+                .map(|p| p.map(f32::to_bits))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(bits(merged.image()), bits(single.image()), "{method}");
+        assert!(
+            Renderer::with_kernels(Arc::clone(&scene), p, vec![1.0], 0).is_err(),
+            "{method}: kernels refused"
+        );
+    }
+}
