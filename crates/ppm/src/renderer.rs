@@ -10,8 +10,8 @@ use crate::aov::Aov;
 use crate::independent::{PassIndependent, PassSums};
 use crate::integrator::Integrator;
 use crate::params::{Method, ParamError, RenderParams};
-use crate::vcm::Vcm;
 use crate::stats::{MemoryUse, PassStats};
+use crate::vcm::Vcm;
 
 /// A progressive render in progress: create it, call [`Renderer::iterate`] as often as the
 /// budget allows, read [`Renderer::image`] (and [`Renderer::aov`]) at any time, and save or

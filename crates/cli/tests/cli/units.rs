@@ -87,7 +87,11 @@ fn bidirectional_units_merge_into_the_one_machine_render_bit_for_bit() {
         let single = format!("{method}-single.exr");
         fppm(
             &dir,
-            &[&["render", CORNELL, "--passes", "5", "-o", &single][..], &film].concat(),
+            &[
+                &["render", CORNELL, "--passes", "5", "-o", &single][..],
+                &film,
+            ]
+            .concat(),
         )
         .ok();
         let job = format!("{method}-job");

@@ -178,6 +178,10 @@ pub struct Kernel {
     /// Initial gather radius in scene units; `None` picks it from the scene (see
     /// [`crate::auto_initial_radius`]).
     pub initial_radius: Option<f64>,
+    /// `vcm`: merge with r(x) = min(the pass's radius, the frequency prediction at x), the
+    /// prediction coming from a freq-sppm pilot (`vcm/radius.rs`); off, every merge of a pass
+    /// has the pass's radius.
+    pub freq_radius: bool,
 }
 
 /// The estimators the photon mappers combine with merging.
@@ -408,6 +412,7 @@ impl RenderParams {
             kernel: Kernel {
                 alpha: 0.7,
                 initial_radius: None,
+                freq_radius: false,
             },
             connections: Connections {
                 light_tracing: true,

@@ -19,6 +19,7 @@
 mod camera;
 mod light;
 pub(crate) mod mis;
+mod radius;
 #[cfg(test)]
 mod tests;
 
@@ -33,6 +34,7 @@ use scene::{Hit, Scene};
 use self::camera::{CameraPass, CameraSample};
 use self::light::{LightChunk, LightPass, LightVertex, LightVertices, PATH_CHUNK};
 use self::mis::{Mis, Strategies};
+use self::radius::{FrequencyField, MergeRadius};
 use crate::checkpoint::codec::{Reader, StateError, Writer};
 use crate::independent::sums::FIXED_POINT;
 use crate::independent::{PassSums, schedule_squared};
@@ -74,6 +76,9 @@ pub(crate) struct Vcm {
     offsets: Vec<u32>,
     /// The grid of the last pass (kept for its memory report).
     grid: Option<HitPointGrid>,
+    /// With frequency-sized merges, the predicted radius over the scene, from the pilot run
+    /// before the first pass this render traces (a function of the scene and the parameters).
+    field: Option<FrequencyField>,
 }
 
 /// What a render will hold (the film aside): the per-pixel sums and a pass's estimate (and the
@@ -83,11 +88,28 @@ pub(crate) fn estimate(pixels: u64, params: &RenderParams) -> MemoryEstimate {
     let sums = pixels.saturating_mul(48);
     let paths = u64::from(params.budget.photons_per_pass);
     let per_path = BYTES_PER_PATH + VERTICES_PER_PATH * BYTES_PER_VERTEX;
-    MemoryEstimate {
+    let own = MemoryEstimate {
         hitpoints: sums.saturating_add(pixels.saturating_mul(24 + 40)),
         photons: paths.saturating_mul(per_path),
         film: 0,
         checkpoint: sums,
+    };
+    if !(params.kernel.freq_radius && params.method == Method::Vcm) {
+        return own;
+    }
+    // Frequency-sized merges: the pilot (a freq-sppm render, gone before the first pass
+    // allocates its buffers) and the field, at most one cell of 16 bytes (and a control byte,
+    // 8/7 full) per hitpoint slot.
+    let pilot = crate::photon_mapper::estimate(pixels, params, true);
+    let slots = pixels.saturating_mul(u64::from(params.film.samples_per_pixel));
+    MemoryEstimate {
+        hitpoints: own
+            .hitpoints
+            .max(pilot.hitpoints)
+            .saturating_add(slots.saturating_mul(20)),
+        photons: own.photons.max(pilot.photons),
+        film: 0,
+        checkpoint: own.checkpoint,
     }
 }
 
@@ -136,6 +158,7 @@ impl Vcm {
             chunks: Vec::new(),
             offsets: Vec::new(),
             grid: None,
+            field: None,
             scene,
         }
     }
@@ -167,9 +190,14 @@ impl Vcm {
         self.radius * schedule_squared(u64::from(pass), self.params.kernel.alpha).sqrt()
     }
 
+    /// Whether merges are sized by the frequency prediction.
+    fn frequency_sized(&self) -> bool {
+        self.strategies.merging && self.params.kernel.freq_radius
+    }
+
     /// Traces the pass's light subpaths into `chunks` (their kept vertices and connections to
     /// the lens stay there) and numbers the kept vertices (`offsets`).
-    fn light_pass(&mut self, mis: Mis, stats: &mut PassStats) {
+    fn light_pass(&mut self, mis: Mis, global_radius: f64, stats: &mut PassStats) {
         let n = u64::from(self.params.budget.photons_per_pass);
         let n_chunks = usize::try_from(n.div_ceil(PATH_CHUNK)).unwrap_or(usize::MAX);
         let mut chunks = std::mem::take(&mut self.chunks);
@@ -177,6 +205,10 @@ impl Vcm {
         let pass = LightPass {
             scene: &self.scene,
             mis,
+            radius: MergeRadius {
+                global: global_radius,
+                field: self.field.as_ref(),
+            },
             seed: self.params.seed,
             pass: self.passes,
             max_depth: self.params.budget.max_depth,
@@ -237,25 +269,33 @@ impl Integrator for Vcm {
         let radius = self.radius_of(pass);
         let light_paths = u64::from(self.params.budget.photons_per_pass);
         let spp = self.params.film.samples_per_pixel;
-        let mis = Mis::new(self.strategies, light_paths, spp, radius);
+        let mis = Mis::new(self.strategies, light_paths, spp);
+        if self.frequency_sized() && self.field.is_none() {
+            // Cells of the first pass's radius: the largest any merge has.
+            self.field = Some(radius::pilot_field(&self.scene, self.params, self.radius));
+        }
 
         let trace_clock = Instant::now();
-        self.light_pass(mis, &mut stats);
+        self.light_pass(mis, radius, &mut stats);
         stats.timings.trace = trace_clock.elapsed().as_secs_f64();
 
         let index_clock = Instant::now();
         self.grid = None;
         if self.strategies.merging {
-            let positions: Vec<Vec3> = self
-                .chunks
-                .iter()
-                .flat_map(|c| c.vertices.iter().map(|v| v.position))
-                .collect();
+            let vertices = || self.chunks.iter().flat_map(|c| c.vertices.iter());
+            let positions: Vec<Vec3> = vertices().map(|v| v.position).collect();
+            // The global radius bounds every merge's r(x); a merge checks its own.
             let radii = vec![radius; positions.len()];
             self.grid = Some(HitPointGrid::build(&positions, &radii, GridParams::DEFAULT));
             stats.mean_radius = radius;
             stats.min_radius = radius;
             stats.max_radius = radius;
+            if self.field.is_some() && !positions.is_empty() {
+                // The radii at the light vertices, as a sample of where merges happen.
+                let at: Vec<f64> = vertices().map(|v| f64::from(v.radius)).collect();
+                stats.mean_radius = at.iter().sum::<f64>() / at.len() as f64;
+                stats.min_radius = at.iter().copied().fold(f64::INFINITY, f64::min);
+            }
         }
         stats.timings.index = index_clock.elapsed().as_secs_f64();
 
@@ -263,6 +303,10 @@ impl Integrator for Vcm {
         let camera = CameraPass {
             scene: &self.scene,
             mis,
+            radius: MergeRadius {
+                global: radius,
+                field: self.field.as_ref(),
+            },
             seed: self.params.seed,
             pass,
             max_depth: self.params.budget.max_depth,
@@ -275,9 +319,6 @@ impl Integrator for Vcm {
             },
             light_paths,
             grid: self.grid.as_ref(),
-            merge_normalisation: (1.0
-                / (std::f64::consts::PI * radius * radius * light_paths as f64))
-                as f32,
         };
         let pixels: Vec<([f64; 3], u64, u64)> = (0..self.sums.sums.len() as u32)
             .into_par_iter()
@@ -366,7 +407,8 @@ impl Integrator for Vcm {
             pass_hitpoint_buffers: 0,
             pass_photon_buffers: chunks
                 + self.offsets.capacity() * 4
-                + self.grid.as_ref().map_or(0, |g| g.stats().bytes),
+                + self.grid.as_ref().map_or(0, |g| g.stats().bytes)
+                + self.field.as_ref().map_or(0, FrequencyField::heap_bytes),
         })
     }
 
