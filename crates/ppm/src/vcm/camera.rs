@@ -269,7 +269,7 @@ impl CameraPass<'_> {
                 light_pdfs.forward * cos_camera / distance2,
                 camera_pdfs.reverse,
                 light_pdfs.reverse,
-                (v.eta, self.mis.eta(f64::from(y.radius))),
+                (v.eta, y.eta),
             );
             if weight <= 0.0 || !self.scene.visible(hit, y.position) {
                 continue;
@@ -292,10 +292,11 @@ impl CameraPass<'_> {
         let shading = v.bsdf.frame().n;
         let mut total = Rgb::ZERO;
         let mut count = 0;
-        let r2 = (v.radius * v.radius) as f32;
+        // The grid holds every vertex within the global radius; a smaller r(x) checks its own.
+        let r2 = (v.radius < self.radius.global).then_some((v.radius * v.radius) as f32);
         grid.for_each_containing(hit.position, |i| {
             let y = self.vertices.get(i);
-            if y.position.distance_squared(hit.position) >= r2 {
+            if r2.is_some_and(|r2| y.position.distance_squared(hit.position) >= r2) {
                 return;
             }
             // The merged path scatters at the light vertices 1..index − 1, at the merged vertex

@@ -26,8 +26,9 @@ pub(crate) struct LightVertex {
     /// [`shading_ratio`] of `incoming` here: what a connection from here multiplies in.
     pub(crate) ratio: f32,
     pub(crate) partial: Partial,
-    /// The merge radius here ([`MergeRadius::at`]).
+    /// The merge radius here ([`MergeRadius::at`]) and its [`Mis::eta`].
     pub(crate) radius: f32,
+    pub(crate) eta: f32,
     /// Its number on the subpath: 1 for the first vertex after the emitter, whose subpath has
     /// scattered `index − 1` times before it.
     pub(crate) index: u32,
@@ -172,6 +173,7 @@ impl LightPass<'_> {
                         ratio: shading_ratio(&hit, incoming),
                         partial,
                         radius: radius as f32,
+                        eta,
                         index: vertex,
                     });
                 }
