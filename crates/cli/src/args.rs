@@ -72,12 +72,12 @@ pub(crate) enum Command {
         #[arg(long, value_name = "FILE")]
         env: Option<PathBuf>,
     },
-    /// Cut a pass-independent render (--method appm) into work units: runs the frequency
-    /// pilot once and writes JOB/plan.fppm.
+    /// Cut a pass-independent render (--method appm, the default here, vcm or bdpt) into work
+    /// units: runs appm's frequency pilot once and writes JOB/plan.fppm.
     ///
     /// Each unit is then rendered by `fppm unit JOB --index I` (on any machine that sees JOB
     /// and the scene, e.g. as a Slurm array task), and `fppm merge JOB` sums the parts. The
-    /// merged image is bit for bit that of `fppm render SCENE --method appm --passes N`, for
+    /// merged image is bit for bit that of `fppm render SCENE --method M --passes N`, for
     /// any number of units and any order of completion.
     Plan(PlanArgs),
     /// Render one work unit of a plan into JOB/unit-I.part.

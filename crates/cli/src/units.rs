@@ -1,4 +1,5 @@
-//! Work units: `fppm plan` cuts a pass-independent render (`--method appm`) into units,
+//! Work units: `fppm plan` cuts a pass-independent render (`--method appm`, `vcm` or `bdpt`)
+//! into units,
 //! `fppm unit` renders one (on any machine, in any order, e.g. as a Slurm array task), and
 //! `fppm merge` sums the parts into the image.
 //!
@@ -85,7 +86,7 @@ pub(crate) fn plan(args: PlanArgs) -> anyhow::Result<Outcome> {
     let job = settings::render_job(Some(&args.scene), &render_args)?;
     if !job.params.method.is_pass_independent() {
         usage!(
-            "--method {} renders passes that depend on each other; work units need --method appm",
+            "--method {} renders passes that depend on each other; work units need --method appm, vcm or bdpt",
             job.params.method
         );
     }

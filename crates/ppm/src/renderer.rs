@@ -9,8 +9,9 @@ use scene::{Rgb, Scene};
 use crate::aov::Aov;
 use crate::independent::{PassIndependent, PassSums};
 use crate::integrator::Integrator;
-use crate::params::{ParamError, RenderParams};
+use crate::params::{Method, ParamError, RenderParams};
 use crate::stats::{MemoryUse, PassStats};
+use crate::vcm::Vcm;
 
 /// A progressive render in progress: create it, call [`Renderer::iterate`] as often as the
 /// budget allows, read [`Renderer::image`] (and [`Renderer::aov`]) at any time, and save or
@@ -37,9 +38,10 @@ impl Renderer {
         Ok(Self { scene, integrator })
     }
 
-    /// The kernels r₀ of a pass-independent render (`appm`): the radius of each hitpoint slot
-    /// in its first pass, from the frequency pilot (`freq_pilot` passes of freq-sppm). A plan
-    /// computes them once, so that every work unit gathers with the same kernels.
+    /// The kernels r₀ of a pass-independent render: for `appm`, the radius of each hitpoint slot
+    /// in its first pass, from the frequency pilot (`freq_pilot` passes of freq-sppm); for `vcm`
+    /// and `bdpt`, none (their merge radius is a function of the pass index). A plan computes
+    /// them once, so that every work unit gathers with the same kernels.
     ///
     /// # Errors
     ///
@@ -50,18 +52,22 @@ impl Renderer {
     ) -> Result<Vec<f64>, ParamError> {
         let scene = scene.into();
         params.validate()?;
+        if matches!(params.method, Method::Vcm | Method::Bdpt) {
+            return Ok(Vec::new());
+        }
         PassIndependent::new(Arc::clone(&scene), params)?;
         Ok(crate::independent::pilot_kernels(&scene, params))
     }
 
-    /// A pass-independent render (`params.method` must be `appm`) with the given kernels (from
-    /// [`Renderer::pass_independent_kernels`]), whose next pass is `first_pass` (0-based): a
-    /// work unit renders its passes and hands back [`Renderer::pass_sums`].
+    /// A pass-independent render (`params.method` is `appm`, `vcm` or `bdpt`) with the given
+    /// kernels (from [`Renderer::pass_independent_kernels`]), whose next pass is `first_pass`
+    /// (0-based): a work unit renders its passes and hands back [`Renderer::pass_sums`].
     ///
     /// # Errors
     ///
     /// [`ParamError`] if the method is not pass-independent, a parameter is outside its
-    /// domain, or the kernels are not one positive finite radius per hitpoint slot.
+    /// domain, or the kernels are not one positive finite radius per hitpoint slot (none for
+    /// `vcm` and `bdpt`).
     pub fn with_kernels(
         scene: impl Into<Arc<Scene>>,
         params: RenderParams,
@@ -69,23 +75,35 @@ impl Renderer {
         first_pass: u32,
     ) -> Result<Self, ParamError> {
         let scene = scene.into();
-        let render =
-            PassIndependent::with_kernels(Arc::clone(&scene), params, kernels, first_pass)?;
-        Ok(Self {
-            scene,
-            integrator: Box::new(render),
-        })
+        let integrator: Box<dyn Integrator> = if matches!(params.method, Method::Vcm | Method::Bdpt)
+        {
+            if !kernels.is_empty() {
+                return Err(ParamError::BadKernels {
+                    expected: 0,
+                    found: kernels.len(),
+                });
+            }
+            Box::new(Vcm::starting_at(Arc::clone(&scene), params, first_pass)?)
+        } else {
+            Box::new(PassIndependent::with_kernels(
+                Arc::clone(&scene),
+                params,
+                kernels,
+                first_pass,
+            )?)
+        };
+        Ok(Self { scene, integrator })
     }
 
-    /// The exact sums of the pass images of a pass-independent render (`appm`) so far; `None`
-    /// for the other methods, or before the first pass.
+    /// The exact sums of the pass images of a pass-independent render (`appm`, `vcm`, `bdpt`)
+    /// so far; `None` for the other methods, or before `appm`'s first pass.
     #[must_use]
     pub fn pass_sums(&self) -> Option<&PassSums> {
         self.integrator.pass_sums()
     }
 
     /// The kernels r₀ of a pass-independent render (`appm`), once the pilot has run (or they
-    /// were given); `None` for the other methods.
+    /// were given); empty for `vcm` and `bdpt`; `None` for the other methods.
     #[must_use]
     pub fn kernels(&self) -> Option<&[f64]> {
         self.integrator.kernels()

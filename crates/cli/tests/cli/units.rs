@@ -78,6 +78,42 @@ fn merged_units_are_the_one_machine_render_bit_for_bit() {
     }
 }
 
+/// `vcm` and `bdpt` need no pilot: their units merge into the one-machine render too.
+#[test]
+fn bidirectional_units_merge_into_the_one_machine_render_bit_for_bit() {
+    let dir = temp_dir("units_vcm");
+    for method in ["vcm", "bdpt"] {
+        let film = [FILM, &["--method", method, "--spp", "1"]].concat();
+        let single = format!("{method}-single.exr");
+        fppm(
+            &dir,
+            &[
+                &["render", CORNELL, "--passes", "5", "-o", &single][..],
+                &film,
+            ]
+            .concat(),
+        )
+        .ok();
+        let job = format!("{method}-job");
+        fppm(
+            &dir,
+            &[
+                &["plan", CORNELL, "-o", &job, "--passes", "5", "--units", "3"][..],
+                &film,
+            ]
+            .concat(),
+        )
+        .ok();
+        for i in [1, 2, 0] {
+            fppm(&dir, &["unit", &job, "--index", &i.to_string()]).ok();
+        }
+        let out = format!("{method}.exr");
+        fppm(&dir, &["merge", &job, "-o", &out]).ok();
+        assert_eq!(bits(&dir, &out), bits(&dir, &single), "{method}");
+        assert_eq!(read_exr(&dir.join(&out)).metadata["fppm.method"], method);
+    }
+}
+
 #[test]
 fn the_unit_index_comes_from_slurm_or_kubernetes() {
     let dir = temp_dir("units_env");

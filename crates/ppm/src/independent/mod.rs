@@ -124,7 +124,7 @@ impl PassIndependent {
         kernels: Vec<f64>,
         first_pass: u32,
     ) -> Result<Self, ParamError> {
-        if !params.method.is_pass_independent() {
+        if params.method != Method::Appm {
             return Err(ParamError::NotPassIndependent {
                 method: params.method,
             });

@@ -104,10 +104,11 @@ impl Method {
         matches!(self, Method::Sppm | Method::FreqSppm | Method::Appm)
     }
 
-    /// Whether passes are independent images, summed exactly (`appm`).
+    /// Whether passes are independent images, summed exactly (`appm`, `vcm`, `bdpt`), so
+    /// that a render can be cut into work units.
     #[must_use]
     pub fn is_pass_independent(self) -> bool {
-        matches!(self, Method::Appm)
+        matches!(self, Method::Appm | Method::Vcm | Method::Bdpt)
     }
 }
 
@@ -177,6 +178,10 @@ pub struct Kernel {
     /// Initial gather radius in scene units; `None` picks it from the scene (see
     /// [`crate::auto_initial_radius`]).
     pub initial_radius: Option<f64>,
+    /// `vcm`: merge with r(x) = min(the pass's radius, the frequency prediction at x), the
+    /// prediction coming from a freq-sppm pilot (`vcm/radius.rs`); off, every merge of a pass
+    /// has the pass's radius.
+    pub freq_radius: bool,
 }
 
 /// The estimators the photon mappers combine with merging.
@@ -333,7 +338,7 @@ pub enum ParamError {
         problem: String,
     },
     /// Kernels were given to a method whose passes are not independent.
-    #[error("{method} does not render independent passes (only appm does)")]
+    #[error("{method} does not render independent passes (only appm, vcm and bdpt do)")]
     NotPassIndependent {
         /// The method asked for.
         method: Method,
@@ -407,6 +412,7 @@ impl RenderParams {
             kernel: Kernel {
                 alpha: 0.7,
                 initial_radius: None,
+                freq_radius: false,
             },
             connections: Connections {
                 light_tracing: true,

@@ -166,6 +166,17 @@ pub const PARAMS: &[Param] = &[
         },
     },
     Param {
+        name: "vcm_freq_radius",
+        flag: "vcm-freq-radius",
+        help: "vcm: merge with the frequency prediction's radius where it is below the pass's radius (a freq-sppm pilot of --freq-pilot passes, at least one, predicts it; MIS weights use the radius used)",
+        kind: ParamKind::Switch { sets: true },
+        get: |p| on_off(p.kernel.freq_radius),
+        set: |p, v| {
+            p.kernel.freq_radius = parse_switch(v)?;
+            Ok(())
+        },
+    },
+    Param {
         name: "freq_fraction",
         flag: "freq-fraction",
         help: "Share of photons that carry a light-field spectrum, in [0, 1] (frequency methods) [default: 0.1]",

@@ -235,6 +235,22 @@ impl PhotonMapper {
         )
     }
 
+    /// Each visible point of the current pass that has a frequency prediction: its position
+    /// and the radius its kernel may hold there (the frequency radius, bounded by the clear
+    /// radius of its disc once probed), in slot order.
+    pub(crate) fn frequency_predictions(&self) -> Vec<(glam::Vec3, f64)> {
+        let k = self.setup.params.frequency.kernel_k;
+        let r_top = self.setup.kernel_max();
+        let (positions, freq) = (self.slots.position(), self.slots.freq());
+        (0..self.slots.len())
+            .filter(|&slot| self.is_valid(slot))
+            .filter_map(|slot| {
+                let r = freq[slot].hold_radius(k, r_top)?;
+                (r.is_finite() && r > 0.0).then_some((positions[slot], r))
+            })
+            .collect()
+    }
+
     /// Forgets the directly seen emission summed so far.
     pub(crate) fn clear_direct(&mut self) {
         for d in &mut self.direct {

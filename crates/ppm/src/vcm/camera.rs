@@ -9,6 +9,7 @@ use scene::{Bsdf, Hit, Rgb, Scene, TransportMode};
 
 use super::light::LightVertices;
 use super::mis::{Mis, Partial};
+use super::radius::MergeRadius;
 use super::shading_ratio_about;
 use crate::rng::{CAMERA_STREAM, Sampler};
 
@@ -21,6 +22,7 @@ const MERGE_NORMAL_COS: f32 = 0.5;
 pub(crate) struct CameraPass<'a> {
     pub(crate) scene: &'a Scene,
     pub(crate) mis: Mis,
+    pub(crate) radius: MergeRadius<'a>,
     pub(crate) seed: u64,
     pub(crate) pass: u32,
     pub(crate) max_depth: u32,
@@ -31,10 +33,9 @@ pub(crate) struct CameraPass<'a> {
     pub(crate) vertices: LightVertices<'a>,
     /// Light subpaths in the pass.
     pub(crate) light_paths: u64,
-    /// The grid over the light vertices with the merge radius, if merging.
+    /// The grid over the light vertices with the pass's global radius (the largest a merge
+    /// has), if merging.
     pub(crate) grid: Option<&'a HitPointGrid>,
-    /// 1/(π r² n_L): a merge's kernel and the light subpaths' count.
-    pub(crate) merge_normalisation: f32,
 }
 
 /// What one camera subpath brought back.
@@ -52,6 +53,9 @@ struct Vertex<'h> {
     /// Unit direction back along the subpath.
     outgoing: Vec3,
     partial: Partial,
+    /// Its merge radius ([`MergeRadius::at`]) and [`Mis::eta`].
+    radius: f64,
+    eta: f32,
     /// Its number on the subpath: 1 for the first hit, after `index − 1` bounces.
     index: u32,
 }
@@ -123,12 +127,20 @@ impl CameraPass<'_> {
             let u_lobe = sampler.next_f32();
             let u = sampler.next_2d();
             let u_roulette = sampler.next_f32();
+            let (radius, eta) = if bsdf.is_specular() {
+                (0.0, 0.0)
+            } else {
+                let r = self.radius.at(hit.position);
+                (r, self.mis.eta(r))
+            };
             if !bsdf.is_specular() {
                 let vertex = Vertex {
                     hit: &hit,
                     bsdf: &bsdf,
                     outgoing,
                     partial,
+                    radius,
+                    eta,
                     index,
                 };
                 let mut here = Rgb::ZERO;
@@ -173,6 +185,7 @@ impl CameraPass<'_> {
                 reverse,
                 sample.is_specular,
                 cos_out,
+                eta,
             );
             ray = hit.spawn_ray(sample.incoming);
             previous = Some(hit);
@@ -210,6 +223,7 @@ impl CameraPass<'_> {
             pdfs.forward,
             pdfs.reverse,
             cos_g,
+            v.eta,
         );
         if weight <= 0.0 || !scene.light_visible(hit, &sample) {
             return Rgb::ZERO;
@@ -255,6 +269,7 @@ impl CameraPass<'_> {
                 light_pdfs.forward * cos_camera / distance2,
                 camera_pdfs.reverse,
                 light_pdfs.reverse,
+                (v.eta, y.eta),
             );
             if weight <= 0.0 || !self.scene.visible(hit, y.position) {
                 continue;
@@ -266,16 +281,24 @@ impl CameraPass<'_> {
         total
     }
 
-    /// The merges of `v` with the light vertices within the merge radius, in the grid's order,
-    /// divided by the kernel's area and the light subpaths' count; and how many there were.
+    /// The merges of `v` with the light vertices within its merge radius r(x), in the grid's
+    /// order, divided by the kernel's area and the light subpaths' count; and how many there
+    /// were. The kernel is centred on the camera vertex: with radii that vary over the scene,
+    /// a kernel centred on each light vertex would not integrate to one where the radius
+    /// changes, and the estimate would be biased there.
     fn merge(&self, v: &Vertex<'_>, grid: &HitPointGrid) -> (Rgb, u64) {
         let hit = v.hit;
         let normal = hit.geometric_normal;
         let shading = v.bsdf.frame().n;
         let mut total = Rgb::ZERO;
         let mut count = 0;
+        // The grid holds every vertex within the global radius; a smaller r(x) checks its own.
+        let r2 = (v.radius < self.radius.global).then_some((v.radius * v.radius) as f32);
         grid.for_each_containing(hit.position, |i| {
             let y = self.vertices.get(i);
+            if r2.is_some_and(|r2| y.position.distance_squared(hit.position) >= r2) {
+                return;
+            }
             // The merged path scatters at the light vertices 1..index − 1, at the merged vertex
             // and at the camera vertices 1..v.index − 1.
             if y.index + v.index > self.max_depth + 1
@@ -296,11 +319,14 @@ impl CameraPass<'_> {
                 y.index,
                 pdfs.forward,
                 pdfs.reverse,
+                v.eta,
             );
             let ratio = shading_ratio_about(shading, normal, y.incoming);
             total += f * y.power * (weight * ratio);
             count += 1;
         });
-        (total * self.merge_normalisation, count)
+        // 1/(π r² n_L): the kernel's area and the light subpaths' count.
+        let kernel = 1.0 / (std::f64::consts::PI * v.radius * v.radius * self.light_paths as f64);
+        (total * kernel as f32, count)
     }
 }

@@ -7,6 +7,7 @@ use glam::Vec3;
 use scene::{Bsdf, Hit, Rgb, Scene};
 
 use super::mis::{Mis, Partial};
+use super::radius::MergeRadius;
 use super::shading_ratio;
 use crate::light_path::{Scatter, lens_point, lens_radiance, scatter};
 use crate::rng::Sampler;
@@ -25,6 +26,9 @@ pub(crate) struct LightVertex {
     /// [`shading_ratio`] of `incoming` here: what a connection from here multiplies in.
     pub(crate) ratio: f32,
     pub(crate) partial: Partial,
+    /// The merge radius here ([`MergeRadius::at`]) and its [`Mis::eta`].
+    pub(crate) radius: f32,
+    pub(crate) eta: f32,
     /// Its number on the subpath: 1 for the first vertex after the emitter, whose subpath has
     /// scattered `index − 1` times before it.
     pub(crate) index: u32,
@@ -91,6 +95,7 @@ impl<'a> LightVertices<'a> {
 pub(crate) struct LightPass<'a> {
     pub(crate) scene: &'a Scene,
     pub(crate) mis: Mis,
+    pub(crate) radius: MergeRadius<'a>,
     pub(crate) seed: u64,
     pub(crate) pass: u32,
     pub(crate) max_depth: u32,
@@ -155,6 +160,8 @@ impl LightPass<'_> {
             } else {
                 Mis::arrive(partial, Some(distance2), cos_in)
             };
+            let radius = self.radius.at(hit.position);
+            let eta = self.mis.eta(radius);
             if !bsdf.is_specular() {
                 if strategies.stores_light_vertices() {
                     out.vertices.push(LightVertex {
@@ -165,11 +172,14 @@ impl LightPass<'_> {
                         power,
                         ratio: shading_ratio(&hit, incoming),
                         partial,
+                        radius: radius as f32,
+                        eta,
                         index: vertex,
                     });
                 }
                 if strategies.light_tracing {
-                    self.to_lens(&hit, &bsdf, incoming, power, partial, vertex, &sampler, out);
+                    let state = (power, partial, eta);
+                    self.to_lens(&hit, &bsdf, incoming, state, vertex, &sampler, out);
                 }
             }
             // A vertex further on would need one more scattering event than the path may have.
@@ -202,26 +212,28 @@ impl LightPass<'_> {
                 reverse,
                 sample.is_specular,
                 cos_out,
+                eta,
             );
             previous = hit.position;
             ray = hit.spawn_ray(sample.incoming);
         }
     }
 
-    /// Light tracing: connects the light vertex number `vertex` at `hit` to the lens and splats
-    /// its MIS-weighted radiance onto the pixel it lands on.
+    /// Light tracing: connects the light vertex number `vertex` at `hit` (its power, MIS sums
+    /// and [`Mis::eta`] in `state`) to the lens and splats its MIS-weighted radiance onto the
+    /// pixel it lands on.
     #[expect(clippy::too_many_arguments, reason = "one light vertex")]
     fn to_lens(
         &self,
         hit: &Hit,
         bsdf: &Bsdf,
         incoming: Vec3,
-        power: Rgb,
-        partial: Partial,
+        state: (Rgb, Partial, f32),
         vertex: u32,
         sampler: &Sampler,
         out: &mut LightChunk,
     ) {
+        let (power, partial, eta) = state;
         let scene = self.scene;
         let Some((connection, pixel)) = lens_point(scene, hit, sampler, vertex - 1, self.film)
         else {
@@ -236,7 +248,7 @@ impl LightPass<'_> {
         let reverse = bsdf.pdf(toward, incoming);
         let weight = self
             .mis
-            .light_tracing_weight(partial, vertex, camera_area, reverse);
+            .light_tracing_weight(partial, vertex, camera_area, reverse, eta);
         if weight <= 0.0 {
             return;
         }

@@ -1,8 +1,8 @@
 //! The multiple importance sampling weights of vertex connection and merging, computed
 //! recursively along each subpath as in Georgiev's technical report "Implementing Vertex
-//! Connection and Merging" (2012; SmallVCM is its reference): every subpath vertex carries three
-//! partial sums ([`Partial`]: dVCM, dVC, dVM), from which the balance-heuristic weight of any
-//! connection or merge that ends there follows in constant time.
+//! Connection and Merging" (2012; SmallVCM is its reference): every subpath vertex carries the
+//! report's partial sums ([`Partial`]: dVCM and dVC; its dVM is dVC/η), from which the
+//! balance-heuristic weight of any connection or merge that ends there follows in constant time.
 //!
 //! The strategies of a path x₀ (on an emitter) … x_k (on the lens) are the connections (s, t) of
 //! a light subpath of s vertices with a camera subpath of t = k + 1 − s vertices: s = 0 is a
@@ -63,55 +63,60 @@ fn on(on: bool) -> f32 {
     if on { 1.0 } else { 0.0 }
 }
 
-/// The partial MIS sums of a subpath at its last vertex (the report's dVCM, dVC, dVM, with the
+/// The partial MIS sums of a subpath at its last vertex (the report's dVCM and dVC, with the
 /// balance heuristic). After [`Mis::arrive`] at vertex v:
 /// - `vcm`: the density ratio of the connection that ends this subpath one vertex earlier and
 ///   lets the other subpath reach v, over the strategy being weighed, but for the reverse
 ///   density of v, which the caller multiplies in;
-/// - `vc`, `vm`: the sums of the ratios of the strategies further back (fewer vertices on this
-///   side), for a connection (`vc`) or a merge (`vm`) at v, less the reverse density of the
-///   vertex before v, which the caller multiplies in as a solid-angle density.
+/// - `vc`: the sum of the ratios of the strategies further back (fewer vertices on this side)
+///   to a connection at v, less the reverse density of the vertex before v, which the caller
+///   multiplies in as a solid-angle density.
+///
+/// The report's dVM, the same sum for a merge at v, is dVC/η_v with η_v the merge factor at v:
+/// every term of dVC is a strategy's density over a connection's, and a merge at v has η_v
+/// times a connection's. Keeping dVC alone lets η differ from vertex to vertex (merge radii
+/// that depend on the position): each scattering vertex j adds its own η_j to dVC.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct Partial {
     pub(crate) vcm: f32,
     pub(crate) vc: f32,
-    pub(crate) vm: f32,
 }
 
 /// The constants of one pass: which strategies run, and the relative sample counts.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Mis {
     pub(crate) strategies: Strategies,
-    /// η = n_L·π·r² if merging, else 0: the merges' count times their acceptance area, relative
-    /// to one connection (the report's η_VCM; n_L light subpaths merge with each camera path,
-    /// one connects to it).
-    vm_factor: f32,
-    /// 1/η: a connection relative to a merge (used only where merges are weighed).
-    vc_factor: f32,
+    /// n_L·π if merging, else 0: η = n_L·π·r² at a vertex of merge radius r is the merges'
+    /// count times their acceptance area, relative to one connection (the report's η_VCM; n_L
+    /// light subpaths merge with each camera path, one connects to it).
+    merge_count: f64,
     /// Light-tracing samples per camera sample of a pixel: n_L / samples per pixel.
     light_tracing_count: f32,
 }
 
 impl Mis {
-    /// The constants of a pass of `light_paths` light subpaths, `samples_per_pixel` camera
-    /// paths per pixel and merge radius `radius`.
-    pub(crate) fn new(
-        strategies: Strategies,
-        light_paths: u64,
-        samples_per_pixel: u32,
-        radius: f64,
-    ) -> Self {
-        let eta = light_paths as f64 * std::f64::consts::PI * radius * radius;
-        let (vm_factor, vc_factor) = if strategies.merging && eta > 0.0 && eta.is_finite() {
-            (eta as f32, (1.0 / eta) as f32)
-        } else {
-            (0.0, 0.0)
-        };
+    /// The constants of a pass of `light_paths` light subpaths and `samples_per_pixel` camera
+    /// paths per pixel.
+    pub(crate) fn new(strategies: Strategies, light_paths: u64, samples_per_pixel: u32) -> Self {
         Self {
             strategies,
-            vm_factor,
-            vc_factor,
+            merge_count: if strategies.merging {
+                light_paths as f64 * std::f64::consts::PI
+            } else {
+                0.0
+            },
             light_tracing_count: (light_paths as f64 / f64::from(samples_per_pixel.max(1))) as f32,
+        }
+    }
+
+    /// η = n_L·π·r² at a vertex whose merge radius is `radius` (0 without merging): a merge
+    /// there relative to one connection.
+    pub(crate) fn eta(&self, radius: f64) -> f32 {
+        let eta = self.merge_count * radius * radius;
+        if eta > 0.0 && eta.is_finite() {
+            eta as f32
+        } else {
+            0.0
         }
     }
 
@@ -145,7 +150,6 @@ impl Mis {
         Partial {
             vcm: self.light_tracing_count / camera_pdf,
             vc: 0.0,
-            vm: 0.0,
         }
     }
 
@@ -175,11 +179,7 @@ impl Mis {
         } else {
             on(self.strategies.emission) * emission.cos_at_light / emitted / cos_in
         };
-        Partial {
-            vcm,
-            vc,
-            vm: vc * self.vc_factor,
-        }
+        Partial { vcm, vc }
     }
 
     /// The subpath's sums after it travels to its next vertex: `distance2` the squared length
@@ -189,14 +189,14 @@ impl Mis {
         Partial {
             vcm: p.vcm * distance2.unwrap_or(1.0) / cos_in,
             vc: p.vc / cos_in,
-            vm: p.vm / cos_in,
         }
     }
 
     /// The subpath's sums after it scatters at its vertex number `index` (1-based from its
     /// start; `camera` says which subpath) into a direction of density `forward`, whose reverse
     /// density is `reverse` (probabilities for a `specular` event), `cos_out` the |cos| of the
-    /// new direction at the vertex's geometric normal. [`Mis::arrive`] completes them.
+    /// new direction at the vertex's geometric normal, `eta` the vertex's [`Mis::eta`].
+    /// [`Mis::arrive`] completes them.
     #[expect(
         clippy::too_many_arguments,
         reason = "the densities of one scattering event"
@@ -210,6 +210,7 @@ impl Mis {
         reverse: f32,
         specular: bool,
         cos_out: f32,
+        eta: f32,
     ) -> Partial {
         let g = cos_out / forward;
         if specular {
@@ -217,7 +218,6 @@ impl Mis {
             return Partial {
                 vcm: 0.0,
                 vc: p.vc * g * reverse,
-                vm: p.vm * g * reverse,
             };
         }
         let switch = if camera {
@@ -227,8 +227,7 @@ impl Mis {
         };
         let vcm = p.vcm * switch;
         Partial {
-            vc: g * (p.vc * reverse + vcm + self.vm_factor),
-            vm: g * (p.vm * reverse + vcm * self.vc_factor + 1.0),
+            vc: g * (p.vc * reverse + vcm + eta),
             vcm: 1.0 / forward,
         }
     }
@@ -250,7 +249,8 @@ impl Mis {
     /// light sample has solid-angle density `light_pdf` (the pick included) and densities
     /// `emission` as a photon toward the vertex, at `distance` (infinite for an infinite
     /// light); the BSDF draws its direction with density `forward` and reverses it with
-    /// `reverse`; `cos_at_vertex` is the |cos| of the direction at the vertex's geometric normal.
+    /// `reverse`; `cos_at_vertex` is the |cos| of the direction at the vertex's geometric normal;
+    /// `eta` is the vertex's [`Mis::eta`].
     #[expect(
         clippy::too_many_arguments,
         reason = "the densities of one light sample"
@@ -265,6 +265,7 @@ impl Mis {
         forward: f32,
         reverse: f32,
         cos_at_vertex: f32,
+        eta: f32,
     ) -> f32 {
         if !self.strategies.next_event {
             return 0.0;
@@ -284,8 +285,8 @@ impl Mis {
         };
         let ratio =
             emission.emission_with_pick() * cos_at_vertex / (emission.direct_with_pick() * travel);
-        let w_camera = ratio
-            * (self.vm_factor + self.camera_vcm_switch(index) * camera.vcm + camera.vc * reverse);
+        let w_camera =
+            ratio * (eta + self.camera_vcm_switch(index) * camera.vcm + camera.vc * reverse);
         balance(w_light + w_camera)
     }
 
@@ -293,7 +294,8 @@ impl Mis {
     /// light vertex number `light_index` (sums `light`). `camera_to_light` is the camera BSDF's
     /// area density of the light vertex, `light_to_camera` the light BSDF's of the camera
     /// vertex; `camera_reverse` and `light_reverse` are the solid-angle densities of each
-    /// vertex's BSDF drawing its subpath's previous direction from the connecting one.
+    /// vertex's BSDF drawing its subpath's previous direction from the connecting one;
+    /// `etas` the two vertices' [`Mis::eta`] (camera, light).
     #[expect(clippy::too_many_arguments, reason = "the densities of one connection")]
     pub(crate) fn connection_weight(
         &self,
@@ -305,16 +307,15 @@ impl Mis {
         light_to_camera: f32,
         camera_reverse: f32,
         light_reverse: f32,
+        etas: (f32, f32),
     ) -> f32 {
         if !self.strategies.connection {
             return 0.0;
         }
         let w_light = camera_to_light
-            * (self.vm_factor
-                + self.light_vcm_switch(light_index) * light.vcm
-                + light.vc * light_reverse);
+            * (etas.1 + self.light_vcm_switch(light_index) * light.vcm + light.vc * light_reverse);
         let w_camera = light_to_camera
-            * (self.vm_factor
+            * (etas.0
                 + self.camera_vcm_switch(camera_index) * camera.vcm
                 + camera.vc * camera_reverse);
         balance(w_light + w_camera)
@@ -323,26 +324,29 @@ impl Mis {
     /// Weight of the connection of light vertex number `index` (sums `light`) to the lens:
     /// `camera_area` is the camera's area density of the vertex per camera sample and unit of
     /// film area, `reverse` the light BSDF's solid-angle density of the subpath's previous
-    /// direction from the direction to the lens.
+    /// direction from the direction to the lens, `eta` the vertex's [`Mis::eta`].
     pub(crate) fn light_tracing_weight(
         &self,
         light: Partial,
         index: u32,
         camera_area: f32,
         reverse: f32,
+        eta: f32,
     ) -> f32 {
         if !self.strategies.light_tracing {
             return 0.0;
         }
         let w_light = camera_area / self.light_tracing_count
-            * (self.vm_factor + self.light_vcm_switch(index) * light.vcm + light.vc * reverse);
+            * (eta + self.light_vcm_switch(index) * light.vcm + light.vc * reverse);
         balance(w_light)
     }
 
     /// Weight of the merge of camera vertex number `camera_index` (sums `camera`) with light
     /// vertex number `light_index` (sums `light`): the camera BSDF draws the light vertex's
     /// arriving direction with density `forward` and its own previous direction from there with
-    /// `reverse`.
+    /// `reverse`; `eta` is the [`Mis::eta`] of the merge's radius. Every rival is relative to a
+    /// connection in the sums, and this merge is η times a connection.
+    #[expect(clippy::too_many_arguments, reason = "the densities of one merge")]
     pub(crate) fn merge_weight(
         &self,
         camera: Partial,
@@ -351,15 +355,14 @@ impl Mis {
         light_index: u32,
         forward: f32,
         reverse: f32,
+        eta: f32,
     ) -> f32 {
-        if !self.strategies.merging {
+        if !self.strategies.merging || eta <= 0.0 {
             return 0.0;
         }
-        let w_light =
-            self.light_vcm_switch(light_index) * light.vcm * self.vc_factor + light.vm * forward;
-        let w_camera = self.camera_vcm_switch(camera_index) * camera.vcm * self.vc_factor
-            + camera.vm * reverse;
-        balance(w_light + w_camera)
+        let w_light = self.light_vcm_switch(light_index) * light.vcm + light.vc * forward;
+        let w_camera = self.camera_vcm_switch(camera_index) * camera.vcm + camera.vc * reverse;
+        balance((w_light + w_camera) / eta)
     }
 }
 

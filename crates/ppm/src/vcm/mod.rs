@@ -12,11 +12,14 @@
 //!
 //! The merge radius of pass i (0-based) is r₀·gᵢ with Knaus and Zwicker's schedule (that of
 //! `appm`, with α = `alpha`), so that merging is consistent: r₀ is `initial_radius` or the
-//! photon mappers' automatic radius. Nothing but the per-pixel sums carries from pass to pass.
+//! photon mappers' automatic radius. Nothing but the per-pixel sums carries from pass to pass:
+//! a pass depends only on its index, so the sums are exact (`PassSums`, fixed point) and work
+//! units that render disjoint ranges of passes merge into the image of one render, bit for bit.
 
 mod camera;
 mod light;
 pub(crate) mod mis;
+mod radius;
 #[cfg(test)]
 mod tests;
 
@@ -31,10 +34,12 @@ use scene::{Hit, Scene};
 use self::camera::{CameraPass, CameraSample};
 use self::light::{LightChunk, LightPass, LightVertex, LightVertices, PATH_CHUNK};
 use self::mis::{Mis, Strategies};
+use self::radius::{FrequencyField, MergeRadius};
 use crate::checkpoint::codec::{Reader, StateError, Writer};
-use crate::independent::schedule_squared;
+use crate::independent::sums::FIXED_POINT;
+use crate::independent::{PassSums, schedule_squared};
 use crate::integrator::Integrator;
-use crate::params::{Method, RenderParams};
+use crate::params::{Method, ParamError, RenderParams};
 use crate::photon_mapper::auto_initial_radius;
 use crate::stats::{MemoryEstimate, MemoryUse, PassStats};
 
@@ -61,27 +66,50 @@ pub(crate) struct Vcm {
     /// r₀, the merge radius of the first pass.
     radius: f64,
     passes: u32,
-    /// Per pixel: the sum over passes of each pass's estimate of the pixel's mean radiance.
-    sum: Vec<[f64; 3]>,
+    /// Per pixel: the exact sum over the passes rendered of each pass's estimate of the pixel's
+    /// mean radiance (fixed point; `sums.passes` of them, fewer than `passes` in a work unit
+    /// that started after pass 0).
+    sums: PassSums,
     /// Per chunk of [`PATH_CHUNK`] light subpaths, what they produced; kept from pass to pass.
     chunks: Vec<LightChunk>,
     /// Per chunk, the pass number of its first kept vertex; then their total.
     offsets: Vec<u32>,
     /// The grid of the last pass (kept for its memory report).
     grid: Option<HitPointGrid>,
+    /// With frequency-sized merges, the predicted radius over the scene, from the pilot run
+    /// before the first pass this render traces (a function of the scene and the parameters).
+    field: Option<FrequencyField>,
 }
 
-/// What a render will hold (the film aside): the per-pixel sums (and as much again while a
-/// checkpoint is written), and the light vertices, grid and connections of a pass.
+/// What a render will hold (the film aside): the per-pixel sums and a pass's estimate (and the
+/// sums again while a checkpoint is written), and the light vertices, grid and connections of a
+/// pass.
 pub(crate) fn estimate(pixels: u64, params: &RenderParams) -> MemoryEstimate {
-    let sums = pixels.saturating_mul(24);
+    let sums = pixels.saturating_mul(48);
     let paths = u64::from(params.budget.photons_per_pass);
     let per_path = BYTES_PER_PATH + VERTICES_PER_PATH * BYTES_PER_VERTEX;
-    MemoryEstimate {
-        hitpoints: sums.saturating_mul(2),
+    let own = MemoryEstimate {
+        hitpoints: sums.saturating_add(pixels.saturating_mul(24 + 40)),
         photons: paths.saturating_mul(per_path),
         film: 0,
         checkpoint: sums,
+    };
+    if !(params.kernel.freq_radius && params.method == Method::Vcm) {
+        return own;
+    }
+    // Frequency-sized merges: the pilot (a freq-sppm render, gone before the first pass
+    // allocates its buffers) and the field, at most one cell of 16 bytes (and a control byte,
+    // 8/7 full) per hitpoint slot.
+    let pilot = crate::photon_mapper::estimate(pixels, params, true);
+    let slots = pixels.saturating_mul(u64::from(params.film.samples_per_pixel));
+    MemoryEstimate {
+        hitpoints: own
+            .hitpoints
+            .max(pilot.hitpoints)
+            .saturating_add(slots.saturating_mul(20)),
+        photons: own.photons.max(pilot.photons),
+        film: 0,
+        checkpoint: own.checkpoint,
     }
 }
 
@@ -126,12 +154,35 @@ impl Vcm {
             height: film.height,
             radius,
             passes: 0,
-            sum: vec![[0.0; 3]; film.width as usize * film.height as usize],
+            sums: PassSums::new(film.width as usize * film.height as usize),
             chunks: Vec::new(),
             offsets: Vec::new(),
             grid: None,
+            field: None,
             scene,
         }
+    }
+
+    /// A render (`vcm` or `bdpt`) whose next pass is `first_pass`: a work unit, which renders
+    /// its passes and hands back their exact sums.
+    ///
+    /// # Errors
+    ///
+    /// [`ParamError`] if the method is not `vcm` or `bdpt` or a parameter is outside its domain.
+    pub(crate) fn starting_at(
+        scene: Arc<Scene>,
+        params: RenderParams,
+        first_pass: u32,
+    ) -> Result<Self, ParamError> {
+        if !matches!(params.method, Method::Vcm | Method::Bdpt) {
+            return Err(ParamError::NotPassIndependent {
+                method: params.method,
+            });
+        }
+        params.validate()?;
+        let mut render = Self::new(scene, params);
+        render.passes = first_pass;
+        Ok(render)
     }
 
     /// The merge radius of pass `pass` (0-based).
@@ -139,9 +190,14 @@ impl Vcm {
         self.radius * schedule_squared(u64::from(pass), self.params.kernel.alpha).sqrt()
     }
 
+    /// Whether merges are sized by the frequency prediction.
+    fn frequency_sized(&self) -> bool {
+        self.strategies.merging && self.params.kernel.freq_radius
+    }
+
     /// Traces the pass's light subpaths into `chunks` (their kept vertices and connections to
     /// the lens stay there) and numbers the kept vertices (`offsets`).
-    fn light_pass(&mut self, mis: Mis, stats: &mut PassStats) {
+    fn light_pass(&mut self, mis: Mis, global_radius: f64, stats: &mut PassStats) {
         let n = u64::from(self.params.budget.photons_per_pass);
         let n_chunks = usize::try_from(n.div_ceil(PATH_CHUNK)).unwrap_or(usize::MAX);
         let mut chunks = std::mem::take(&mut self.chunks);
@@ -149,6 +205,10 @@ impl Vcm {
         let pass = LightPass {
             scene: &self.scene,
             mis,
+            radius: MergeRadius {
+                global: global_radius,
+                field: self.field.as_ref(),
+            },
             seed: self.params.seed,
             pass: self.passes,
             max_depth: self.params.budget.max_depth,
@@ -209,25 +269,33 @@ impl Integrator for Vcm {
         let radius = self.radius_of(pass);
         let light_paths = u64::from(self.params.budget.photons_per_pass);
         let spp = self.params.film.samples_per_pixel;
-        let mis = Mis::new(self.strategies, light_paths, spp, radius);
+        let mis = Mis::new(self.strategies, light_paths, spp);
+        if self.frequency_sized() && self.field.is_none() {
+            // Cells of the first pass's radius: the largest any merge has.
+            self.field = Some(radius::pilot_field(&self.scene, self.params, self.radius));
+        }
 
         let trace_clock = Instant::now();
-        self.light_pass(mis, &mut stats);
+        self.light_pass(mis, radius, &mut stats);
         stats.timings.trace = trace_clock.elapsed().as_secs_f64();
 
         let index_clock = Instant::now();
         self.grid = None;
         if self.strategies.merging {
-            let positions: Vec<Vec3> = self
-                .chunks
-                .iter()
-                .flat_map(|c| c.vertices.iter().map(|v| v.position))
-                .collect();
+            let vertices = || self.chunks.iter().flat_map(|c| c.vertices.iter());
+            let positions: Vec<Vec3> = vertices().map(|v| v.position).collect();
+            // The global radius bounds every merge's r(x); a merge checks its own.
             let radii = vec![radius; positions.len()];
             self.grid = Some(HitPointGrid::build(&positions, &radii, GridParams::DEFAULT));
             stats.mean_radius = radius;
             stats.min_radius = radius;
             stats.max_radius = radius;
+            if self.field.is_some() && !positions.is_empty() {
+                // The radii at the light vertices, as a sample of where merges happen.
+                let at: Vec<f64> = vertices().map(|v| f64::from(v.radius)).collect();
+                stats.mean_radius = at.iter().sum::<f64>() / at.len() as f64;
+                stats.min_radius = at.iter().copied().fold(f64::INFINITY, f64::min);
+            }
         }
         stats.timings.index = index_clock.elapsed().as_secs_f64();
 
@@ -235,6 +303,10 @@ impl Integrator for Vcm {
         let camera = CameraPass {
             scene: &self.scene,
             mis,
+            radius: MergeRadius {
+                global: radius,
+                field: self.field.as_ref(),
+            },
             seed: self.params.seed,
             pass,
             max_depth: self.params.budget.max_depth,
@@ -247,11 +319,8 @@ impl Integrator for Vcm {
             },
             light_paths,
             grid: self.grid.as_ref(),
-            merge_normalisation: (1.0
-                / (std::f64::consts::PI * radius * radius * light_paths as f64))
-                as f32,
         };
-        let pixels: Vec<([f64; 3], u64, u64)> = (0..self.sum.len() as u32)
+        let pixels: Vec<([f64; 3], u64, u64)> = (0..self.sums.sums.len() as u32)
             .into_par_iter()
             .with_min_len(PIXEL_CHUNK)
             .map(|pixel| {
@@ -275,7 +344,7 @@ impl Integrator for Vcm {
                 (total, merges, non_finite)
             })
             .collect();
-        stats.camera_paths = self.sum.len() as u64 * u64::from(spp);
+        stats.camera_paths = self.sums.sums.len() as u64 * u64::from(spp);
         stats.timings.camera = camera_clock.elapsed().as_secs_f64();
 
         let gather_clock = Instant::now();
@@ -299,11 +368,15 @@ impl Integrator for Vcm {
                 }
             }
         }
-        for (sum, e) in self.sum.iter_mut().zip(estimate) {
+        // Rounded to 2⁻⁶⁴ and summed as integers: the same bits whatever passes a render (or a
+        // work unit) added before. Every term is finite (non-finite samples were left out).
+        for (sum, e) in self.sums.sums.iter_mut().zip(estimate) {
             for c in 0..3 {
-                sum[c] += e[c];
+                // `as` saturates: a pass estimate beyond 9 · 10¹⁸ is clamped, never wrapped.
+                sum[c] = sum[c].saturating_add((e[c] * FIXED_POINT).round() as i128);
             }
         }
+        self.sums.passes += 1;
         stats.timings.gather = gather_clock.elapsed().as_secs_f64();
         self.passes += 1;
         stats
@@ -311,8 +384,7 @@ impl Integrator for Vcm {
 
     /// The mean of the pass estimates per pixel.
     fn image(&self) -> Vec<[f32; 3]> {
-        let n = f64::from(self.passes.max(1));
-        self.sum.iter().map(|s| s.map(|v| (v / n) as f32)).collect()
+        self.sums.image()
     }
 
     fn memory(&self) -> Option<MemoryUse> {
@@ -327,38 +399,55 @@ impl Integrator for Vcm {
             })
             .sum();
         Some(MemoryUse {
-            hitpoints: self.sum.len(),
-            records: self.sum.capacity() * size_of::<[f64; 3]>(),
+            hitpoints: self.sums.sums.len(),
+            records: self.sums.sums.capacity() * size_of::<[i128; 3]>(),
             slot_columns: 0,
             // The grid is over the pass's light vertices: a photon buffer, not the slots'.
             grid: 0,
             pass_hitpoint_buffers: 0,
             pass_photon_buffers: chunks
                 + self.offsets.capacity() * 4
-                + self.grid.as_ref().map_or(0, |g| g.stats().bytes),
+                + self.grid.as_ref().map_or(0, |g| g.stats().bytes)
+                + self.field.as_ref().map_or(0, FrequencyField::heap_bytes),
         })
     }
 
-    /// The per-pixel sums.
+    /// The exact per-pixel sums and how many passes they hold.
     fn save(&self, w: &mut Writer) {
-        w.u64(self.sum.len() as u64);
-        for s in &self.sum {
-            s.iter().for_each(|&v| w.f64(v));
+        w.u64(self.sums.passes);
+        w.u64(self.sums.sums.len() as u64);
+        for s in &self.sums.sums {
+            for v in s {
+                w.bytes(&v.to_le_bytes());
+            }
         }
     }
 
     fn saved_bound(&self) -> usize {
-        8 + self.sum.len().saturating_mul(24)
+        16 + self.sums.sums.len().saturating_mul(48)
     }
 
     fn restore(&mut self, r: &mut Reader<'_>, passes: u32) -> Result<(), StateError> {
-        if r.len()? != self.sum.len() {
+        let summed = r.u64()?;
+        if r.len()? != self.sums.sums.len() || summed > u64::from(passes) {
             return Err(StateError::Corrupt);
         }
-        for s in &mut self.sum {
-            *s = [r.f64()?, r.f64()?, r.f64()?];
+        for s in &mut self.sums.sums {
+            for v in s {
+                *v = i128::from_le_bytes(r.array()?);
+            }
         }
+        self.sums.passes = summed;
         self.passes = passes;
         Ok(())
+    }
+
+    fn pass_sums(&self) -> Option<&PassSums> {
+        Some(&self.sums)
+    }
+
+    /// None: every merge of a pass has the pass's one radius, a function of the pass index.
+    fn kernels(&self) -> Option<&[f64]> {
+        Some(&[])
     }
 }

@@ -12,6 +12,7 @@ use scene::{Bsdf, Hit, Scene, TransportMode};
 
 use super::Vcm;
 use super::mis::{Mis, Strategies};
+use super::radius::FrequencyField;
 use crate::integrator::Integrator;
 use crate::rng::Sampler;
 use crate::{Method, RenderParams};
@@ -160,9 +161,18 @@ fn densities(v: &Vertex, a: Vec3, b: Vec3) -> (f32, f32) {
 }
 
 /// Every strategy of one path, with its recursive weight and its weight from the densities of
-/// all strategies one by one (Veach's balance heuristic with the sample counts n_s).
-fn weights(scene: &Scene, x: &[Vertex], mis: &Mis, counts: (f32, f32, f32)) -> Vec<(f64, f64)> {
-    let (light_paths, spp, eta) = counts;
+/// all strategies one by one (Veach's balance heuristic with the sample counts n_s); a merge at
+/// a vertex at p has the radius `radius(p)`.
+fn weights(
+    scene: &Scene,
+    x: &[Vertex],
+    mis: &Mis,
+    counts: (f32, f32),
+    radius: &dyn Fn(Vec3) -> f64,
+) -> Vec<(f64, f64)> {
+    let (light_paths, spp) = counts;
+    // η at a path vertex: every strategy computes it from the vertex's position alone.
+    let eta = |i: usize| mis.eta(radius(x[i].hit.position));
     let strategies = mis.strategies;
     let k = x.len();
     let lens = scene.camera().position();
@@ -218,7 +228,8 @@ fn weights(scene: &Scene, x: &[Vertex], mis: &Mis, counts: (f32, f32, f32)) -> V
     }
     for i in 1..k {
         let on = strategies.merging && !specular(i);
-        let p = f64::from(eta) * reverse[i] * product(&forward[..=i]) * product(&reverse[i + 1..]);
+        let p =
+            f64::from(eta(i)) * reverse[i] * product(&forward[..=i]) * product(&reverse[i + 1..]);
         brute.push((on, p));
     }
     let total: f64 = brute.iter().filter(|b| b.0).map(|b| b.1).sum();
@@ -228,7 +239,17 @@ fn weights(scene: &Scene, x: &[Vertex], mis: &Mis, counts: (f32, f32, f32)) -> V
     light[1] = mis.light_start(&emission, emission.pick_direct, d2(0, 1), cos(1, 0));
     for i in 1..k - 1 {
         let (f, r) = densities(&x[i], dir(i, i - 1), dir(i, i + 1));
-        let p = mis.scatter(light[i], false, i as u32, f, r, specular(i), cos(i, i + 1));
+        let e = eta(i);
+        let p = mis.scatter(
+            light[i],
+            false,
+            i as u32,
+            f,
+            r,
+            specular(i),
+            cos(i, i + 1),
+            e,
+        );
         light[i + 1] = Mis::arrive(p, Some(d2(i, i + 1)), cos(i + 1, i));
     }
     let mut camera = vec![super::mis::Partial::default(); k + 1];
@@ -240,7 +261,17 @@ fn weights(scene: &Scene, x: &[Vertex], mis: &Mis, counts: (f32, f32, f32)) -> V
     for j in 1..k {
         let v = k - j;
         let (f, r) = densities(&x[v], dir(v, v + 1), dir(v, v - 1));
-        let p = mis.scatter(camera[j], true, j as u32, f, r, specular(v), cos(v, v - 1));
+        let e = eta(v);
+        let p = mis.scatter(
+            camera[j],
+            true,
+            j as u32,
+            f,
+            r,
+            specular(v),
+            cos(v, v - 1),
+            e,
+        );
         camera[j + 1] = Mis::arrive(p, Some(d2(v, v - 1)), cos(v - 1, v));
     }
     let mut recursive: Vec<f32> = Vec::new();
@@ -260,12 +291,13 @@ fn weights(scene: &Scene, x: &[Vertex], mis: &Mis, counts: (f32, f32, f32)) -> V
                     f,
                     r,
                     cos(1, 0),
+                    eta(1),
                 )
             }
             (_, 1) => {
                 let (r, _) = densities(&x[k - 1], dir(k - 1, k), dir(k - 1, k - 2));
                 let area = camera_pdf * cos(k - 1, k) / d2(k - 1, k);
-                mis.light_tracing_weight(light[k - 1], (k - 1) as u32, area, r)
+                mis.light_tracing_weight(light[k - 1], (k - 1) as u32, area, r, eta(k - 1))
             }
             _ => {
                 let (cf, cr) = densities(&x[s], dir(s, s + 1), dir(s, s - 1));
@@ -279,6 +311,7 @@ fn weights(scene: &Scene, x: &[Vertex], mis: &Mis, counts: (f32, f32, f32)) -> V
                     lf * cos(s, s - 1) / d2(s - 1, s),
                     cr,
                     lr,
+                    (eta(s), eta(s - 1)),
                 )
             }
         };
@@ -286,7 +319,8 @@ fn weights(scene: &Scene, x: &[Vertex], mis: &Mis, counts: (f32, f32, f32)) -> V
     }
     for i in 1..k {
         let (f, r) = densities(&x[i], dir(i, i + 1), dir(i, i - 1));
-        recursive.push(mis.merge_weight(camera[k - i], (k - i) as u32, light[i], i as u32, f, r));
+        let (c, l) = (camera[k - i], light[i]);
+        recursive.push(mis.merge_weight(c, (k - i) as u32, l, i as u32, f, r, eta(i)));
     }
     brute
         .iter()
@@ -297,12 +331,21 @@ fn weights(scene: &Scene, x: &[Vertex], mis: &Mis, counts: (f32, f32, f32)) -> V
 }
 
 /// For paths of 3 to 6 vertices and every subset of the strategies, each strategy's recursive
-/// weight is its share of the summed densities, and the weights sum to one.
+/// weight is its share of the summed densities, and the weights sum to one: with one merge
+/// radius, and with a radius that depends on the position (as frequency-sized merges have),
+/// from 0.005 to 0.05.
 #[test]
 fn mis_weights_of_every_strategy_sum_to_one() {
+    let constant = |_: Vec3| 0.05;
+    let varying =
+        |p: Vec3| 0.005 + 0.045 * f64::from(0.5 + 0.5 * (9.0 * p.x + 5.0 * p.y + 7.0 * p.z).sin());
+    mis_weights_sum_to_one(&constant);
+    mis_weights_sum_to_one(&varying);
+}
+
+fn mis_weights_sum_to_one(radius: &dyn Fn(Vec3) -> f64) {
     let scene = scene(BOX);
-    let (light_paths, spp, radius) = (1000u64, 2u32, 0.05f64);
-    let eta = (light_paths as f64 * std::f64::consts::PI * radius * radius) as f32;
+    let (light_paths, spp) = (1000u64, 2u32);
     let mut paths = 0;
     let mut with_specular = 0;
     for k in 2..=5usize {
@@ -320,9 +363,8 @@ fn mis_weights_of_every_strategy_sum_to_one() {
                     connection: mask & 8 != 0,
                     merging: mask & 16 != 0,
                 };
-                let mis = Mis::new(strategies, light_paths, spp, radius);
-                let eta = if strategies.merging { eta } else { 0.0 };
-                let w = weights(&scene, &x, &mis, (light_paths as f32, spp as f32, eta));
+                let mis = Mis::new(strategies, light_paths, spp);
+                let w = weights(&scene, &x, &mis, (light_paths as f32, spp as f32), radius);
                 if w.is_empty() {
                     continue;
                 }
@@ -392,9 +434,37 @@ fn emissive_sphere() -> Arc<Scene> {
     Arc::new(Scene::new(description).unwrap())
 }
 
-/// The mean radiance of 16 passes of `strategies` in the emissive sphere with `max_depth`.
+/// How a furnace render sizes its merges.
+#[derive(Clone, Copy, Debug)]
+enum Radii {
+    /// The pass's one radius.
+    Global,
+    /// The frequency prediction of the pilot (`vcm_freq_radius`).
+    Frequency,
+    /// A made-up field that varies from cell to cell between a fifth of r₀ and r₀: merges of
+    /// many radii in one pass.
+    Varying,
+}
+
+/// A field of radii from 0.02 to 0.1 on cells of 0.1 over [−1, 1]³.
+fn varying_field() -> FrequencyField {
+    let mut predictions = Vec::new();
+    for i in -10..10 {
+        for j in -10..10 {
+            for k in -10..10 {
+                let p = Vec3::new(i as f32, j as f32, k as f32) * 0.1 + 0.05;
+                let wave = 0.5 + 0.5 * (7.0 * p.x + 5.0 * p.y + 3.0 * p.z).sin();
+                predictions.push((p, 0.02 + 0.08 * f64::from(wave)));
+            }
+        }
+    }
+    FrequencyField::new(&predictions, 0.1)
+}
+
+/// The mean radiance of [`PASSES`] passes of `strategies` in the emissive sphere with
+/// `max_depth`, merging with `radii`.
 const PASSES: u32 = 32;
-fn furnace_mean(scene: &Arc<Scene>, strategies: Strategies, max_depth: u32) -> f64 {
+fn furnace_mean(scene: &Arc<Scene>, strategies: Strategies, max_depth: u32, radii: Radii) -> f64 {
     let mut params = RenderParams::preview();
     params.method = Method::Vcm;
     params.seed = 11;
@@ -403,7 +473,11 @@ fn furnace_mean(scene: &Arc<Scene>, strategies: Strategies, max_depth: u32) -> f
     // About a tenth of a facet: merging's bias where a kernel crosses a facet's edge stays
     // far below the tolerance (measured: 0.02 % with merging alone at 8192 paths × 32 passes).
     params.kernel.initial_radius = Some(0.1);
+    params.kernel.freq_radius = matches!(radii, Radii::Frequency);
     let mut vcm = Vcm::with_strategies(Arc::clone(scene), params, strategies);
+    if matches!(radii, Radii::Varying) {
+        vcm.field = Some(varying_field());
+    }
     for _ in 0..PASSES {
         vcm.iterate();
     }
@@ -437,6 +511,7 @@ fn furnace_for_each_strategy_alone_and_combined() {
                 ..none
             },
             1,
+            Radii::Global,
         ),
         (
             "next event",
@@ -445,6 +520,7 @@ fn furnace_for_each_strategy_alone_and_combined() {
                 ..none
             },
             1,
+            Radii::Global,
         ),
         (
             "light tracing",
@@ -453,6 +529,7 @@ fn furnace_for_each_strategy_alone_and_combined() {
                 ..none
             },
             1,
+            Radii::Global,
         ),
         (
             "connections",
@@ -461,6 +538,7 @@ fn furnace_for_each_strategy_alone_and_combined() {
                 ..none
             },
             2,
+            Radii::Global,
         ),
         (
             "merging",
@@ -469,9 +547,10 @@ fn furnace_for_each_strategy_alone_and_combined() {
                 ..none
             },
             1,
+            Radii::Global,
         ),
-        ("bdpt", Strategies::BDPT, 1),
-        ("vcm", Strategies::VCM, 1),
+        ("bdpt", Strategies::BDPT, 1, Radii::Global),
+        ("vcm", Strategies::VCM, 1, Radii::Global),
         (
             "vcm without connections",
             Strategies {
@@ -480,16 +559,28 @@ fn furnace_for_each_strategy_alone_and_combined() {
                 ..none
             },
             1,
+            Radii::Global,
+        ),
+        ("vcm, frequency radii", Strategies::VCM, 1, Radii::Frequency),
+        ("vcm, varying radii", Strategies::VCM, 1, Radii::Varying),
+        (
+            "merging alone, varying radii",
+            Strategies {
+                merging: true,
+                ..none
+            },
+            1,
+            Radii::Varying,
         ),
     ];
     for max_depth in [2u32, 1024] {
-        for (name, strategies, fewest_bounces) in cases {
+        for (name, strategies, fewest_bounces, radii) in cases {
             // Le = 0.5 seen directly, Le·ρ^j = 0.5^(j+1) for fewest_bounces ≤ j ≤ max_depth.
             let expected = 0.5
                 + (fewest_bounces..=max_depth.min(60))
                     .map(|j| 0.5f64.powi(j as i32 + 1))
                     .sum::<f64>();
-            let m = furnace_mean(&scene, strategies, max_depth);
+            let m = furnace_mean(&scene, strategies, max_depth, radii);
             eprintln!("{name}, max_depth {max_depth}: {m:.5} (expected {expected:.5})");
             assert!(
                 (m / expected - 1.0).abs() < 0.01,

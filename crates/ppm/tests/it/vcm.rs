@@ -14,6 +14,18 @@ use crate::support::{mean, params, render, scene};
 
 const BIDIRECTIONAL: [Method; 2] = [Method::Bdpt, Method::Vcm];
 
+/// The bidirectional methods' parameters (`params` of `support`), and `vcm` again with
+/// frequency-sized merges (`vcm_freq_radius`), named.
+fn configurations(light_paths: u32) -> [(&'static str, RenderParams); 3] {
+    let mut freq = params(Method::Vcm, light_paths);
+    freq.kernel.freq_radius = true;
+    [
+        ("bdpt", params(Method::Bdpt, light_paths)),
+        ("vcm", params(Method::Vcm, light_paths)),
+        ("vcm with frequency radii", freq),
+    ]
+}
+
 /// The repository's Cornell-style box with a glass and a mirror sphere
 /// (`scenes/peers/box-glass-mirror.toml`) at `size` × `size`, with `edit` applied to its text.
 fn glass_mirror_box(size: u32, edit: impl Fn(String) -> String) -> Arc<Scene> {
@@ -32,8 +44,7 @@ fn glass_mirror_box(size: u32, edit: impl Fn(String) -> String) -> Arc<Scene> {
 #[test]
 fn furnace_sphere_around_a_point_light() {
     let scene = scene(FURNACE);
-    for method in BIDIRECTIONAL {
-        let mut p = params(method, 2_000);
+    for (method, mut p) in configurations(2_000) {
         p.budget.max_depth = 64;
         p.film.samples_per_pixel = 4;
         let m = mean(&render(&scene, p, 8));
@@ -144,8 +155,7 @@ fn bdpt_and_vcm_agree_with_the_path_tracer() {
         let mut path = params(Method::Path, 1);
         path.film.samples_per_pixel = 256;
         let reference = over_seeds(&scene, path, 1, SEEDS, SIZE);
-        for method in BIDIRECTIONAL {
-            let mut p = params(method, (SIZE * SIZE) as u32);
+        for (method, mut p) in configurations((SIZE * SIZE) as u32) {
             p.film.samples_per_pixel = 4;
             // About a sixth of a pixel's footprint (0.12 at the walls): merging's kernel bias
             // stays below the noise.
@@ -174,14 +184,14 @@ fn bdpt_and_vcm_agree_with_the_path_tracer() {
 #[test]
 fn bit_identical_for_one_and_two_threads() {
     let scene = glass_mirror_box(16, |t| t);
-    for method in BIDIRECTIONAL {
+    for (method, p) in configurations(3_000) {
         let run = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
                 .unwrap();
             pool.install(|| {
-                let mut p = params(method, 3_000);
+                let mut p = p;
                 p.film.samples_per_pixel = 2;
                 let mut renderer = Renderer::new(Arc::clone(&scene), p).unwrap();
                 for _ in 0..3 {
@@ -209,8 +219,7 @@ fn bit_identical_for_one_and_two_threads() {
 #[test]
 fn resumed_render_is_bit_identical() {
     let scene = glass_mirror_box(16, |t| t);
-    for method in BIDIRECTIONAL {
-        let p = params(method, 2_000);
+    for (method, p) in configurations(2_000) {
         let mut straight = Renderer::new(Arc::clone(&scene), p).unwrap();
         for _ in 0..4 {
             straight.iterate();
@@ -232,5 +241,50 @@ fn resumed_render_is_bit_identical() {
             "{method}: resumed image differs"
         );
         assert_eq!(straight.photons_emitted(), resumed.photons_emitted());
+    }
+}
+
+/// Work units: renders of disjoint ranges of passes (started at their first pass) whose exact
+/// sums, added in any order, are those of one render of all the passes, bit for bit; a unit's
+/// image is the mean of its own passes.
+#[test]
+fn units_of_passes_merge_into_the_single_render_bit_for_bit() {
+    let scene = glass_mirror_box(12, |t| t);
+    for (method, p) in configurations(1_500) {
+        let mut single = Renderer::new(Arc::clone(&scene), p).unwrap();
+        for _ in 0..5 {
+            single.iterate();
+        }
+        let whole = single.pass_sums().unwrap().clone();
+        assert_eq!(whole.passes, 5);
+        assert!(
+            Renderer::pass_independent_kernels(Arc::clone(&scene), p)
+                .unwrap()
+                .is_empty()
+        );
+        let unit = |first: u32, count: u32| {
+            let mut r = Renderer::with_kernels(Arc::clone(&scene), p, Vec::new(), first).unwrap();
+            for _ in 0..count {
+                r.iterate();
+            }
+            assert_eq!(r.passes(), first + count);
+            r.pass_sums().unwrap().clone()
+        };
+        let mut merged = ppm::PassSums::new(whole.sums.len());
+        for (first, count) in [(3, 2), (0, 1), (1, 2)] {
+            assert!(merged.add(&unit(first, count)));
+        }
+        assert_eq!(merged, whole, "{method}: merged sums differ");
+        let bits = |image: Vec<[f32; 3]>| {
+            image
+                .iter()
+                .map(|p| p.map(f32::to_bits))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(bits(merged.image()), bits(single.image()), "{method}");
+        assert!(
+            Renderer::with_kernels(Arc::clone(&scene), p, vec![1.0], 0).is_err(),
+            "{method}: kernels refused"
+        );
     }
 }
