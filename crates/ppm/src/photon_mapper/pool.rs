@@ -107,6 +107,7 @@ pub(super) struct Pooled {
 
 impl PhotonMapper {
     /// The slot's own photon radiance τ/(πR²N) (zero where none was gathered).
+    #[inline]
     pub(super) fn own_radiance(&self, slot: usize) -> [f64; 3] {
         GatherStats {
             radius: self.slots.radius()[slot],
@@ -181,139 +182,133 @@ impl PhotonMapper {
                     let first_slot = rows.start * film.width * film.spp;
                     let slots = rows.len() * film.width * film.spp;
                     // Taken out of the planes while `pool_group` reads them.
-                    let (mut radiance, mut width) = std::mem::take(&mut planes.band);
-                    radiance.clear();
-                    radiance.resize(slots, [0.0; 3]);
-                    width.clear();
-                    width.resize(slots, 0.0);
+                    let mut band = std::mem::take(&mut planes.band);
+                    band.reset(slots);
                     if pools {
+                        let plane_rows =
+                            rows.start.saturating_sub(halo)..(rows.end + halo).min(film.height);
                         for sample in 0..film.spp {
-                            let plane_rows =
-                                rows.start.saturating_sub(halo)..(rows.end + halo).min(film.height);
-                            planes.fill(self, film, sample, plane_rows, halo);
+                            let centre = (&mut band, &rule, rows.clone(), first_slot);
+                            planes.fill(self, film, sample, plane_rows.clone(), halo, centre);
                             for y in rows.clone() {
                                 for x0 in (0..film.width).step_by(LANES) {
-                                    let group = self.pool_group(
+                                    pool_group(
                                         planes,
+                                        &mut band,
                                         &rule,
                                         &taps,
                                         film,
                                         (x0, y),
                                         sample,
+                                        first_slot,
                                     );
-                                    for (lane, (l, s)) in group.into_iter().enumerate() {
-                                        let x = x0 + lane;
-                                        if x < film.width {
-                                            let slot = film.slot(x, y, sample) - first_slot;
-                                            radiance[slot] = l;
-                                            width[slot] = s;
-                                        }
-                                    }
                                 }
                             }
                         }
                     } else {
-                        for (i, l) in radiance.iter_mut().enumerate() {
+                        for (i, l) in band.radiance.iter_mut().enumerate() {
                             *l = self.own_radiance(first_slot + i);
                         }
                     }
-                    emit(first_slot, out, &radiance, &width);
-                    planes.band = (radiance, width);
+                    emit(first_slot, out, &band.radiance, &band.width);
+                    planes.band = band;
                 });
             });
     }
 
-    /// The pooled photon radiance and the width of the eight pixels of row `y` from `x0` on
-    /// (those past the film's edge are computed and thrown away).
-    fn pool_group(
-        &self,
-        planes: &Planes,
-        rule: &WidthRule,
-        taps: &[Tap],
-        film: Film,
-        (x0, y): (usize, usize),
-        sample: usize,
-    ) -> [([f64; 3], f32); LANES] {
-        let centre = Centre::load(planes, planes.index(x0, y));
-        // The footprint: the mean distance to the pixels beside it on its surface.
-        let (mut sum, mut count) = (f32x8::ZERO, f32x8::ZERO);
-        for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
-            let Some(at) = planes.neighbour(x0, y, dx, dy) else {
-                continue;
-            };
-            let position = planes.position.load(at);
-            let offset = position - centre.position;
-            let d2 = offset.dot(offset);
-            let on = centre.on_surface(planes, at, offset, d2);
-            sum += d2.sqrt() & on;
-            count += f32x8::ONE & on;
-        }
-        let (sum, count) = (sum.to_array(), count.to_array());
-        let slots: [Option<usize>; LANES] = std::array::from_fn(|lane| {
-            let x = x0 + lane;
-            (x < film.width).then(|| film.slot(x, y, sample))
-        });
-        let s: [f32; LANES] = std::array::from_fn(|lane| {
-            let Some(slot) = slots[lane] else {
-                return 0.0;
-            };
-            let footprint =
-                (count[lane] > 0.0 && sum[lane] > 0.0).then(|| f64::from(sum[lane] / count[lane]));
-            footprint.map_or(0.0, |footprint| rule.width(self, slot, footprint))
-        });
-        let own = |lane: usize| slots[lane].map_or([0.0; 3], |slot| self.own_radiance(slot));
-        if s.iter().all(|&s| s <= 0.0) {
-            return std::array::from_fn(|lane| (own(lane), 0.0));
-        }
+}
 
-        let width = f32x8::new(s);
-        let active = width.simd_gt(f32x8::ZERO);
-        let inv_width = (f32x8::ONE / width) & active;
-        let inv_two_var = f32x8::splat(0.5) * inv_width * inv_width;
-        let reach = f32x8::splat(CUTOFF_SIGMAS) * width;
-        let cutoff2 = active.select(reach * reach, f32x8::splat(-1.0));
-        let (t, b) = centre.normal.orthonormal_pair();
-        let mut fit = Fit::new(centre.flat);
-        for tap in taps {
-            let Some(at) = planes.neighbour(x0, y, tap.dx, tap.dy) else {
-                continue;
-            };
-            let position = planes.position.load(at);
-            let offset = position - centre.position;
-            let d2 = offset.dot(offset);
-            let near = d2.simd_le(cutoff2);
-            if !near.any() {
-                continue;
-            }
-            let on = near & centre.on_surface(planes, at, offset, d2);
-            if !on.any() {
-                continue;
-            }
-            let k = (f32x8::splat(tap.area) * (-(d2 * inv_two_var)).exp()) & on;
-            let u = offset.dot(t) * inv_width;
-            let v = offset.dot(b) * inv_width;
-            let flat = planes.flat.load(at);
-            fit.add(k, u & on, v & on, [flat.x & on, flat.y & on, flat.z & on]);
+/// Pools the eight pixels of row `y` from `x0` on (those past the film's edge are computed and
+/// thrown away): writes the pooled photon radiance and the width of each lane that pools into
+/// `band` (whose radiance already holds every slot's own).
+#[allow(clippy::too_many_arguments)]
+fn pool_group(
+    planes: &Planes,
+    band: &mut Band,
+    rule: &WidthRule,
+    taps: &[Tap],
+    film: Film,
+    (x0, y): (usize, usize),
+    sample: usize,
+    first_slot: usize,
+) {
+    let centre = Centre::load(planes, planes.index(x0, y));
+    if centre.valid.none() {
+        return;
+    }
+    // The footprint: the mean distance to the pixels beside it on its surface.
+    let (mut sum, mut count) = (f32x8::ZERO, f32x8::ZERO);
+    for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
+        let Some(at) = planes.neighbour(x0, y, dx, dy) else {
+            continue;
+        };
+        let position = planes.position.load(at);
+        let offset = position - centre.position;
+        let d2 = offset.dot(offset);
+        let on = centre.on_surface(planes, at, offset, d2);
+        sum += d2.sqrt() & on;
+        count += f32x8::ONE & on;
+    }
+    let (sum, count) = (sum.to_array(), count.to_array());
+    let lanes = LANES.min(film.width - x0);
+    let band_slot = |lane: usize| film.slot(x0 + lane, y, sample) - first_slot;
+    let mut s = [0.0f32; LANES];
+    for lane in 0..lanes {
+        if count[lane] > 0.0 && sum[lane] > 0.0 {
+            let footprint = f64::from(sum[lane] / count[lane]);
+            s[lane] = rule.width(band.cap[band_slot(lane)], footprint);
         }
-        let weight = centre.weight.to_arrays();
-        let fit = fit.lanes();
-        std::array::from_fn(|lane| {
-            let own = own(lane);
-            if s[lane] <= 0.0 {
-                return (own, 0.0);
+    }
+    if s.iter().all(|&s| s <= 0.0) {
+        return;
+    }
+
+    let width = f32x8::new(s);
+    let active = width.simd_gt(f32x8::ZERO);
+    let inv_width = (f32x8::ONE / width) & active;
+    let inv_two_var = f32x8::splat(0.5) * inv_width * inv_width;
+    let reach = f32x8::splat(CUTOFF_SIGMAS) * width;
+    let cutoff2 = active.select(reach * reach, f32x8::splat(-1.0));
+    let (t, b) = centre.normal.orthonormal_pair();
+    let mut fit = Fit::new(centre.flat);
+    for tap in taps {
+        let Some(at) = planes.neighbour(x0, y, tap.dx, tap.dy) else {
+            continue;
+        };
+        let position = planes.position.load(at);
+        let offset = position - centre.position;
+        let d2 = offset.dot(offset);
+        let near = d2.simd_le(cutoff2);
+        if !near.any() {
+            continue;
+        }
+        let on = near & centre.on_surface(planes, at, offset, d2);
+        if !on.any() {
+            continue;
+        }
+        let k = (f32x8::splat(tap.area) * (-(d2 * inv_two_var)).exp()) & on;
+        let u = offset.dot(t) * inv_width;
+        let v = offset.dot(b) * inv_width;
+        let flat = planes.flat.load(at);
+        fit.add(k, u & on, v & on, [flat.x & on, flat.y & on, flat.z & on]);
+    }
+    // Remodulated by the pixel's own weight: a texture is not blurred.
+    let weight = centre.weight;
+    let [fx, fy, fz] = fit.centre();
+    let pooled = [weight.x * fx, weight.y * fy, weight.z * fz].map(f32x8::to_array);
+    let has = [weight.x, weight.y, weight.z].map(|w| w.simd_gt(f32x8::ZERO).to_array());
+    for lane in 0..lanes {
+        if s[lane] <= 0.0 {
+            continue;
+        }
+        let slot = band_slot(lane);
+        let radiance = &mut band.radiance[slot];
+        for c in 0..3 {
+            if has[c][lane] != 0.0 {
+                radiance[c] = f64::from(pooled[c][lane]);
             }
-            let flat = fit[lane].centre();
-            // Remodulated by the pixel's own weight: a texture is not blurred.
-            let radiance = std::array::from_fn(|c| {
-                let w = weight[c][lane];
-                if w > 0.0 {
-                    f64::from(w) * flat[c]
-                } else {
-                    own[c]
-                }
-            });
-            (radiance, s[lane])
-        })
+        }
+        band.width[slot] = s[lane];
     }
 }
 
@@ -362,22 +357,20 @@ impl WidthRule {
         }
     }
 
-    /// The Gaussian's standard deviation in scene units of a slot whose neighbours on its
-    /// surface lie `footprint` away (their mean), 0 where it does not pool.
-    fn width(&self, mapper: &PhotonMapper, slot: usize, footprint: f64) -> f32 {
+    /// The widest a slot may pool whatever its footprint (scene units, before the shrink): the
+    /// frequency rule's width, under half the clear radius where the disc is not clear.
+    fn cap(&self, mapper: &PhotonMapper, slot: usize) -> f64 {
         let slots = &mapper.slots;
-        let window = self.half_window * footprint;
         let freq = slots.freq()[slot];
         let mut s = match self.mode {
             PoolMode::Off => 0.0,
-            PoolMode::Geometry => window,
+            PoolMode::Geometry => f64::INFINITY,
             PoolMode::Frequency => freq.frequency_radius(self.kernel_k).map_or(0.0, |r_freq| {
                 let budget = self.scale * r_freq;
                 let r = slots.radius()[slot];
                 (budget * budget - r * r).max(0.0).sqrt() / 2.0
             }),
         };
-        s = s.min(window);
         // A disc not clear at the largest kernel sits near another surface: pool no further
         // than half its clear radius.
         if freq.clear_level() != 0
@@ -385,9 +378,39 @@ impl WidthRule {
         {
             s = s.min(0.5 * clear);
         }
-        let s = s * self.shrink;
+        s
+    }
+
+    /// The Gaussian's standard deviation in scene units of a slot of [`Self::cap`] `cap` whose
+    /// neighbours on its surface lie `footprint` away (their mean), 0 where it does not pool.
+    #[inline]
+    fn width(&self, cap: f64, footprint: f64) -> f32 {
+        let window = self.half_window * footprint;
+        let s = cap.min(window) * self.shrink;
         // A width far below a pixel pools nothing worth the taps.
         if s < 0.25 * footprint { 0.0 } else { s as f32 }
+    }
+}
+
+/// One band's results in slot order from its first slot, and what its slots' own state gives.
+#[derive(Default)]
+struct Band {
+    /// Photon radiance: each slot's own, replaced by the pooled value where it pools.
+    radiance: Vec<[f64; 3]>,
+    /// The pooling width (0: not pooled).
+    width: Vec<f32>,
+    /// [`WidthRule::cap`] of each slot with a visible point.
+    cap: Vec<f64>,
+}
+
+impl Band {
+    fn reset(&mut self, slots: usize) {
+        self.radiance.clear();
+        self.radiance.resize(slots, [0.0; 3]);
+        self.width.clear();
+        self.width.resize(slots, 0.0);
+        self.cap.clear();
+        self.cap.resize(slots, 0.0);
     }
 }
 
@@ -447,12 +470,14 @@ struct Planes {
     material: Vec<u32>,
     /// The photon-bounce budget, [`NO_VISIBLE_POINT`] without a visible point.
     budget: Vec<u32>,
-    /// The band's results, in slot order: pooled radiance and width.
-    band: (Vec<[f64; 3]>, Vec<f32>),
+    /// The band's results.
+    band: Band,
 }
 
 impl Planes {
-    /// Copies the visible points of `rows` for `sample`.
+    /// Copies the visible points of `rows` for `sample`, and writes into `band` the own
+    /// radiance and cap ([`WidthRule::cap`]) of each slot of its rows (`band_rows`, whose
+    /// first slot is `first_slot`): each slot's radiance τ/(πR²N) is computed once.
     fn fill(
         &mut self,
         mapper: &PhotonMapper,
@@ -460,6 +485,7 @@ impl Planes {
         sample: usize,
         rows: Range<usize>,
         halo: usize,
+        (band, rule, band_rows, first_slot): (&mut Band, &WidthRule, Range<usize>, usize),
     ) {
         self.halo = halo;
         self.stride = film.width + 2 * halo + LANES;
@@ -477,6 +503,7 @@ impl Planes {
         self.budget.resize(len, 0);
         let slots = &mapper.slots;
         for (row, y) in rows.clone().enumerate() {
+            let in_band = band_rows.contains(&y);
             for col in 0..self.stride {
                 let at = row * self.stride + col;
                 let x = col.wrapping_sub(halo);
@@ -486,13 +513,19 @@ impl Planes {
                 }
                 let slot = film.slot(x, y, sample);
                 let budget = mapper.photon_bounces[slot];
+                let own = mapper.own_radiance(slot);
+                if in_band {
+                    band.radiance[slot - first_slot] = own;
+                }
                 if budget == NO_VISIBLE_POINT {
                     self.clear(at);
                     continue;
                 }
+                if in_band {
+                    band.cap[slot - first_slot] = rule.cap(mapper, slot);
+                }
                 // The mean weight of the passes, which the radiance carries (not the last one's).
                 let weight = mapper.mean_weight[slot];
-                let own = mapper.own_radiance(slot);
                 let flat = std::array::from_fn(|c| {
                     if weight[c] > 0.0 {
                         (own[c] / f64::from(weight[c])) as f32
@@ -559,10 +592,6 @@ impl V3 {
     #[inline]
     fn dot(self, other: Self) -> f32x8 {
         self.x * other.x + self.y * other.y + self.z * other.z
-    }
-
-    fn to_arrays(self) -> [[f32; LANES]; 3] {
-        [self.x.to_array(), self.y.to_array(), self.z.to_array()]
     }
 
     /// Two tangents completing each unit vector to an orthonormal basis (Duff et al. 2017, as
@@ -632,7 +661,7 @@ impl Centre {
     /// pixel's surface: a visible point of the same material and photon-bounce budget, both
     /// normals within about 25°, close to the pixel's tangent plane, and hitpoint weights within
     /// 10 % per channel.
-    #[inline]
+    #[inline(always)]
     fn on_surface(&self, planes: &Planes, at: usize, offset: V3, d2: f32x8) -> f32x8 {
         let same = mask(load_u32(&planes.material, at).simd_eq(self.material))
             & mask(load_u32(&planes.budget, at).simd_eq(self.budget))
@@ -705,45 +734,27 @@ impl Fit {
         }
     }
 
-    /// Each lane's fit.
-    fn lanes(&self) -> [LinearFit; LANES] {
-        let moments = self.moments.map(f32x8::to_array);
-        let values = self.values.map(|v| v.map(f32x8::to_array));
-        std::array::from_fn(|lane| LinearFit {
-            moments: moments.map(|m| f64::from(m[lane])),
-            values: values.map(|v| v.map(|v| f64::from(v[lane]))),
-        })
-    }
-}
-
-/// The moments of one weighted least-squares plane fit through a pixel's neighbourhood.
-struct LinearFit {
-    /// Σk·[1, u, v, uu, uv, vv].
-    moments: [f64; 6],
-    /// Σk·L·[1, u, v] per channel.
-    values: [[f64; 3]; 3],
-}
-
-impl LinearFit {
-    /// The plane's value at the centre, or the weighted mean where the neighbours do not
+    /// Each lane's plane value at the centre, or the weighted mean where the neighbours do not
     /// span the plane (all on one line) well enough to fit a gradient.
-    fn centre(&self) -> [f64; 3] {
+    #[inline]
+    fn centre(&self) -> [f32x8; 3] {
         let [m0, mu, mv, muu, muv, mvv] = self.moments;
-        let mean = self.values[0].map(|v| v / m0);
+        let inv = f32x8::ONE / m0;
         // Covariance of the tap positions about their weighted mean.
-        let (cu, cv) = (mu / m0, mv / m0);
-        let (suu, suv, svv) = (muu / m0 - cu * cu, muv / m0 - cu * cv, mvv / m0 - cv * cv);
+        let (cu, cv) = (mu * inv, mv * inv);
+        let (suu, suv, svv) = (muu * inv - cu * cu, muv * inv - cu * cv, mvv * inv - cv * cv);
         let det = suu * svv - suv * suv;
-        if det.is_nan() || det <= 1e-3 {
-            return mean;
-        }
-        // L(0) = mean − g·centroid, g = Σ⁻¹·cov(p, L).
+        // False for a NaN determinant too.
+        let spans = det.simd_gt(f32x8::splat(1e-3));
+        let inv_det = f32x8::ONE / det;
         std::array::from_fn(|c| {
-            let lu = self.values[1][c] / m0 - cu * mean[c];
-            let lv = self.values[2][c] / m0 - cv * mean[c];
-            let gu = (svv * lu - suv * lv) / det;
-            let gv = (suu * lv - suv * lu) / det;
-            mean[c] - gu * cu - gv * cv
+            let mean = self.values[0][c] * inv;
+            // L(0) = mean − g·centroid, g = Σ⁻¹·cov(p, L).
+            let lu = self.values[1][c] * inv - cu * mean;
+            let lv = self.values[2][c] * inv - cv * mean;
+            let gu = (svv * lu - suv * lv) * inv_det;
+            let gv = (suu * lv - suv * lu) * inv_det;
+            spans.select(mean - gu * cu - gv * cv, mean)
         })
     }
 }
