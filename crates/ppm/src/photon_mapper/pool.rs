@@ -56,6 +56,8 @@ const WEIGHT_TOLERANCE: f32 = 0.1;
 const CUTOFF_SIGMAS: f32 = 3.0;
 /// Pixels of a row pooled at once, one per lane of a vector.
 const LANES: usize = 8;
+/// Columns of a band pooled row after row before the next: a multiple of [`LANES`].
+const TILE_COLUMNS: usize = 128;
 /// Rows of the film one task pools: its planes hold them and the window's rows around them.
 const BAND_ROWS: usize = 32;
 
@@ -73,7 +75,13 @@ struct Tap {
     dx: i32,
     dy: i32,
     area: f32,
+    /// Its index in [`FOOTPRINT`] if it is one of the footprint's taps (whose surface test
+    /// the footprint already made), else `usize::MAX`.
+    footprint: usize,
 }
+
+/// The neighbours whose mean distance is a pixel's footprint.
+const FOOTPRINT: [(i32, i32); 4] = [(1, 0), (-1, 0), (0, 1), (0, -1)];
 
 /// The taps of a window of `radius` pixels, without the centre.
 fn taps(radius: u32) -> Vec<Tap> {
@@ -84,11 +92,25 @@ fn taps(radius: u32) -> Vec<Tap> {
             if (dx == 0 && dy == 0) || dx * dx + dy * dy > m * m {
                 continue;
             }
+            let footprint = FOOTPRINT
+                .iter()
+                .position(|&d| d == (dx, dy))
+                .unwrap_or(usize::MAX);
             let dense = dx.abs().max(dy.abs()) <= DENSE_RADIUS;
             if dense {
-                taps.push(Tap { dx, dy, area: 1.0 });
+                taps.push(Tap {
+                    dx,
+                    dy,
+                    area: 1.0,
+                    footprint,
+                });
             } else if dx % 2 == 0 && dy % 2 == 0 {
-                taps.push(Tap { dx, dy, area: 4.0 });
+                taps.push(Tap {
+                    dx,
+                    dy,
+                    area: 4.0,
+                    footprint,
+                });
             }
         }
     }
@@ -190,18 +212,24 @@ impl PhotonMapper {
                         for sample in 0..film.spp {
                             let centre = (&mut band, &rule, rows.clone(), first_slot);
                             planes.fill(self, film, sample, plane_rows.clone(), halo, centre);
-                            for y in rows.clone() {
-                                for x0 in (0..film.width).step_by(LANES) {
-                                    pool_group(
-                                        planes,
-                                        &mut band,
-                                        &rule,
-                                        &taps,
-                                        film,
-                                        (x0, y),
-                                        sample,
-                                        first_slot,
-                                    );
+                            let view = planes.view();
+                            // Tiles of columns, so that the window's rows of every plane stay
+                            // in the cache from one row of the band to the next.
+                            for tile in (0..film.width).step_by(TILE_COLUMNS) {
+                                let tile = tile..(tile + TILE_COLUMNS).min(film.width);
+                                for y in rows.clone() {
+                                    for x0 in tile.clone().step_by(LANES) {
+                                        pool_group(
+                                            &view,
+                                            &mut band,
+                                            &rule,
+                                            &taps,
+                                            film,
+                                            (x0, y),
+                                            sample,
+                                            first_slot,
+                                        );
+                                    }
                                 }
                             }
                         }
@@ -215,7 +243,6 @@ impl PhotonMapper {
                 });
             });
     }
-
 }
 
 /// Pools the eight pixels of row `y` from `x0` on (those past the film's edge are computed and
@@ -223,7 +250,7 @@ impl PhotonMapper {
 /// `band` (whose radiance already holds every slot's own).
 #[allow(clippy::too_many_arguments)]
 fn pool_group(
-    planes: &Planes,
+    planes: &View,
     band: &mut Band,
     rule: &WidthRule,
     taps: &[Tap],
@@ -238,7 +265,9 @@ fn pool_group(
     }
     // The footprint: the mean distance to the pixels beside it on its surface.
     let (mut sum, mut count) = (f32x8::ZERO, f32x8::ZERO);
-    for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
+    // Each footprint tap's surface test, which the pooling's taps reuse.
+    let mut footprint_on = [f32x8::ZERO; FOOTPRINT.len()];
+    for ((dx, dy), footprint_on) in FOOTPRINT.into_iter().zip(&mut footprint_on) {
         let Some(at) = planes.neighbour(x0, y, dx, dy) else {
             continue;
         };
@@ -246,6 +275,7 @@ fn pool_group(
         let offset = position - centre.position;
         let d2 = offset.dot(offset);
         let on = centre.on_surface(planes, at, offset, d2);
+        *footprint_on = on;
         sum += d2.sqrt() & on;
         count += f32x8::ONE & on;
     }
@@ -282,11 +312,15 @@ fn pool_group(
         if !near.any() {
             continue;
         }
-        let on = near & centre.on_surface(planes, at, offset, d2);
+        let on = near
+            & match footprint_on.get(tap.footprint) {
+                Some(&on) => on,
+                None => centre.on_surface(planes, at, offset, d2),
+            };
         if !on.any() {
             continue;
         }
-        let k = (f32x8::splat(tap.area) * (-(d2 * inv_two_var)).exp()) & on;
+        let k = (f32x8::splat(tap.area) * gaussian(-(d2 * inv_two_var))) & on;
         let u = offset.dot(t) * inv_width;
         let v = offset.dot(b) * inv_width;
         let flat = planes.flat.load(at);
@@ -414,6 +448,38 @@ impl Band {
     }
 }
 
+/// e^x for the lanes where −4.5 ≤ x ≤ 0 (a tap within [`CUTOFF_SIGMAS`]), bit for bit what
+/// `f32x8::exp` gives there (the same reduction and polynomial), without its handling of
+/// overflow, underflow and NaN: the other lanes are masked out, and are only kept finite.
+#[inline(always)]
+fn gaussian(x: f32x8) -> f32x8 {
+    const LN2_HI: f32 = 0.693_359_4;
+    const LN2_LO: f32 = -2.121_944_4e-4;
+    let x = x.max(f32x8::splat(-87.0));
+    let r = (x * f32x8::LOG2_E).round_ties_even();
+    let x = r.mul_neg_add(f32x8::splat(LN2_HI), x);
+    let x = r.mul_neg_add(f32x8::splat(LN2_LO), x);
+    let [p0, p1, p2, p3, p4, p5] = [
+        1.0 / 2.0,
+        1.0 / 6.0,
+        1.0 / 24.0,
+        1.0 / 120.0,
+        1.0 / 720.0,
+        1.0 / 5040.0,
+    ]
+    .map(f32x8::splat);
+    let x2 = x * x;
+    let x4 = x2 * x2;
+    let z = p3
+        .mul_add(x, p2)
+        .mul_add(x2, p5.mul_add(x, p4).mul_add(x4, p1.mul_add(x, p0)));
+    let z = z.mul_add(x2, x);
+    // 2^r by the exponent's bits (r ≥ −126 after the clamp).
+    let biased = r + f32x8::splat(127.0 + 8_388_608.0);
+    let scale = f32x8::from_bits(biased.to_bits() << 23);
+    (z + f32x8::ONE) * scale
+}
+
 /// Three planes of one vector quantity.
 #[derive(Default)]
 struct Plane3 {
@@ -433,15 +499,6 @@ impl Plane3 {
         self.x[at] = value[0];
         self.y[at] = value[1];
         self.z[at] = value[2];
-    }
-
-    #[inline]
-    fn load(&self, at: usize) -> V3 {
-        V3 {
-            x: load(&self.x, at),
-            y: load(&self.y, at),
-            z: load(&self.z, at),
-        }
     }
 }
 
@@ -562,6 +619,69 @@ impl Planes {
         self.budget[at] = u32::from(NO_VISIBLE_POINT);
     }
 
+    /// The planes as [`View`] reads them.
+    fn view(&self) -> View<'_> {
+        let len = self.material.len();
+        View {
+            halo: self.halo,
+            stride: self.stride,
+            rows: self.rows.clone(),
+            position: self.position.slices(len),
+            normal: self.normal.slices(len),
+            shading_normal: self.shading_normal.slices(len),
+            weight: self.weight.slices(len),
+            flat: self.flat.slices(len),
+            material: &self.material[..len],
+            budget: &self.budget[..len],
+        }
+    }
+}
+
+/// Three planes cut to one length.
+#[derive(Clone, Copy)]
+struct Slices3<'a> {
+    x: &'a [f32],
+    y: &'a [f32],
+    z: &'a [f32],
+}
+
+impl Slices3<'_> {
+    #[inline(always)]
+    fn load(&self, at: usize) -> V3 {
+        V3 {
+            x: load(self.x, at),
+            y: load(self.y, at),
+            z: load(self.z, at),
+        }
+    }
+}
+
+impl Plane3 {
+    fn slices(&self, len: usize) -> Slices3<'_> {
+        Slices3 {
+            x: &self.x[..len],
+            y: &self.y[..len],
+            z: &self.z[..len],
+        }
+    }
+}
+
+/// The planes as the pooling reads them: every plane cut to the same length, so that the
+/// compiler checks the bounds of a tap's seventeen loads once.
+struct View<'a> {
+    halo: usize,
+    stride: usize,
+    rows: Range<usize>,
+    position: Slices3<'a>,
+    normal: Slices3<'a>,
+    shading_normal: Slices3<'a>,
+    weight: Slices3<'a>,
+    flat: Slices3<'a>,
+    material: &'a [u32],
+    budget: &'a [u32],
+}
+
+impl View<'_> {
     /// Where pixel (x, y) of the film is.
     #[inline]
     fn index(&self, x: usize, y: usize) -> usize {
@@ -642,8 +762,8 @@ struct Centre {
 
 impl Centre {
     #[inline]
-    fn load(planes: &Planes, at: usize) -> Self {
-        let budget = load_u32(&planes.budget, at);
+    fn load(planes: &View, at: usize) -> Self {
+        let budget = load_u32(planes.budget, at);
         let none = u32x8::splat(u32::from(NO_VISIBLE_POINT));
         Self {
             position: planes.position.load(at),
@@ -651,7 +771,7 @@ impl Centre {
             shading_normal: planes.shading_normal.load(at),
             weight: planes.weight.load(at),
             flat: planes.flat.load(at),
-            material: load_u32(&planes.material, at),
+            material: load_u32(planes.material, at),
             budget,
             valid: !mask(budget.simd_eq(none)),
         }
@@ -662,9 +782,9 @@ impl Centre {
     /// normals within about 25°, close to the pixel's tangent plane, and hitpoint weights within
     /// 10 % per channel.
     #[inline(always)]
-    fn on_surface(&self, planes: &Planes, at: usize, offset: V3, d2: f32x8) -> f32x8 {
-        let same = mask(load_u32(&planes.material, at).simd_eq(self.material))
-            & mask(load_u32(&planes.budget, at).simd_eq(self.budget))
+    fn on_surface(&self, planes: &View, at: usize, offset: V3, d2: f32x8) -> f32x8 {
+        let same = mask(load_u32(planes.material, at).simd_eq(self.material))
+            & mask(load_u32(planes.budget, at).simd_eq(self.budget))
             & self.valid;
         let cos = f32x8::splat(NORMAL_COS);
         let normals = self.normal.dot(planes.normal.load(at)).simd_ge(cos)
@@ -742,7 +862,11 @@ impl Fit {
         let inv = f32x8::ONE / m0;
         // Covariance of the tap positions about their weighted mean.
         let (cu, cv) = (mu * inv, mv * inv);
-        let (suu, suv, svv) = (muu * inv - cu * cu, muv * inv - cu * cv, mvv * inv - cv * cv);
+        let (suu, suv, svv) = (
+            muu * inv - cu * cu,
+            muv * inv - cu * cv,
+            mvv * inv - cv * cv,
+        );
         let det = suu * svv - suv * suv;
         // False for a NaN determinant too.
         let spans = det.simd_gt(f32x8::splat(1e-3));
@@ -782,6 +906,30 @@ mod tests {
         }
         assert!(taps(0).is_empty());
         assert!(taps(8).len() < 80);
+    }
+
+    #[test]
+    fn gaussian_is_exp_bit_for_bit_within_the_cutoff() {
+        let cutoff = 0.5 * CUTOFF_SIGMAS * CUTOFF_SIGMAS;
+        let steps = 1 << 20;
+        for i in (0..=steps).step_by(LANES) {
+            let x = f32x8::new(std::array::from_fn(|lane| {
+                -cutoff * (i + lane) as f32 / steps as f32
+            }));
+            let (got, want) = (gaussian(x).to_array(), x.exp().to_array());
+            for lane in 0..LANES {
+                assert_eq!(
+                    got[lane].to_bits(),
+                    want[lane].to_bits(),
+                    "{:?}",
+                    x.to_array()
+                );
+            }
+        }
+        // Far taps stay finite (they are masked out).
+        for x in [-50.0, -87.0, -200.0, -1e30] {
+            assert!(gaussian(f32x8::splat(x)).to_array()[0].is_finite());
+        }
     }
 
     #[test]
