@@ -37,7 +37,6 @@ use wide::{f32x8, u32x8};
 
 use super::{NO_VISIBLE_POINT, PhotonMapper};
 use crate::params::PoolMode;
-use crate::update::GatherStats;
 
 /// Photons counted after which the pooling width starts to shrink.
 const SHRINK_AFTER: f64 = 1e7;
@@ -78,6 +77,8 @@ struct Tap {
     /// Its index in [`FOOTPRINT`] if it is one of the footprint's taps (whose surface test
     /// the footprint already made), else `usize::MAX`.
     footprint: usize,
+    /// How far it is in the planes ([`View::offset`]), set for each band.
+    offset: isize,
 }
 
 /// The neighbours whose mean distance is a pixel's footprint.
@@ -103,6 +104,7 @@ fn taps(radius: u32) -> Vec<Tap> {
                     dy,
                     area: 1.0,
                     footprint,
+                    offset: 0,
                 });
             } else if dx % 2 == 0 && dy % 2 == 0 {
                 taps.push(Tap {
@@ -110,6 +112,7 @@ fn taps(radius: u32) -> Vec<Tap> {
                     dy,
                     area: 4.0,
                     footprint,
+                    offset: 0,
                 });
             }
         }
@@ -131,13 +134,11 @@ impl PhotonMapper {
     /// The slot's own photon radiance τ/(πR²N) (zero where none was gathered).
     #[inline]
     pub(super) fn own_radiance(&self, slot: usize) -> [f64; 3] {
-        GatherStats {
-            radius: self.slots.radius()[slot],
-            photon_count: self.slots.photon_count()[slot],
-            flux: self.slots.flux()[slot],
-        }
-        .radiance(self.photons_counted() as f64)
-        .unwrap_or([0.0; 3])
+        own_radiance(
+            self.slots.radius()[slot],
+            self.slots.flux()[slot],
+            self.photons_counted() as f64,
+        )
     }
 
     /// Whether this render pools at all (never `appm`, whose image is its exact pass sums).
@@ -193,9 +194,15 @@ impl PhotonMapper {
         }
         let pools = self.pools();
         let rule = WidthRule::new(self);
-        let taps = taps(self.setup.params.pool.max_pixels);
+        let mut taps = taps(self.setup.params.pool.max_pixels);
         // The window's rows and columns, and at least the footprint's neighbours.
         let halo = (self.setup.params.pool.max_pixels as usize).max(1);
+        // Every band's planes have the same stride.
+        let stride = film.width + 2 * halo + LANES;
+        for tap in &mut taps {
+            tap.offset = tap.dy as isize * stride as isize + tap.dx as isize;
+        }
+        let taps = &taps;
         out.par_chunks_mut(BAND_ROWS * per_row)
             .enumerate()
             .for_each(|(band, out)| {
@@ -207,11 +214,9 @@ impl PhotonMapper {
                     let mut band = std::mem::take(&mut planes.band);
                     band.reset(slots);
                     if pools {
-                        let plane_rows =
-                            rows.start.saturating_sub(halo)..(rows.end + halo).min(film.height);
                         for sample in 0..film.spp {
                             let centre = (&mut band, &rule, rows.clone(), first_slot);
-                            planes.fill(self, film, sample, plane_rows.clone(), halo, centre);
+                            planes.fill(self, film, sample, halo, centre);
                             let view = planes.view();
                             // Tiles of columns, so that the window's rows of every plane stay
                             // in the cache from one row of the band to the next.
@@ -223,7 +228,7 @@ impl PhotonMapper {
                                             &view,
                                             &mut band,
                                             &rule,
-                                            &taps,
+                                            taps,
                                             film,
                                             (x0, y),
                                             sample,
@@ -259,7 +264,8 @@ fn pool_group(
     sample: usize,
     first_slot: usize,
 ) {
-    let centre = Centre::load(planes, planes.index(x0, y));
+    let at = planes.index(x0, y);
+    let centre = Centre::load(planes, at);
     if centre.valid.none() {
         return;
     }
@@ -268,9 +274,7 @@ fn pool_group(
     // Each footprint tap's surface test, which the pooling's taps reuse.
     let mut footprint_on = [f32x8::ZERO; FOOTPRINT.len()];
     for ((dx, dy), footprint_on) in FOOTPRINT.into_iter().zip(&mut footprint_on) {
-        let Some(at) = planes.neighbour(x0, y, dx, dy) else {
-            continue;
-        };
+        let at = at.wrapping_add_signed(planes.offset(dx, dy));
         let position = planes.position.load(at);
         let offset = position - centre.position;
         let d2 = offset.dot(offset);
@@ -302,9 +306,7 @@ fn pool_group(
     let (t, b) = centre.normal.orthonormal_pair();
     let mut fit = Fit::new(centre.flat);
     for tap in taps {
-        let Some(at) = planes.neighbour(x0, y, tap.dx, tap.dy) else {
-            continue;
-        };
+        let at = at.wrapping_add_signed(tap.offset);
         let position = planes.position.load(at);
         let offset = position - centre.position;
         let d2 = offset.dot(offset);
@@ -324,7 +326,9 @@ fn pool_group(
         let u = offset.dot(t) * inv_width;
         let v = offset.dot(b) * inv_width;
         let flat = planes.flat.load(at);
-        fit.add(k, u & on, v & on, [flat.x & on, flat.y & on, flat.z & on]);
+        // k is 0 on the lanes off the surface, and u, v and the values are finite there (the
+        // empty columns hold zeros): they add ±0 and need no mask.
+        fit.add(k, u, v, [flat.x, flat.y, flat.z]);
     }
     // Remodulated by the pixel's own weight: a texture is not blurred.
     let weight = centre.weight;
@@ -343,6 +347,20 @@ fn pool_group(
             }
         }
         band.width[slot] = s[lane];
+    }
+}
+
+/// The photon radiance τ/(πR²N) of a slot of radius `radius` and flux `flux` after `n`
+/// photons (zero where none was gathered): τ times one reciprocal, not three quotients
+/// (f64 division is the slowest step of a read-out's pass over the slots).
+#[inline]
+fn own_radiance(radius: f64, flux: [f64; 3], n: f64) -> [f64; 3] {
+    let denominator = std::f64::consts::PI * radius * radius * n;
+    if denominator > 0.0 {
+        let inverse = 1.0 / denominator;
+        flux.map(|c| c * inverse)
+    } else {
+        [0.0; 3]
     }
 }
 
@@ -438,12 +456,13 @@ struct Band {
 }
 
 impl Band {
+    /// Room for `slots` slots, with no width: the radiance of every slot and the cap of every
+    /// slot with a visible point are written before they are read (`Planes::fill`, or the
+    /// own radiance where nothing pools), so only the widths are cleared.
     fn reset(&mut self, slots: usize) {
-        self.radiance.clear();
         self.radiance.resize(slots, [0.0; 3]);
         self.width.clear();
         self.width.resize(slots, 0.0);
-        self.cap.clear();
         self.cap.resize(slots, 0.0);
     }
 }
@@ -455,7 +474,7 @@ impl Band {
 fn gaussian(x: f32x8) -> f32x8 {
     const LN2_HI: f32 = 0.693_359_4;
     const LN2_LO: f32 = -2.121_944_4e-4;
-    let x = x.max(f32x8::splat(-87.0));
+    let x = x.fast_max(f32x8::splat(-87.0));
     let r = (x * f32x8::LOG2_E).round_ties_even();
     let x = r.mul_neg_add(f32x8::splat(LN2_HI), x);
     let x = r.mul_neg_add(f32x8::splat(LN2_LO), x);
@@ -494,12 +513,6 @@ impl Plane3 {
             plane.resize(len, 0.0);
         }
     }
-
-    fn set(&mut self, at: usize, value: [f32; 3]) {
-        self.x[at] = value[0];
-        self.y[at] = value[1];
-        self.z[at] = value[2];
-    }
 }
 
 /// Eight consecutive values of a plane as a vector.
@@ -508,15 +521,17 @@ fn load(plane: &[f32], at: usize) -> f32x8 {
     f32x8::from(&plane[at..at + LANES])
 }
 
-/// The visible points of one sample index over a band of rows and the window's rows around it,
-/// one plane per quantity, `stride` columns per row: the film's columns with `halo` columns
-/// before and `halo + LANES` after that hold no visible point, so that any tap of eight
-/// neighbouring pixels loads as one vector without a bounds test per lane.
+/// The visible points of one sample index over a band of rows and the window's `halo` rows
+/// around it (rows off the film hold no visible point), one plane per quantity, `stride` columns
+/// per row: the film's columns with `halo` columns before and `halo + LANES` after that hold no
+/// visible point, so that any tap of eight neighbouring pixels loads as one vector without a
+/// bounds test per lane, and every tap of a pixel of the band is in the planes.
 #[derive(Default)]
 struct Planes {
     halo: usize,
     stride: usize,
-    rows: Range<usize>,
+    /// The film row of the planes' first row (negative above the film).
+    top: isize,
     position: Plane3,
     normal: Plane3,
     shading_normal: Plane3,
@@ -531,22 +546,73 @@ struct Planes {
     band: Band,
 }
 
+/// One row of every plane, to write.
+struct RowMut<'a> {
+    position: [&'a mut [f32]; 3],
+    normal: [&'a mut [f32]; 3],
+    shading_normal: [&'a mut [f32]; 3],
+    weight: [&'a mut [f32]; 3],
+    flat: [&'a mut [f32]; 3],
+    material: &'a mut [u32],
+    budget: &'a mut [u32],
+}
+
+impl RowMut<'_> {
+    /// Columns `cols` without a visible point (finite zeros everywhere, so that masked lanes
+    /// stay 0).
+    #[inline]
+    fn clear(&mut self, cols: Range<usize>) {
+        for plane in [
+            &mut self.position,
+            &mut self.normal,
+            &mut self.shading_normal,
+            &mut self.weight,
+            &mut self.flat,
+        ] {
+            for p in plane.iter_mut() {
+                p[cols.clone()].fill(0.0);
+            }
+        }
+        self.material[cols.clone()].fill(0);
+        self.budget[cols].fill(u32::from(NO_VISIBLE_POINT));
+    }
+
+    #[inline]
+    fn set(plane: &mut [&mut [f32]; 3], col: usize, value: [f32; 3]) {
+        for (p, v) in plane.iter_mut().zip(value) {
+            p[col] = v;
+        }
+    }
+}
+
+impl Plane3 {
+    fn row_mut(&mut self, row: Range<usize>) -> [&mut [f32]; 3] {
+        [
+            &mut self.x[row.clone()],
+            &mut self.y[row.clone()],
+            &mut self.z[row],
+        ]
+    }
+}
+
 impl Planes {
-    /// Copies the visible points of `rows` for `sample`, and writes into `band` the own
-    /// radiance and cap ([`WidthRule::cap`]) of each slot of its rows (`band_rows`, whose
-    /// first slot is `first_slot`): each slot's radiance τ/(πR²N) is computed once.
+    /// Copies the visible points of the band's rows `band_rows` and of the `halo` rows around
+    /// them for `sample`, and writes into `band` the own radiance and cap ([`WidthRule::cap`])
+    /// of each slot of the band's rows (whose first slot is `first_slot`): each slot's radiance
+    /// τ/(πR²N) is computed once.
     fn fill(
         &mut self,
         mapper: &PhotonMapper,
         film: Film,
         sample: usize,
-        rows: Range<usize>,
         halo: usize,
         (band, rule, band_rows, first_slot): (&mut Band, &WidthRule, Range<usize>, usize),
     ) {
         self.halo = halo;
         self.stride = film.width + 2 * halo + LANES;
-        let len = rows.len() * self.stride;
+        self.top = band_rows.start as isize - halo as isize;
+        let rows = band_rows.len() + 2 * halo;
+        let len = rows * self.stride;
         for plane in [
             &mut self.position,
             &mut self.normal,
@@ -559,23 +625,49 @@ impl Planes {
         self.material.resize(len, 0);
         self.budget.resize(len, 0);
         let slots = &mapper.slots;
-        for (row, y) in rows.clone().enumerate() {
+        let (radius, flux) = (slots.radius(), slots.flux());
+        let (positions, normals, shading_normals) = (
+            slots.position(),
+            slots.geometric_normal(),
+            slots.shading_normal(),
+        );
+        let materials = slots.material_idx();
+        let n = mapper.photons_counted() as f64;
+        for row in 0..rows {
+            let cols = row * self.stride..(row + 1) * self.stride;
+            let mut out = RowMut {
+                position: self.position.row_mut(cols.clone()),
+                normal: self.normal.row_mut(cols.clone()),
+                shading_normal: self.shading_normal.row_mut(cols.clone()),
+                weight: self.weight.row_mut(cols.clone()),
+                flat: self.flat.row_mut(cols.clone()),
+                material: &mut self.material[cols.clone()],
+                budget: &mut self.budget[cols],
+            };
+            let y = self.top + row as isize;
+            if y < 0 || y >= film.height as isize {
+                out.clear(0..self.stride);
+                continue;
+            }
+            let y = y as usize;
+            out.clear(0..halo);
+            out.clear(halo + film.width..self.stride);
             let in_band = band_rows.contains(&y);
-            for col in 0..self.stride {
-                let at = row * self.stride + col;
-                let x = col.wrapping_sub(halo);
-                if x >= film.width {
-                    self.clear(at);
-                    continue;
-                }
+            for x in 0..film.width {
+                let col = x + halo;
                 let slot = film.slot(x, y, sample);
                 let budget = mapper.photon_bounces[slot];
-                let own = mapper.own_radiance(slot);
+                let visible = budget != NO_VISIBLE_POINT;
+                if !visible && !in_band {
+                    out.clear(col..col + 1);
+                    continue;
+                }
+                let own = own_radiance(radius[slot], flux[slot], n);
                 if in_band {
                     band.radiance[slot - first_slot] = own;
                 }
-                if budget == NO_VISIBLE_POINT {
-                    self.clear(at);
+                if !visible {
+                    out.clear(col..col + 1);
                     continue;
                 }
                 if in_band {
@@ -585,38 +677,24 @@ impl Planes {
                 let weight = mapper.mean_weight[slot];
                 let flat = std::array::from_fn(|c| {
                     if weight[c] > 0.0 {
-                        (own[c] / f64::from(weight[c])) as f32
+                        own[c] as f32 / weight[c]
                     } else {
                         0.0
                     }
                 });
-                self.position.set(at, slots.position()[slot].to_array());
-                self.normal
-                    .set(at, slots.geometric_normal()[slot].to_array());
-                self.shading_normal
-                    .set(at, slots.shading_normal()[slot].to_array());
-                self.weight.set(at, weight.to_array());
-                self.flat.set(at, flat);
-                self.material[at] = slots.material_idx()[slot];
-                self.budget[at] = u32::from(budget);
+                RowMut::set(&mut out.position, col, positions[slot].to_array());
+                RowMut::set(&mut out.normal, col, normals[slot].to_array());
+                RowMut::set(
+                    &mut out.shading_normal,
+                    col,
+                    shading_normals[slot].to_array(),
+                );
+                RowMut::set(&mut out.weight, col, weight.to_array());
+                RowMut::set(&mut out.flat, col, flat);
+                out.material[col] = materials[slot];
+                out.budget[col] = u32::from(budget);
             }
         }
-        self.rows = rows;
-    }
-
-    /// A column without a visible point (finite zeros everywhere, so that masked lanes stay 0).
-    fn clear(&mut self, at: usize) {
-        for plane in [
-            &mut self.position,
-            &mut self.normal,
-            &mut self.shading_normal,
-            &mut self.weight,
-            &mut self.flat,
-        ] {
-            plane.set(at, [0.0; 3]);
-        }
-        self.material[at] = 0;
-        self.budget[at] = u32::from(NO_VISIBLE_POINT);
     }
 
     /// The planes as [`View`] reads them.
@@ -625,7 +703,7 @@ impl Planes {
         View {
             halo: self.halo,
             stride: self.stride,
-            rows: self.rows.clone(),
+            top: self.top,
             position: self.position.slices(len),
             normal: self.normal.slices(len),
             shading_normal: self.shading_normal.slices(len),
@@ -671,7 +749,7 @@ impl Plane3 {
 struct View<'a> {
     halo: usize,
     stride: usize,
-    rows: Range<usize>,
+    top: isize,
     position: Slices3<'a>,
     normal: Slices3<'a>,
     shading_normal: Slices3<'a>,
@@ -685,18 +763,12 @@ impl View<'_> {
     /// Where pixel (x, y) of the film is.
     #[inline]
     fn index(&self, x: usize, y: usize) -> usize {
-        (y - self.rows.start) * self.stride + x + self.halo
+        (y as isize - self.top) as usize * self.stride + x + self.halo
     }
 
-    /// Where the pixels `(dx, dy)` beside (x0, y) and its seven successors are, if their row is
-    /// on the film (columns off the film read the halo's empty columns).
-    #[inline]
-    fn neighbour(&self, x0: usize, y: usize, dx: i32, dy: i32) -> Option<usize> {
-        let qy = y.checked_add_signed(dy as isize)?;
-        if !self.rows.contains(&qy) {
-            return None;
-        }
-        Some((self.index(x0, qy) as isize + dx as isize) as usize)
+    /// How far from a pixel its neighbour `(dx, dy)` is in the planes.
+    fn offset(&self, dx: i32, dy: i32) -> isize {
+        dy as isize * self.stride as isize + dx as isize
     }
 }
 
@@ -813,7 +885,8 @@ fn mask(m: u32x8) -> f32x8 {
 #[inline]
 fn weights_agree(a: V3, b: V3) -> f32x8 {
     let tolerance = f32x8::splat(WEIGHT_TOLERANCE);
-    let agree = |a: f32x8, b: f32x8| (a - b).abs().simd_le(a.max(b) * tolerance);
+    // Weights are finite: the maximum needs no care for NaN.
+    let agree = |a: f32x8, b: f32x8| (a - b).abs().simd_le(a.fast_max(b) * tolerance);
     agree(a.x, b.x) & agree(a.y, b.y) & agree(a.z, b.z)
 }
 
