@@ -212,12 +212,12 @@ impl PhotonMapper {
                     let slots = rows.len() * film.width * film.spp;
                     // Taken out of the planes while `pool_group` reads them.
                     let mut band = std::mem::take(&mut planes.band);
+                    let mut scratch = std::mem::take(&mut planes.scratch);
                     band.reset(slots);
                     if pools {
                         for sample in 0..film.spp {
                             let centre = (&mut band, &rule, rows.clone(), first_slot);
                             planes.fill(self, film, sample, halo, centre);
-                            let view = planes.view();
                             // Tiles of columns, so that the window's rows of every plane stay
                             // in the cache from one row of the band to the next.
                             for tile in (0..film.width).step_by(TILE_COLUMNS) {
@@ -225,8 +225,9 @@ impl PhotonMapper {
                                 for y in rows.clone() {
                                     for x0 in tile.clone().step_by(LANES) {
                                         pool_group(
-                                            &view,
+                                            planes,
                                             &mut band,
+                                            &mut scratch,
                                             &rule,
                                             taps,
                                             film,
@@ -245,6 +246,7 @@ impl PhotonMapper {
                     }
                     emit(first_slot, out, &band.radiance, &band.width);
                     planes.band = band;
+                    planes.scratch = scratch;
                 });
             });
     }
@@ -255,8 +257,9 @@ impl PhotonMapper {
 /// `band` (whose radiance already holds every slot's own).
 #[allow(clippy::too_many_arguments)]
 fn pool_group(
-    planes: &View,
+    planes: &Planes,
     band: &mut Band,
+    scratch: &mut Vec<Weighted>,
     rule: &WidthRule,
     taps: &[Tap],
     film: Film,
@@ -264,6 +267,8 @@ fn pool_group(
     sample: usize,
     first_slot: usize,
 ) {
+    // Cut here, where the compiler sees that every plane has the same length.
+    let planes = &planes.view();
     let at = planes.index(x0, y);
     let centre = Centre::load(planes, at);
     if centre.valid.none() {
@@ -304,7 +309,10 @@ fn pool_group(
     let reach = f32x8::splat(CUTOFF_SIGMAS) * width;
     let cutoff2 = active.select(reach * reach, f32x8::splat(-1.0));
     let (t, b) = centre.normal.orthonormal_pair();
-    let mut fit = Fit::new(centre.flat);
+    // In three sweeps, each with few enough live vectors to stay in registers: the taps'
+    // weights and coordinates, the moments, the values. Every sum still adds the taps in
+    // their order.
+    scratch.clear();
     for tap in taps {
         let at = at.wrapping_add_signed(tap.offset);
         let position = planes.position.load(at);
@@ -322,14 +330,18 @@ fn pool_group(
         if !on.any() {
             continue;
         }
-        let k = (f32x8::splat(tap.area) * gaussian(-(d2 * inv_two_var))) & on;
-        let u = offset.dot(t) * inv_width;
-        let v = offset.dot(b) * inv_width;
-        let flat = planes.flat.load(at);
         // k is 0 on the lanes off the surface, and u, v and the values are finite there (the
         // empty columns hold zeros): they add ±0 and need no mask.
-        fit.add(k, u, v, [flat.x, flat.y, flat.z]);
+        scratch.push(Weighted {
+            k: (f32x8::splat(tap.area) * gaussian(-(d2 * inv_two_var))) & on,
+            u: offset.dot(t) * inv_width,
+            v: offset.dot(b) * inv_width,
+            at,
+        });
     }
+    let mut fit = Fit::new(centre.flat);
+    fit.add_moments(scratch);
+    fit.add_values(scratch, &planes.flat);
     // Remodulated by the pixel's own weight: a texture is not blurred.
     let weight = centre.weight;
     let [fx, fy, fz] = fit.centre();
@@ -544,6 +556,8 @@ struct Planes {
     budget: Vec<u32>,
     /// The band's results.
     band: Band,
+    /// The taps of one group that reach it.
+    scratch: Vec<Weighted>,
 }
 
 /// One row of every plane, to write.
@@ -698,6 +712,7 @@ impl Planes {
     }
 
     /// The planes as [`View`] reads them.
+    #[inline(always)]
     fn view(&self) -> View<'_> {
         let len = self.material.len();
         View {
@@ -890,6 +905,17 @@ fn weights_agree(a: V3, b: V3) -> f32x8 {
     agree(a.x, b.x) & agree(a.y, b.y) & agree(a.z, b.z)
 }
 
+/// A tap that reaches some of a group's pixels: its Gaussian weight per lane (0 where it does
+/// not reach or lies off the pixel's surface), its position in units of the width in the
+/// pixel's tangent frame, and where it is in the planes.
+#[derive(Clone, Copy)]
+struct Weighted {
+    k: f32x8,
+    u: f32x8,
+    v: f32x8,
+    at: usize,
+}
+
 /// The moments of eight weighted least-squares plane fits, in units of the pooling width, with
 /// the pixels' own values at weight 1 at (0, 0).
 struct Fit {
@@ -910,21 +936,36 @@ impl Fit {
         }
     }
 
+    /// Adds the taps' weights and positions to the moments.
     #[inline]
-    fn add(&mut self, k: f32x8, u: f32x8, v: f32x8, value: [f32x8; 3]) {
-        let (ku, kv) = (k * u, k * v);
-        let m = &mut self.moments;
-        m[0] += k;
-        m[1] += ku;
-        m[2] += kv;
-        m[3] += ku * u;
-        m[4] += ku * v;
-        m[5] += kv * v;
-        for (c, value) in value.into_iter().enumerate() {
-            self.values[0][c] += k * value;
-            self.values[1][c] += ku * value;
-            self.values[2][c] += kv * value;
+    fn add_moments(&mut self, taps: &[Weighted]) {
+        let mut m = self.moments;
+        for &Weighted { k, u, v, .. } in taps {
+            let (ku, kv) = (k * u, k * v);
+            m[0] += k;
+            m[1] += ku;
+            m[2] += kv;
+            m[3] += ku * u;
+            m[4] += ku * v;
+            m[5] += kv * v;
         }
+        self.moments = m;
+    }
+
+    /// Adds the taps' values (of `flat`) to the value sums.
+    #[inline]
+    fn add_values(&mut self, taps: &[Weighted], flat: &Slices3) {
+        let mut values = self.values;
+        for &Weighted { k, u, v, at } in taps {
+            let (ku, kv) = (k * u, k * v);
+            let value = flat.load(at);
+            for (c, value) in [value.x, value.y, value.z].into_iter().enumerate() {
+                values[0][c] += k * value;
+                values[1][c] += ku * value;
+                values[2][c] += kv * value;
+            }
+        }
+        self.values = values;
     }
 
     /// Each lane's plane value at the centre, or the weighted mean where the neighbours do not
