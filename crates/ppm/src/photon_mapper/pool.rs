@@ -520,9 +520,13 @@ struct Plane3 {
 }
 
 impl Plane3 {
-    fn resize(&mut self, len: usize) {
+    /// Room for `len` entries at least (never shrunk: the last band is shorter than the others,
+    /// and growing back would write every entry again).
+    fn reserve(&mut self, len: usize) {
         for plane in [&mut self.x, &mut self.y, &mut self.z] {
-            plane.resize(len, 0.0);
+            if plane.len() < len {
+                plane.resize(len, 0.0);
+            }
         }
     }
 }
@@ -544,6 +548,8 @@ struct Planes {
     stride: usize,
     /// The film row of the planes' first row (negative above the film).
     top: isize,
+    /// The entries of each plane in use.
+    len: usize,
     position: Plane3,
     normal: Plane3,
     shading_normal: Plane3,
@@ -591,6 +597,23 @@ impl RowMut<'_> {
         self.budget[cols].fill(u32::from(NO_VISIBLE_POINT));
     }
 
+    /// Column `col` without a visible point, as [`Self::clear`] (without a call to fill a
+    /// slice per plane).
+    #[inline]
+    fn clear_one(&mut self, col: usize) {
+        for plane in [
+            &mut self.position,
+            &mut self.normal,
+            &mut self.shading_normal,
+            &mut self.weight,
+            &mut self.flat,
+        ] {
+            Self::set(plane, col, [0.0; 3]);
+        }
+        self.material[col] = 0;
+        self.budget[col] = u32::from(NO_VISIBLE_POINT);
+    }
+
     #[inline]
     fn set(plane: &mut [&mut [f32]; 3], col: usize, value: [f32; 3]) {
         for (p, v) in plane.iter_mut().zip(value) {
@@ -634,10 +657,14 @@ impl Planes {
             &mut self.weight,
             &mut self.flat,
         ] {
-            plane.resize(len);
+            plane.reserve(len);
         }
-        self.material.resize(len, 0);
-        self.budget.resize(len, 0);
+        for plane in [&mut self.material, &mut self.budget] {
+            if plane.len() < len {
+                plane.resize(len, 0);
+            }
+        }
+        self.len = len;
         let slots = &mapper.slots;
         let (radius, flux) = (slots.radius(), slots.flux());
         let (positions, normals, shading_normals) = (
@@ -673,7 +700,7 @@ impl Planes {
                 let budget = mapper.photon_bounces[slot];
                 let visible = budget != NO_VISIBLE_POINT;
                 if !visible && !in_band {
-                    out.clear(col..col + 1);
+                    out.clear_one(col);
                     continue;
                 }
                 let own = own_radiance(radius[slot], flux[slot], n);
@@ -681,7 +708,7 @@ impl Planes {
                     band.radiance[slot - first_slot] = own;
                 }
                 if !visible {
-                    out.clear(col..col + 1);
+                    out.clear_one(col);
                     continue;
                 }
                 if in_band {
@@ -714,7 +741,7 @@ impl Planes {
     /// The planes as [`View`] reads them.
     #[inline(always)]
     fn view(&self) -> View<'_> {
-        let len = self.material.len();
+        let len = self.len;
         View {
             halo: self.halo,
             stride: self.stride,
