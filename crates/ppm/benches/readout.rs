@@ -7,7 +7,9 @@
 //! (the default) and off (`pool = off`, the same state), and the first read-out apart (the
 //! first touch of its buffers' pages), in wall seconds and in the CPU seconds of all the
 //! process's threads (rayon's idle workers spinning included). `FPPM_BENCH_READS` sets the timed
-//! read-outs per configuration, `FPPM_BENCH_SIZE=WxH` the film, `FPPM_BENCH_SCENE` the scene file.
+//! read-outs per configuration, `FPPM_BENCH_SIZE=WxH` the film, `FPPM_BENCH_SCENE` the scene file,
+//! `FPPM_BENCH_DUMP=PATH` writes the pooled image read with 1 and 2 threads to `PATH.1` and
+//! `PATH.2` (raw little-endian f32 RGB), to compare builds.
 
 #![allow(clippy::print_stdout, clippy::unwrap_used, missing_docs)]
 
@@ -84,6 +86,21 @@ fn main() {
             (n, pool)
         })
         .collect();
+    // The pooled image of each thread count as raw little-endian f32 RGB, to compare builds.
+    if let Some(dump) = std::env::var_os("FPPM_BENCH_DUMP") {
+        for (threads, pool) in &pools {
+            let renderer = &mut pooled;
+            let image = pool.install(move || renderer.image());
+            let bytes: Vec<u8> = image
+                .iter()
+                .flatten()
+                .flat_map(|v| v.to_le_bytes())
+                .collect();
+            let mut path = dump.clone();
+            path.push(format!(".{threads}"));
+            std::fs::write(path, bytes).unwrap();
+        }
+    }
     // `&mut`: a renderer is Send, not Sync.
     let mut configs: [(&str, &mut Renderer); 2] =
         [("pooled", &mut pooled), ("unpooled", &mut unpooled)];
