@@ -390,7 +390,8 @@ impl Integrator for PhotonMapper {
         if self.slots.is_empty() {
             return image;
         }
-        let camera_passes = f64::from(self.camera_passes.max(1));
+        // Times a reciprocal: three f64 quotients a pixel were a tenth of a pooled read-out.
+        let per_camera_pass = 1.0 / f64::from(self.camera_passes.max(1));
         let width = self.setup.width as usize;
         // Band by band, each pixel's slots summed in f64: the image is the only image-sized
         // buffer a read-out writes.
@@ -401,7 +402,7 @@ impl Integrator for PhotonMapper {
                 let mut sum = [0.0f64; 3];
                 for (photons, direct) in photons[slots.clone()].iter().zip(&direct[slots]) {
                     for c in 0..3 {
-                        sum[c] += photons[c] + direct[c] / camera_passes;
+                        sum[c] += photons[c] + direct[c] * per_camera_pass;
                     }
                 }
                 *out = sum.map(|v| v as f32);

@@ -37,7 +37,6 @@ use wide::{f32x8, u32x8};
 
 use super::{NO_VISIBLE_POINT, PhotonMapper};
 use crate::params::PoolMode;
-use crate::update::GatherStats;
 
 /// Photons counted after which the pooling width starts to shrink.
 const SHRINK_AFTER: f64 = 1e7;
@@ -56,6 +55,8 @@ const WEIGHT_TOLERANCE: f32 = 0.1;
 const CUTOFF_SIGMAS: f32 = 3.0;
 /// Pixels of a row pooled at once, one per lane of a vector.
 const LANES: usize = 8;
+/// Columns of a band pooled row after row before the next: a multiple of [`LANES`].
+const TILE_COLUMNS: usize = 128;
 /// Rows of the film one task pools: its planes hold them and the window's rows around them.
 const BAND_ROWS: usize = 32;
 
@@ -73,7 +74,15 @@ struct Tap {
     dx: i32,
     dy: i32,
     area: f32,
+    /// Its index in [`FOOTPRINT`] if it is one of the footprint's taps (whose surface test
+    /// the footprint already made), else `usize::MAX`.
+    footprint: usize,
+    /// How far it is in the planes ([`View::offset`]), set for each band.
+    offset: isize,
 }
+
+/// The neighbours whose mean distance is a pixel's footprint.
+const FOOTPRINT: [(i32, i32); 4] = [(1, 0), (-1, 0), (0, 1), (0, -1)];
 
 /// The taps of a window of `radius` pixels, without the centre.
 fn taps(radius: u32) -> Vec<Tap> {
@@ -84,11 +93,27 @@ fn taps(radius: u32) -> Vec<Tap> {
             if (dx == 0 && dy == 0) || dx * dx + dy * dy > m * m {
                 continue;
             }
+            let footprint = FOOTPRINT
+                .iter()
+                .position(|&d| d == (dx, dy))
+                .unwrap_or(usize::MAX);
             let dense = dx.abs().max(dy.abs()) <= DENSE_RADIUS;
             if dense {
-                taps.push(Tap { dx, dy, area: 1.0 });
+                taps.push(Tap {
+                    dx,
+                    dy,
+                    area: 1.0,
+                    footprint,
+                    offset: 0,
+                });
             } else if dx % 2 == 0 && dy % 2 == 0 {
-                taps.push(Tap { dx, dy, area: 4.0 });
+                taps.push(Tap {
+                    dx,
+                    dy,
+                    area: 4.0,
+                    footprint,
+                    offset: 0,
+                });
             }
         }
     }
@@ -107,14 +132,13 @@ pub(super) struct Pooled {
 
 impl PhotonMapper {
     /// The slot's own photon radiance τ/(πR²N) (zero where none was gathered).
+    #[inline]
     pub(super) fn own_radiance(&self, slot: usize) -> [f64; 3] {
-        GatherStats {
-            radius: self.slots.radius()[slot],
-            photon_count: self.slots.photon_count()[slot],
-            flux: self.slots.flux()[slot],
-        }
-        .radiance(self.photons_counted() as f64)
-        .unwrap_or([0.0; 3])
+        own_radiance(
+            self.slots.radius()[slot],
+            self.slots.flux()[slot],
+            self.photons_counted() as f64,
+        )
     }
 
     /// Whether this render pools at all (never `appm`, whose image is its exact pass sums).
@@ -170,9 +194,15 @@ impl PhotonMapper {
         }
         let pools = self.pools();
         let rule = WidthRule::new(self);
-        let taps = taps(self.setup.params.pool.max_pixels);
+        let mut taps = taps(self.setup.params.pool.max_pixels);
         // The window's rows and columns, and at least the footprint's neighbours.
         let halo = (self.setup.params.pool.max_pixels as usize).max(1);
+        // Every band's planes have the same stride.
+        let stride = film.width + 2 * halo + LANES;
+        for tap in &mut taps {
+            tap.offset = tap.dy as isize * stride as isize + tap.dx as isize;
+        }
+        let taps = &taps;
         out.par_chunks_mut(BAND_ROWS * per_row)
             .enumerate()
             .for_each(|(band, out)| {
@@ -181,139 +211,168 @@ impl PhotonMapper {
                     let first_slot = rows.start * film.width * film.spp;
                     let slots = rows.len() * film.width * film.spp;
                     // Taken out of the planes while `pool_group` reads them.
-                    let (mut radiance, mut width) = std::mem::take(&mut planes.band);
-                    radiance.clear();
-                    radiance.resize(slots, [0.0; 3]);
-                    width.clear();
-                    width.resize(slots, 0.0);
+                    let mut band = std::mem::take(&mut planes.band);
+                    let mut scratch = std::mem::take(&mut planes.scratch);
+                    band.reset(slots);
                     if pools {
                         for sample in 0..film.spp {
-                            let plane_rows =
-                                rows.start.saturating_sub(halo)..(rows.end + halo).min(film.height);
-                            planes.fill(self, film, sample, plane_rows, halo);
-                            for y in rows.clone() {
-                                for x0 in (0..film.width).step_by(LANES) {
-                                    let group = self.pool_group(
-                                        planes,
-                                        &rule,
-                                        &taps,
-                                        film,
-                                        (x0, y),
-                                        sample,
-                                    );
-                                    for (lane, (l, s)) in group.into_iter().enumerate() {
-                                        let x = x0 + lane;
-                                        if x < film.width {
-                                            let slot = film.slot(x, y, sample) - first_slot;
-                                            radiance[slot] = l;
-                                            width[slot] = s;
-                                        }
+                            let centre = (&mut band, &rule, rows.clone(), first_slot);
+                            planes.fill(self, film, sample, halo, centre);
+                            // Tiles of columns, so that the window's rows of every plane stay
+                            // in the cache from one row of the band to the next.
+                            for tile in (0..film.width).step_by(TILE_COLUMNS) {
+                                let tile = tile..(tile + TILE_COLUMNS).min(film.width);
+                                for y in rows.clone() {
+                                    for x0 in tile.clone().step_by(LANES) {
+                                        pool_group(
+                                            planes,
+                                            &mut band,
+                                            &mut scratch,
+                                            &rule,
+                                            taps,
+                                            film,
+                                            (x0, y),
+                                            sample,
+                                            first_slot,
+                                        );
                                     }
                                 }
                             }
                         }
                     } else {
-                        for (i, l) in radiance.iter_mut().enumerate() {
+                        for (i, l) in band.radiance.iter_mut().enumerate() {
                             *l = self.own_radiance(first_slot + i);
                         }
                     }
-                    emit(first_slot, out, &radiance, &width);
-                    planes.band = (radiance, width);
+                    emit(first_slot, out, &band.radiance, &band.width);
+                    planes.band = band;
+                    planes.scratch = scratch;
                 });
             });
     }
+}
 
-    /// The pooled photon radiance and the width of the eight pixels of row `y` from `x0` on
-    /// (those past the film's edge are computed and thrown away).
-    fn pool_group(
-        &self,
-        planes: &Planes,
-        rule: &WidthRule,
-        taps: &[Tap],
-        film: Film,
-        (x0, y): (usize, usize),
-        sample: usize,
-    ) -> [([f64; 3], f32); LANES] {
-        let centre = Centre::load(planes, planes.index(x0, y));
-        // The footprint: the mean distance to the pixels beside it on its surface.
-        let (mut sum, mut count) = (f32x8::ZERO, f32x8::ZERO);
-        for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
-            let Some(at) = planes.neighbour(x0, y, dx, dy) else {
-                continue;
-            };
-            let position = planes.position.load(at);
-            let offset = position - centre.position;
-            let d2 = offset.dot(offset);
-            let on = centre.on_surface(planes, at, offset, d2);
-            sum += d2.sqrt() & on;
-            count += f32x8::ONE & on;
+/// Pools the eight pixels of row `y` from `x0` on (those past the film's edge are computed and
+/// thrown away): writes the pooled photon radiance and the width of each lane that pools into
+/// `band` (whose radiance already holds every slot's own).
+#[allow(clippy::too_many_arguments)]
+fn pool_group(
+    planes: &Planes,
+    band: &mut Band,
+    scratch: &mut Vec<Weighted>,
+    rule: &WidthRule,
+    taps: &[Tap],
+    film: Film,
+    (x0, y): (usize, usize),
+    sample: usize,
+    first_slot: usize,
+) {
+    // Cut here, where the compiler sees that every plane has the same length.
+    let planes = &planes.view();
+    let at = planes.index(x0, y);
+    let centre = Centre::load(planes, at);
+    if centre.valid.none() {
+        return;
+    }
+    // The footprint: the mean distance to the pixels beside it on its surface.
+    let (mut sum, mut count) = (f32x8::ZERO, f32x8::ZERO);
+    // Each footprint tap's surface test, which the pooling's taps reuse.
+    let mut footprint_on = [f32x8::ZERO; FOOTPRINT.len()];
+    for ((dx, dy), footprint_on) in FOOTPRINT.into_iter().zip(&mut footprint_on) {
+        let at = at.wrapping_add_signed(planes.offset(dx, dy));
+        let position = planes.position.load(at);
+        let offset = position - centre.position;
+        let d2 = offset.dot(offset);
+        let on = centre.on_surface(planes, at, offset, d2);
+        *footprint_on = on;
+        sum += d2.sqrt() & on;
+        count += f32x8::ONE & on;
+    }
+    let (sum, count) = (sum.to_array(), count.to_array());
+    let lanes = LANES.min(film.width - x0);
+    let band_slot = |lane: usize| film.slot(x0 + lane, y, sample) - first_slot;
+    let mut s = [0.0f32; LANES];
+    for lane in 0..lanes {
+        if count[lane] > 0.0 && sum[lane] > 0.0 {
+            let footprint = f64::from(sum[lane] / count[lane]);
+            s[lane] = rule.width(band.cap[band_slot(lane)], footprint);
         }
-        let (sum, count) = (sum.to_array(), count.to_array());
-        let slots: [Option<usize>; LANES] = std::array::from_fn(|lane| {
-            let x = x0 + lane;
-            (x < film.width).then(|| film.slot(x, y, sample))
-        });
-        let s: [f32; LANES] = std::array::from_fn(|lane| {
-            let Some(slot) = slots[lane] else {
-                return 0.0;
-            };
-            let footprint =
-                (count[lane] > 0.0 && sum[lane] > 0.0).then(|| f64::from(sum[lane] / count[lane]));
-            footprint.map_or(0.0, |footprint| rule.width(self, slot, footprint))
-        });
-        let own = |lane: usize| slots[lane].map_or([0.0; 3], |slot| self.own_radiance(slot));
-        if s.iter().all(|&s| s <= 0.0) {
-            return std::array::from_fn(|lane| (own(lane), 0.0));
-        }
+    }
+    if s.iter().all(|&s| s <= 0.0) {
+        return;
+    }
 
-        let width = f32x8::new(s);
-        let active = width.simd_gt(f32x8::ZERO);
-        let inv_width = (f32x8::ONE / width) & active;
-        let inv_two_var = f32x8::splat(0.5) * inv_width * inv_width;
-        let reach = f32x8::splat(CUTOFF_SIGMAS) * width;
-        let cutoff2 = active.select(reach * reach, f32x8::splat(-1.0));
-        let (t, b) = centre.normal.orthonormal_pair();
-        let mut fit = Fit::new(centre.flat);
-        for tap in taps {
-            let Some(at) = planes.neighbour(x0, y, tap.dx, tap.dy) else {
-                continue;
-            };
-            let position = planes.position.load(at);
-            let offset = position - centre.position;
-            let d2 = offset.dot(offset);
-            let near = d2.simd_le(cutoff2);
-            if !near.any() {
-                continue;
-            }
-            let on = near & centre.on_surface(planes, at, offset, d2);
-            if !on.any() {
-                continue;
-            }
-            let k = (f32x8::splat(tap.area) * (-(d2 * inv_two_var)).exp()) & on;
-            let u = offset.dot(t) * inv_width;
-            let v = offset.dot(b) * inv_width;
-            let flat = planes.flat.load(at);
-            fit.add(k, u & on, v & on, [flat.x & on, flat.y & on, flat.z & on]);
+    let width = f32x8::new(s);
+    let active = width.simd_gt(f32x8::ZERO);
+    let inv_width = (f32x8::ONE / width) & active;
+    let inv_two_var = f32x8::splat(0.5) * inv_width * inv_width;
+    let reach = f32x8::splat(CUTOFF_SIGMAS) * width;
+    let cutoff2 = active.select(reach * reach, f32x8::splat(-1.0));
+    let (t, b) = centre.normal.orthonormal_pair();
+    // In three sweeps, each with few enough live vectors to stay in registers: the taps'
+    // weights and coordinates, the moments, the values. Every sum still adds the taps in
+    // their order.
+    scratch.clear();
+    for tap in taps {
+        let at = at.wrapping_add_signed(tap.offset);
+        let position = planes.position.load(at);
+        let offset = position - centre.position;
+        let d2 = offset.dot(offset);
+        let near = d2.simd_le(cutoff2);
+        if !near.any() {
+            continue;
         }
-        let weight = centre.weight.to_arrays();
-        let fit = fit.lanes();
-        std::array::from_fn(|lane| {
-            let own = own(lane);
-            if s[lane] <= 0.0 {
-                return (own, 0.0);
+        let on = near
+            & match footprint_on.get(tap.footprint) {
+                Some(&on) => on,
+                None => centre.on_surface(planes, at, offset, d2),
+            };
+        if !on.any() {
+            continue;
+        }
+        // k is 0 on the lanes off the surface, and u, v and the values are finite there (the
+        // empty columns hold zeros): they add ±0 and need no mask.
+        scratch.push(Weighted {
+            k: (f32x8::splat(tap.area) * gaussian(-(d2 * inv_two_var))) & on,
+            u: offset.dot(t) * inv_width,
+            v: offset.dot(b) * inv_width,
+            at,
+        });
+    }
+    let mut fit = Fit::new(centre.flat);
+    fit.add_moments(scratch);
+    fit.add_values(scratch, &planes.flat);
+    // Remodulated by the pixel's own weight: a texture is not blurred.
+    let weight = centre.weight;
+    let [fx, fy, fz] = fit.centre();
+    let pooled = [weight.x * fx, weight.y * fy, weight.z * fz].map(f32x8::to_array);
+    let has = [weight.x, weight.y, weight.z].map(|w| w.simd_gt(f32x8::ZERO).to_array());
+    for lane in 0..lanes {
+        if s[lane] <= 0.0 {
+            continue;
+        }
+        let slot = band_slot(lane);
+        let radiance = &mut band.radiance[slot];
+        for c in 0..3 {
+            if has[c][lane] != 0.0 {
+                radiance[c] = f64::from(pooled[c][lane]);
             }
-            let flat = fit[lane].centre();
-            // Remodulated by the pixel's own weight: a texture is not blurred.
-            let radiance = std::array::from_fn(|c| {
-                let w = weight[c][lane];
-                if w > 0.0 {
-                    f64::from(w) * flat[c]
-                } else {
-                    own[c]
-                }
-            });
-            (radiance, s[lane])
-        })
+        }
+        band.width[slot] = s[lane];
+    }
+}
+
+/// The photon radiance τ/(πR²N) of a slot of radius `radius` and flux `flux` after `n`
+/// photons (zero where none was gathered): τ times one reciprocal, not three quotients
+/// (f64 division is the slowest step of a read-out's pass over the slots).
+#[inline]
+fn own_radiance(radius: f64, flux: [f64; 3], n: f64) -> [f64; 3] {
+    let denominator = std::f64::consts::PI * radius * radius * n;
+    if denominator > 0.0 {
+        let inverse = 1.0 / denominator;
+        flux.map(|c| c * inverse)
+    } else {
+        [0.0; 3]
     }
 }
 
@@ -362,22 +421,20 @@ impl WidthRule {
         }
     }
 
-    /// The Gaussian's standard deviation in scene units of a slot whose neighbours on its
-    /// surface lie `footprint` away (their mean), 0 where it does not pool.
-    fn width(&self, mapper: &PhotonMapper, slot: usize, footprint: f64) -> f32 {
+    /// The widest a slot may pool whatever its footprint (scene units, before the shrink): the
+    /// frequency rule's width, under half the clear radius where the disc is not clear.
+    fn cap(&self, mapper: &PhotonMapper, slot: usize) -> f64 {
         let slots = &mapper.slots;
-        let window = self.half_window * footprint;
         let freq = slots.freq()[slot];
         let mut s = match self.mode {
             PoolMode::Off => 0.0,
-            PoolMode::Geometry => window,
+            PoolMode::Geometry => f64::INFINITY,
             PoolMode::Frequency => freq.frequency_radius(self.kernel_k).map_or(0.0, |r_freq| {
                 let budget = self.scale * r_freq;
                 let r = slots.radius()[slot];
                 (budget * budget - r * r).max(0.0).sqrt() / 2.0
             }),
         };
-        s = s.min(window);
         // A disc not clear at the largest kernel sits near another surface: pool no further
         // than half its clear radius.
         if freq.clear_level() != 0
@@ -385,10 +442,73 @@ impl WidthRule {
         {
             s = s.min(0.5 * clear);
         }
-        let s = s * self.shrink;
+        s
+    }
+
+    /// The Gaussian's standard deviation in scene units of a slot of [`Self::cap`] `cap` whose
+    /// neighbours on its surface lie `footprint` away (their mean), 0 where it does not pool.
+    #[inline]
+    fn width(&self, cap: f64, footprint: f64) -> f32 {
+        let window = self.half_window * footprint;
+        let s = cap.min(window) * self.shrink;
         // A width far below a pixel pools nothing worth the taps.
         if s < 0.25 * footprint { 0.0 } else { s as f32 }
     }
+}
+
+/// One band's results in slot order from its first slot, and what its slots' own state gives.
+#[derive(Default)]
+struct Band {
+    /// Photon radiance: each slot's own, replaced by the pooled value where it pools.
+    radiance: Vec<[f64; 3]>,
+    /// The pooling width (0: not pooled).
+    width: Vec<f32>,
+    /// [`WidthRule::cap`] of each slot with a visible point.
+    cap: Vec<f64>,
+}
+
+impl Band {
+    /// Room for `slots` slots, with no width: the radiance of every slot and the cap of every
+    /// slot with a visible point are written before they are read (`Planes::fill`, or the
+    /// own radiance where nothing pools), so only the widths are cleared.
+    fn reset(&mut self, slots: usize) {
+        self.radiance.resize(slots, [0.0; 3]);
+        self.width.clear();
+        self.width.resize(slots, 0.0);
+        self.cap.resize(slots, 0.0);
+    }
+}
+
+/// e^x for the lanes where −4.5 ≤ x ≤ 0 (a tap within [`CUTOFF_SIGMAS`]), bit for bit what
+/// `f32x8::exp` gives there (the same reduction and polynomial), without its handling of
+/// overflow, underflow and NaN: the other lanes are masked out, and are only kept finite.
+#[inline(always)]
+fn gaussian(x: f32x8) -> f32x8 {
+    const LN2_HI: f32 = 0.693_359_4;
+    const LN2_LO: f32 = -2.121_944_4e-4;
+    let x = x.fast_max(f32x8::splat(-87.0));
+    let r = (x * f32x8::LOG2_E).round_ties_even();
+    let x = r.mul_neg_add(f32x8::splat(LN2_HI), x);
+    let x = r.mul_neg_add(f32x8::splat(LN2_LO), x);
+    let [p0, p1, p2, p3, p4, p5] = [
+        1.0 / 2.0,
+        1.0 / 6.0,
+        1.0 / 24.0,
+        1.0 / 120.0,
+        1.0 / 720.0,
+        1.0 / 5040.0,
+    ]
+    .map(f32x8::splat);
+    let x2 = x * x;
+    let x4 = x2 * x2;
+    let z = p3
+        .mul_add(x, p2)
+        .mul_add(x2, p5.mul_add(x, p4).mul_add(x4, p1.mul_add(x, p0)));
+    let z = z.mul_add(x2, x);
+    // 2^r by the exponent's bits (r ≥ −126 after the clamp).
+    let biased = r + f32x8::splat(127.0 + 8_388_608.0);
+    let scale = f32x8::from_bits(biased.to_bits() << 23);
+    (z + f32x8::ONE) * scale
 }
 
 /// Three planes of one vector quantity.
@@ -400,24 +520,13 @@ struct Plane3 {
 }
 
 impl Plane3 {
-    fn resize(&mut self, len: usize) {
+    /// Room for `len` entries at least (never shrunk: the last band is shorter than the others,
+    /// and growing back would write every entry again).
+    fn reserve(&mut self, len: usize) {
         for plane in [&mut self.x, &mut self.y, &mut self.z] {
-            plane.resize(len, 0.0);
-        }
-    }
-
-    fn set(&mut self, at: usize, value: [f32; 3]) {
-        self.x[at] = value[0];
-        self.y[at] = value[1];
-        self.z[at] = value[2];
-    }
-
-    #[inline]
-    fn load(&self, at: usize) -> V3 {
-        V3 {
-            x: load(&self.x, at),
-            y: load(&self.y, at),
-            z: load(&self.z, at),
+            if plane.len() < len {
+                plane.resize(len, 0.0);
+            }
         }
     }
 }
@@ -428,15 +537,19 @@ fn load(plane: &[f32], at: usize) -> f32x8 {
     f32x8::from(&plane[at..at + LANES])
 }
 
-/// The visible points of one sample index over a band of rows and the window's rows around it,
-/// one plane per quantity, `stride` columns per row: the film's columns with `halo` columns
-/// before and `halo + LANES` after that hold no visible point, so that any tap of eight
-/// neighbouring pixels loads as one vector without a bounds test per lane.
+/// The visible points of one sample index over a band of rows and the window's `halo` rows
+/// around it (rows off the film hold no visible point), one plane per quantity, `stride` columns
+/// per row: the film's columns with `halo` columns before and `halo + LANES` after that hold no
+/// visible point, so that any tap of eight neighbouring pixels loads as one vector without a
+/// bounds test per lane, and every tap of a pixel of the band is in the planes.
 #[derive(Default)]
 struct Planes {
     halo: usize,
     stride: usize,
-    rows: Range<usize>,
+    /// The film row of the planes' first row (negative above the film).
+    top: isize,
+    /// The entries of each plane in use.
+    len: usize,
     position: Plane3,
     normal: Plane3,
     shading_normal: Plane3,
@@ -447,23 +560,96 @@ struct Planes {
     material: Vec<u32>,
     /// The photon-bounce budget, [`NO_VISIBLE_POINT`] without a visible point.
     budget: Vec<u32>,
-    /// The band's results, in slot order: pooled radiance and width.
-    band: (Vec<[f64; 3]>, Vec<f32>),
+    /// The band's results.
+    band: Band,
+    /// The taps of one group that reach it.
+    scratch: Vec<Weighted>,
+}
+
+/// One row of every plane, to write.
+struct RowMut<'a> {
+    position: [&'a mut [f32]; 3],
+    normal: [&'a mut [f32]; 3],
+    shading_normal: [&'a mut [f32]; 3],
+    weight: [&'a mut [f32]; 3],
+    flat: [&'a mut [f32]; 3],
+    material: &'a mut [u32],
+    budget: &'a mut [u32],
+}
+
+impl RowMut<'_> {
+    /// Columns `cols` without a visible point (finite zeros everywhere, so that masked lanes
+    /// stay 0).
+    #[inline]
+    fn clear(&mut self, cols: Range<usize>) {
+        for plane in [
+            &mut self.position,
+            &mut self.normal,
+            &mut self.shading_normal,
+            &mut self.weight,
+            &mut self.flat,
+        ] {
+            for p in plane.iter_mut() {
+                p[cols.clone()].fill(0.0);
+            }
+        }
+        self.material[cols.clone()].fill(0);
+        self.budget[cols].fill(u32::from(NO_VISIBLE_POINT));
+    }
+
+    /// Column `col` without a visible point, as [`Self::clear`] (without a call to fill a
+    /// slice per plane).
+    #[inline]
+    fn clear_one(&mut self, col: usize) {
+        for plane in [
+            &mut self.position,
+            &mut self.normal,
+            &mut self.shading_normal,
+            &mut self.weight,
+            &mut self.flat,
+        ] {
+            Self::set(plane, col, [0.0; 3]);
+        }
+        self.material[col] = 0;
+        self.budget[col] = u32::from(NO_VISIBLE_POINT);
+    }
+
+    #[inline]
+    fn set(plane: &mut [&mut [f32]; 3], col: usize, value: [f32; 3]) {
+        for (p, v) in plane.iter_mut().zip(value) {
+            p[col] = v;
+        }
+    }
+}
+
+impl Plane3 {
+    fn row_mut(&mut self, row: Range<usize>) -> [&mut [f32]; 3] {
+        [
+            &mut self.x[row.clone()],
+            &mut self.y[row.clone()],
+            &mut self.z[row],
+        ]
+    }
 }
 
 impl Planes {
-    /// Copies the visible points of `rows` for `sample`.
+    /// Copies the visible points of the band's rows `band_rows` and of the `halo` rows around
+    /// them for `sample`, and writes into `band` the own radiance and cap ([`WidthRule::cap`])
+    /// of each slot of the band's rows (whose first slot is `first_slot`): each slot's radiance
+    /// τ/(πR²N) is computed once.
     fn fill(
         &mut self,
         mapper: &PhotonMapper,
         film: Film,
         sample: usize,
-        rows: Range<usize>,
         halo: usize,
+        (band, rule, band_rows, first_slot): (&mut Band, &WidthRule, Range<usize>, usize),
     ) {
         self.halo = halo;
         self.stride = film.width + 2 * halo + LANES;
-        let len = rows.len() * self.stride;
+        self.top = band_rows.start as isize - halo as isize;
+        let rows = band_rows.len() + 2 * halo;
+        let len = rows * self.stride;
         for plane in [
             &mut self.position,
             &mut self.normal,
@@ -471,79 +657,160 @@ impl Planes {
             &mut self.weight,
             &mut self.flat,
         ] {
-            plane.resize(len);
+            plane.reserve(len);
         }
-        self.material.resize(len, 0);
-        self.budget.resize(len, 0);
+        for plane in [&mut self.material, &mut self.budget] {
+            if plane.len() < len {
+                plane.resize(len, 0);
+            }
+        }
+        self.len = len;
         let slots = &mapper.slots;
-        for (row, y) in rows.clone().enumerate() {
-            for col in 0..self.stride {
-                let at = row * self.stride + col;
-                let x = col.wrapping_sub(halo);
-                if x >= film.width {
-                    self.clear(at);
-                    continue;
-                }
+        let (radius, flux) = (slots.radius(), slots.flux());
+        let (positions, normals, shading_normals) = (
+            slots.position(),
+            slots.geometric_normal(),
+            slots.shading_normal(),
+        );
+        let materials = slots.material_idx();
+        let n = mapper.photons_counted() as f64;
+        for row in 0..rows {
+            let cols = row * self.stride..(row + 1) * self.stride;
+            let mut out = RowMut {
+                position: self.position.row_mut(cols.clone()),
+                normal: self.normal.row_mut(cols.clone()),
+                shading_normal: self.shading_normal.row_mut(cols.clone()),
+                weight: self.weight.row_mut(cols.clone()),
+                flat: self.flat.row_mut(cols.clone()),
+                material: &mut self.material[cols.clone()],
+                budget: &mut self.budget[cols],
+            };
+            let y = self.top + row as isize;
+            if y < 0 || y >= film.height as isize {
+                out.clear(0..self.stride);
+                continue;
+            }
+            let y = y as usize;
+            out.clear(0..halo);
+            out.clear(halo + film.width..self.stride);
+            let in_band = band_rows.contains(&y);
+            for x in 0..film.width {
+                let col = x + halo;
                 let slot = film.slot(x, y, sample);
                 let budget = mapper.photon_bounces[slot];
-                if budget == NO_VISIBLE_POINT {
-                    self.clear(at);
+                let visible = budget != NO_VISIBLE_POINT;
+                if !visible && !in_band {
+                    out.clear_one(col);
                     continue;
+                }
+                let own = own_radiance(radius[slot], flux[slot], n);
+                if in_band {
+                    band.radiance[slot - first_slot] = own;
+                }
+                if !visible {
+                    out.clear_one(col);
+                    continue;
+                }
+                if in_band {
+                    band.cap[slot - first_slot] = rule.cap(mapper, slot);
                 }
                 // The mean weight of the passes, which the radiance carries (not the last one's).
                 let weight = mapper.mean_weight[slot];
-                let own = mapper.own_radiance(slot);
                 let flat = std::array::from_fn(|c| {
                     if weight[c] > 0.0 {
-                        (own[c] / f64::from(weight[c])) as f32
+                        own[c] as f32 / weight[c]
                     } else {
                         0.0
                     }
                 });
-                self.position.set(at, slots.position()[slot].to_array());
-                self.normal
-                    .set(at, slots.geometric_normal()[slot].to_array());
-                self.shading_normal
-                    .set(at, slots.shading_normal()[slot].to_array());
-                self.weight.set(at, weight.to_array());
-                self.flat.set(at, flat);
-                self.material[at] = slots.material_idx()[slot];
-                self.budget[at] = u32::from(budget);
+                RowMut::set(&mut out.position, col, positions[slot].to_array());
+                RowMut::set(&mut out.normal, col, normals[slot].to_array());
+                RowMut::set(
+                    &mut out.shading_normal,
+                    col,
+                    shading_normals[slot].to_array(),
+                );
+                RowMut::set(&mut out.weight, col, weight.to_array());
+                RowMut::set(&mut out.flat, col, flat);
+                out.material[col] = materials[slot];
+                out.budget[col] = u32::from(budget);
             }
         }
-        self.rows = rows;
     }
 
-    /// A column without a visible point (finite zeros everywhere, so that masked lanes stay 0).
-    fn clear(&mut self, at: usize) {
-        for plane in [
-            &mut self.position,
-            &mut self.normal,
-            &mut self.shading_normal,
-            &mut self.weight,
-            &mut self.flat,
-        ] {
-            plane.set(at, [0.0; 3]);
+    /// The planes as [`View`] reads them.
+    #[inline(always)]
+    fn view(&self) -> View<'_> {
+        let len = self.len;
+        View {
+            halo: self.halo,
+            stride: self.stride,
+            top: self.top,
+            position: self.position.slices(len),
+            normal: self.normal.slices(len),
+            shading_normal: self.shading_normal.slices(len),
+            weight: self.weight.slices(len),
+            flat: self.flat.slices(len),
+            material: &self.material[..len],
+            budget: &self.budget[..len],
         }
-        self.material[at] = 0;
-        self.budget[at] = u32::from(NO_VISIBLE_POINT);
     }
+}
 
+/// Three planes cut to one length.
+#[derive(Clone, Copy)]
+struct Slices3<'a> {
+    x: &'a [f32],
+    y: &'a [f32],
+    z: &'a [f32],
+}
+
+impl Slices3<'_> {
+    #[inline(always)]
+    fn load(&self, at: usize) -> V3 {
+        V3 {
+            x: load(self.x, at),
+            y: load(self.y, at),
+            z: load(self.z, at),
+        }
+    }
+}
+
+impl Plane3 {
+    fn slices(&self, len: usize) -> Slices3<'_> {
+        Slices3 {
+            x: &self.x[..len],
+            y: &self.y[..len],
+            z: &self.z[..len],
+        }
+    }
+}
+
+/// The planes as the pooling reads them: every plane cut to the same length, so that the
+/// compiler checks the bounds of a tap's seventeen loads once.
+struct View<'a> {
+    halo: usize,
+    stride: usize,
+    top: isize,
+    position: Slices3<'a>,
+    normal: Slices3<'a>,
+    shading_normal: Slices3<'a>,
+    weight: Slices3<'a>,
+    flat: Slices3<'a>,
+    material: &'a [u32],
+    budget: &'a [u32],
+}
+
+impl View<'_> {
     /// Where pixel (x, y) of the film is.
     #[inline]
     fn index(&self, x: usize, y: usize) -> usize {
-        (y - self.rows.start) * self.stride + x + self.halo
+        (y as isize - self.top) as usize * self.stride + x + self.halo
     }
 
-    /// Where the pixels `(dx, dy)` beside (x0, y) and its seven successors are, if their row is
-    /// on the film (columns off the film read the halo's empty columns).
-    #[inline]
-    fn neighbour(&self, x0: usize, y: usize, dx: i32, dy: i32) -> Option<usize> {
-        let qy = y.checked_add_signed(dy as isize)?;
-        if !self.rows.contains(&qy) {
-            return None;
-        }
-        Some((self.index(x0, qy) as isize + dx as isize) as usize)
+    /// How far from a pixel its neighbour `(dx, dy)` is in the planes.
+    fn offset(&self, dx: i32, dy: i32) -> isize {
+        dy as isize * self.stride as isize + dx as isize
     }
 }
 
@@ -559,10 +826,6 @@ impl V3 {
     #[inline]
     fn dot(self, other: Self) -> f32x8 {
         self.x * other.x + self.y * other.y + self.z * other.z
-    }
-
-    fn to_arrays(self) -> [[f32; LANES]; 3] {
-        [self.x.to_array(), self.y.to_array(), self.z.to_array()]
     }
 
     /// Two tangents completing each unit vector to an orthonormal basis (Duff et al. 2017, as
@@ -613,8 +876,8 @@ struct Centre {
 
 impl Centre {
     #[inline]
-    fn load(planes: &Planes, at: usize) -> Self {
-        let budget = load_u32(&planes.budget, at);
+    fn load(planes: &View, at: usize) -> Self {
+        let budget = load_u32(planes.budget, at);
         let none = u32x8::splat(u32::from(NO_VISIBLE_POINT));
         Self {
             position: planes.position.load(at),
@@ -622,7 +885,7 @@ impl Centre {
             shading_normal: planes.shading_normal.load(at),
             weight: planes.weight.load(at),
             flat: planes.flat.load(at),
-            material: load_u32(&planes.material, at),
+            material: load_u32(planes.material, at),
             budget,
             valid: !mask(budget.simd_eq(none)),
         }
@@ -632,10 +895,10 @@ impl Centre {
     /// pixel's surface: a visible point of the same material and photon-bounce budget, both
     /// normals within about 25°, close to the pixel's tangent plane, and hitpoint weights within
     /// 10 % per channel.
-    #[inline]
-    fn on_surface(&self, planes: &Planes, at: usize, offset: V3, d2: f32x8) -> f32x8 {
-        let same = mask(load_u32(&planes.material, at).simd_eq(self.material))
-            & mask(load_u32(&planes.budget, at).simd_eq(self.budget))
+    #[inline(always)]
+    fn on_surface(&self, planes: &View, at: usize, offset: V3, d2: f32x8) -> f32x8 {
+        let same = mask(load_u32(planes.material, at).simd_eq(self.material))
+            & mask(load_u32(planes.budget, at).simd_eq(self.budget))
             & self.valid;
         let cos = f32x8::splat(NORMAL_COS);
         let normals = self.normal.dot(planes.normal.load(at)).simd_ge(cos)
@@ -664,8 +927,20 @@ fn mask(m: u32x8) -> f32x8 {
 #[inline]
 fn weights_agree(a: V3, b: V3) -> f32x8 {
     let tolerance = f32x8::splat(WEIGHT_TOLERANCE);
-    let agree = |a: f32x8, b: f32x8| (a - b).abs().simd_le(a.max(b) * tolerance);
+    // Weights are finite: the maximum needs no care for NaN.
+    let agree = |a: f32x8, b: f32x8| (a - b).abs().simd_le(a.fast_max(b) * tolerance);
     agree(a.x, b.x) & agree(a.y, b.y) & agree(a.z, b.z)
+}
+
+/// A tap that reaches some of a group's pixels: its Gaussian weight per lane (0 where it does
+/// not reach or lies off the pixel's surface), its position in units of the width in the
+/// pixel's tangent frame, and where it is in the planes.
+#[derive(Clone, Copy)]
+struct Weighted {
+    k: f32x8,
+    u: f32x8,
+    v: f32x8,
+    at: usize,
 }
 
 /// The moments of eight weighted least-squares plane fits, in units of the pooling width, with
@@ -688,62 +963,63 @@ impl Fit {
         }
     }
 
+    /// Adds the taps' weights and positions to the moments.
     #[inline]
-    fn add(&mut self, k: f32x8, u: f32x8, v: f32x8, value: [f32x8; 3]) {
-        let (ku, kv) = (k * u, k * v);
-        let m = &mut self.moments;
-        m[0] += k;
-        m[1] += ku;
-        m[2] += kv;
-        m[3] += ku * u;
-        m[4] += ku * v;
-        m[5] += kv * v;
-        for (c, value) in value.into_iter().enumerate() {
-            self.values[0][c] += k * value;
-            self.values[1][c] += ku * value;
-            self.values[2][c] += kv * value;
+    fn add_moments(&mut self, taps: &[Weighted]) {
+        let mut m = self.moments;
+        for &Weighted { k, u, v, .. } in taps {
+            let (ku, kv) = (k * u, k * v);
+            m[0] += k;
+            m[1] += ku;
+            m[2] += kv;
+            m[3] += ku * u;
+            m[4] += ku * v;
+            m[5] += kv * v;
         }
+        self.moments = m;
     }
 
-    /// Each lane's fit.
-    fn lanes(&self) -> [LinearFit; LANES] {
-        let moments = self.moments.map(f32x8::to_array);
-        let values = self.values.map(|v| v.map(f32x8::to_array));
-        std::array::from_fn(|lane| LinearFit {
-            moments: moments.map(|m| f64::from(m[lane])),
-            values: values.map(|v| v.map(|v| f64::from(v[lane]))),
-        })
+    /// Adds the taps' values (of `flat`) to the value sums.
+    #[inline]
+    fn add_values(&mut self, taps: &[Weighted], flat: &Slices3) {
+        let mut values = self.values;
+        for &Weighted { k, u, v, at } in taps {
+            let (ku, kv) = (k * u, k * v);
+            let value = flat.load(at);
+            for (c, value) in [value.x, value.y, value.z].into_iter().enumerate() {
+                values[0][c] += k * value;
+                values[1][c] += ku * value;
+                values[2][c] += kv * value;
+            }
+        }
+        self.values = values;
     }
-}
 
-/// The moments of one weighted least-squares plane fit through a pixel's neighbourhood.
-struct LinearFit {
-    /// Σk·[1, u, v, uu, uv, vv].
-    moments: [f64; 6],
-    /// Σk·L·[1, u, v] per channel.
-    values: [[f64; 3]; 3],
-}
-
-impl LinearFit {
-    /// The plane's value at the centre, or the weighted mean where the neighbours do not
+    /// Each lane's plane value at the centre, or the weighted mean where the neighbours do not
     /// span the plane (all on one line) well enough to fit a gradient.
-    fn centre(&self) -> [f64; 3] {
+    #[inline]
+    fn centre(&self) -> [f32x8; 3] {
         let [m0, mu, mv, muu, muv, mvv] = self.moments;
-        let mean = self.values[0].map(|v| v / m0);
+        let inv = f32x8::ONE / m0;
         // Covariance of the tap positions about their weighted mean.
-        let (cu, cv) = (mu / m0, mv / m0);
-        let (suu, suv, svv) = (muu / m0 - cu * cu, muv / m0 - cu * cv, mvv / m0 - cv * cv);
+        let (cu, cv) = (mu * inv, mv * inv);
+        let (suu, suv, svv) = (
+            muu * inv - cu * cu,
+            muv * inv - cu * cv,
+            mvv * inv - cv * cv,
+        );
         let det = suu * svv - suv * suv;
-        if det.is_nan() || det <= 1e-3 {
-            return mean;
-        }
-        // L(0) = mean − g·centroid, g = Σ⁻¹·cov(p, L).
+        // False for a NaN determinant too.
+        let spans = det.simd_gt(f32x8::splat(1e-3));
+        let inv_det = f32x8::ONE / det;
         std::array::from_fn(|c| {
-            let lu = self.values[1][c] / m0 - cu * mean[c];
-            let lv = self.values[2][c] / m0 - cv * mean[c];
-            let gu = (svv * lu - suv * lv) / det;
-            let gv = (suu * lv - suv * lu) / det;
-            mean[c] - gu * cu - gv * cv
+            let mean = self.values[0][c] * inv;
+            // L(0) = mean − g·centroid, g = Σ⁻¹·cov(p, L).
+            let lu = self.values[1][c] * inv - cu * mean;
+            let lv = self.values[2][c] * inv - cv * mean;
+            let gu = (svv * lu - suv * lv) * inv_det;
+            let gv = (suu * lv - suv * lu) * inv_det;
+            spans.select(mean - gu * cu - gv * cv, mean)
         })
     }
 }
@@ -771,6 +1047,30 @@ mod tests {
         }
         assert!(taps(0).is_empty());
         assert!(taps(8).len() < 80);
+    }
+
+    #[test]
+    fn gaussian_is_exp_bit_for_bit_within_the_cutoff() {
+        let cutoff = 0.5 * CUTOFF_SIGMAS * CUTOFF_SIGMAS;
+        let steps = 1 << 20;
+        for i in (0..=steps).step_by(LANES) {
+            let x = f32x8::new(std::array::from_fn(|lane| {
+                -cutoff * (i + lane) as f32 / steps as f32
+            }));
+            let (got, want) = (gaussian(x).to_array(), x.exp().to_array());
+            for lane in 0..LANES {
+                assert_eq!(
+                    got[lane].to_bits(),
+                    want[lane].to_bits(),
+                    "{:?}",
+                    x.to_array()
+                );
+            }
+        }
+        // Far taps stay finite (they are masked out).
+        for x in [-50.0, -87.0, -200.0, -1e30] {
+            assert!(gaussian(f32x8::splat(x)).to_array()[0].is_finite());
+        }
     }
 
     #[test]
