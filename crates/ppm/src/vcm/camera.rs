@@ -294,17 +294,27 @@ impl CameraPass<'_> {
         let mut count = 0;
         // The grid holds every vertex within the global radius; a smaller r(x) checks its own.
         let r2 = (v.radius < self.radius.global).then_some((v.radius * v.radius) as f32);
+        // A surface that transmits through a lobe of finite density (a rough dielectric) sees
+        // light from both sides: a light vertex that arrived on its other side is merged too if
+        // it lies on the same surface (within a quarter of the radius of the tangent plane, as the
+        // photon mappers' gather does), or the weight the MIS gives this merge would be lost.
+        let transmits = v.bsdf.kind().transmits();
+        let plane = 0.25 * v.radius as f32;
         grid.for_each_containing(hit.position, |i| {
             let y = self.vertices.get(i);
             if r2.is_some_and(|r2| y.position.distance_squared(hit.position) >= r2) {
                 return;
             }
+            let same_side = y.incoming.dot(normal) > 0.0 && y.normal.dot(normal) > MERGE_NORMAL_COS;
+            let crossed = || {
+                transmits
+                    && y.incoming.dot(normal) < 0.0
+                    && y.normal.dot(-normal) > MERGE_NORMAL_COS
+                    && (y.position - hit.position).dot(normal).abs() <= plane
+            };
             // The merged path scatters at the light vertices 1..index − 1, at the merged vertex
             // and at the camera vertices 1..v.index − 1.
-            if y.index + v.index > self.max_depth + 1
-                || y.incoming.dot(normal) <= 0.0
-                || y.normal.dot(normal) <= MERGE_NORMAL_COS
-            {
+            if y.index + v.index > self.max_depth + 1 || !(same_side || crossed()) {
                 return;
             }
             let f = v.bsdf.eval(v.outgoing, y.incoming);
