@@ -54,7 +54,7 @@ def test_method_defaults_to_the_scenes_then_freq_sppm(scene):
     [
         (dict(alpha=1.5), r"^alpha 1.5 is outside \(0, 1\]$"),
         (dict(colour="red"), r"^colour is not a render parameter$"),
-        (dict(method="bdpt"), r"^method bdpt is not one of "),
+        (dict(method="mlt"), r"^method mlt is not one of "),
         (dict(photons_per_pass=0), r"^photons_per_pass 0 must be positive$"),
         (dict(photons_per_pass="lots"), r"^photons_per_pass lots is not a whole number"),
         (dict(seed=None), r"^seed None is not a value"),
