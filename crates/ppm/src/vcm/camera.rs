@@ -171,20 +171,14 @@ impl CameraPass<'_> {
             if beta == Rgb::ZERO || !beta.is_finite() {
                 break;
             }
-            let reverse = if sample.is_specular {
-                bsdf.specular_probability(sample.incoming, sample.is_transmission)
-            } else {
-                bsdf.pdf(sample.incoming, outgoing)
-            };
-            let cos_out = sample.incoming.dot(hit.geometric_normal).abs();
-            partial = self.mis.scatter(
+            partial = self.mis.scatter_sample(
                 partial,
                 true,
                 index,
-                sample.pdf,
-                reverse,
-                sample.is_specular,
-                cos_out,
+                &bsdf,
+                outgoing,
+                &sample,
+                hit.geometric_normal,
                 eta,
             );
             ray = hit.spawn_ray(sample.incoming);

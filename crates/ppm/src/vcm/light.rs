@@ -198,20 +198,14 @@ impl LightPass<'_> {
                     break;
                 }
             };
-            let reverse = if sample.is_specular {
-                bsdf.specular_probability(sample.incoming, sample.is_transmission)
-            } else {
-                bsdf.pdf(sample.incoming, incoming)
-            };
-            let cos_out = sample.incoming.dot(hit.geometric_normal).abs();
-            partial = self.mis.scatter(
+            partial = self.mis.scatter_sample(
                 partial,
                 false,
                 vertex,
-                sample.pdf,
-                reverse,
-                sample.is_specular,
-                cos_out,
+                &bsdf,
+                incoming,
+                &sample,
+                hit.geometric_normal,
                 eta,
             );
             previous = hit.position;

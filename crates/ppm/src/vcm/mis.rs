@@ -20,7 +20,8 @@
 //! weights that sum to one keep the estimate unbiased whatever densities they are computed from,
 //! as long as every strategy computes the same ones.
 
-use scene::EmissionPdf;
+use glam::Vec3;
+use scene::{Bsdf, BsdfSample, EmissionPdf};
 
 /// Which strategies a render combines.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -230,6 +231,42 @@ impl Mis {
             vc: g * (p.vc * reverse + vcm + eta),
             vcm: 1.0 / forward,
         }
+    }
+
+    /// [`Mis::scatter`] for `sample`, drawn by `bsdf` from `outgoing` at a vertex of geometric
+    /// normal `normal`: the reverse density is the BSDF's from the sampled direction back to
+    /// `outgoing` (the lobe's probability for a specular sample).
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "the sample and where it was drawn"
+    )]
+    pub(crate) fn scatter_sample(
+        &self,
+        p: Partial,
+        camera: bool,
+        index: u32,
+        bsdf: &Bsdf,
+        outgoing: Vec3,
+        sample: &BsdfSample,
+        normal: Vec3,
+        eta: f32,
+    ) -> Partial {
+        let reverse = if sample.is_specular {
+            bsdf.specular_probability(sample.incoming, sample.is_transmission)
+        } else {
+            bsdf.pdf(sample.incoming, outgoing)
+        };
+        let cos_out = sample.incoming.dot(normal).abs();
+        self.scatter(
+            p,
+            camera,
+            index,
+            sample.pdf,
+            reverse,
+            sample.is_specular,
+            cos_out,
+            eta,
+        )
     }
 
     /// Weight of emission that a camera subpath at `camera` (after [`Mis::arrive`] on the
