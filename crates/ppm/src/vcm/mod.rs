@@ -11,10 +11,11 @@
 //! sampled its path, computed recursively (`mis.rs`).
 //!
 //! The merge radius of pass i (0-based) is r₀·gᵢ with Knaus and Zwicker's schedule (that of
-//! `appm`, with α = `alpha`), so that merging is consistent: r₀ is `initial_radius` or the
-//! photon mappers' automatic radius. Nothing but the per-pixel sums carries from pass to pass:
-//! a pass depends only on its index, so the sums are exact (`PassSums`, fixed point) and work
-//! units that render disjoint ranges of passes merge into the image of one render, bit for bit.
+//! `appm`, with α = `alpha`), so that merging is consistent: r₀ is `initial_radius` or
+//! [`AUTO_RADIUS_SCALE`] times the photon mappers' automatic radius. Nothing but the per-pixel
+//! sums carries from pass to pass: a pass depends only on its index, so the sums are exact
+//! (`PassSums`, fixed point) and work units that render disjoint ranges of passes merge into the
+//! image of one render, bit for bit.
 
 mod camera;
 mod light;
@@ -42,6 +43,12 @@ use crate::integrator::Integrator;
 use crate::params::{Method, ParamError, RenderParams};
 use crate::photon_mapper::auto_initial_radius;
 use crate::stats::{MemoryEstimate, MemoryUse, PassStats};
+
+/// vcm's default r₀ as a share of the photon mappers' automatic radius (about two pixels'
+/// footprint): about half a pixel's. Merges cost a grid query and a BSDF evaluation for every
+/// light vertex in the disc, and connections already carry most diffuse transport, so a smaller
+/// disc than a photon mapper's gather wins at equal time (docs/integrators.md, "The radius").
+pub(crate) const AUTO_RADIUS_SCALE: f64 = 0.25;
 
 /// Pixels per parallel work item of the camera subpaths.
 const PIXEL_CHUNK: usize = 64;
@@ -146,7 +153,7 @@ impl Vcm {
         let radius = params
             .kernel
             .initial_radius
-            .unwrap_or_else(|| auto_initial_radius(&scene));
+            .unwrap_or_else(|| AUTO_RADIUS_SCALE * auto_initial_radius(&scene));
         Self {
             params,
             strategies,
