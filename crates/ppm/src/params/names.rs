@@ -146,7 +146,7 @@ pub const PARAMS: &[Param] = &[
     Param {
         name: "initial_radius",
         flag: "initial-radius",
-        help: "Initial gather radius in scene units, or auto [default: scene, else auto: picked from the scene size]",
+        help: "Initial gather radius (vcm: merge radius) in scene units, or auto [default: scene, else auto: picked from the scene size, about two pixels' footprint; a quarter of that for vcm]",
         kind: ParamKind::Value {
             value_name: "RADIUS",
             choices: &[],
