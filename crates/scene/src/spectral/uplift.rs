@@ -6,13 +6,13 @@
 //! `src/pbrt/cmd/rgb2spec_opt.cpp`).
 //!
 //! The fit is per colour, and [`UpliftCache`] keeps each colour's coefficients. `rgb2spec_opt`
-//! instead fits a 3 × 64³ table offline and interpolates it; fitting such a table at first use
-//! would cost seconds (786 432 fits), and a coarse one would interpolate coefficients, not
-//! colours, with errors above the 1 % the round trip must meet for saturated colours. A fit
+//! instead fits a 3 × 64³ table offline and interpolates it; fitting that table at first use
+//! would take about a minute on one core (786 432 warm-started fits), and a table coarse enough
+//! to build in a second (16³) would add an interpolation error that has not been measured. A fit
 //! walks from the grey of the colour's mean, whose coefficients are exact, to the colour in
-//! [`STEPS`] steps, each a few Gauss–Newton iterations warm-started from the previous one: it
-//! costs about a millisecond (`docs/spectral.md` has the figures), nothing for a scene's few
-//! constant colours. Textures will need the table; that is for the transport change.
+//! `STEPS` steps, each a few Gauss–Newton iterations warm-started from the previous one: about
+//! a millisecond per colour, nothing for a scene's few constant colours (`docs/spectral.md` has the measurements). Textures will need a table; that
+//! belongs to the transport change.
 
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
