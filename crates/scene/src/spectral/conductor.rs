@@ -15,7 +15,8 @@ use super::spectra::PiecewiseLinear;
 /// of refraction `eta` + i `k` (relative to the side the light comes from), at `cos_theta` of
 /// the incident direction to the normal: the mean of |r∥|² and |r⊥|², with the complex
 /// refracted cosine (pbrt-v4's `FrComplex`). With `k` = 0 it is the dielectric's, total internal
-/// reflection included.
+/// reflection included. `eta` must be positive (as [`Conductor::new`] and the named metals
+/// guarantee) and `k` non-negative.
 pub fn fresnel_conductor(cos_theta: f64, eta: f64, k: f64) -> f64 {
     let cos_i = cos_theta.clamp(0.0, 1.0);
     if cos_i == 0.0 {

@@ -481,4 +481,42 @@ mod tests {
             E::NonFinite { index: 0, .. }
         ));
     }
+
+    /// Every kind of spectrum evaluates through the enum as it does alone, lane by lane, and the
+    /// exact XYZ of a spectrum of 1 everywhere has Y = 1.
+    #[test]
+    fn the_enum_samples_each_kind() {
+        let kinds = [
+            Spectrum::Constant(0.25),
+            Spectrum::PiecewiseLinear(NamedIlluminant::A.spectrum().clone()),
+            Spectrum::Blackbody(Blackbody::new(4000.0).unwrap()),
+            Spectrum::RgbAlbedo(RgbAlbedo::new([0.7, 0.2, 0.1]).unwrap()),
+            Spectrum::RgbUnbounded(RgbUnbounded::new([2.0, 4.0, 1.0]).unwrap()),
+            Spectrum::RgbIlluminant(RgbIlluminant::new([1.0, 0.5, 0.25]).unwrap()),
+        ];
+        let w = SampledWavelengths::sample_visible(0.42);
+        for s in &kinds {
+            let sampled = s.sample(&w);
+            for i in 0..4 {
+                let l = f64::from(w.lambda(i));
+                assert!((f64::from(sampled[i]) - s.eval(l)).abs() <= 1e-6 * s.eval(l).max(1.0));
+            }
+        }
+        assert!((kinds[0].eval(612.0) - 0.25).abs() < 1e-15);
+        assert!(
+            (NamedIlluminant::A.spectrum().eval(560.0) / NamedIlluminant::A.spectrum().eval(300.0)
+                - 100.0 / 0.930_483)
+                .abs()
+                < 1e-6
+        );
+        let y = Spectrum::Constant(1.0).to_xyz().y;
+        assert!((y - 1.0).abs() < 1e-6, "{y}");
+        // pbrt's names resolve; others do not.
+        assert_eq!(
+            NamedIlluminant::from_name("stdillum-D65"),
+            Some(NamedIlluminant::D65)
+        );
+        assert_eq!(NamedIlluminant::from_name("A"), Some(NamedIlluminant::A));
+        assert_eq!(NamedIlluminant::from_name("F11"), None);
+    }
 }
