@@ -133,11 +133,12 @@ fn spectrum_depends_on_nothing_but_std() {
     assert_eq!(deps["spectrum"], Vec::<String>::new());
 }
 
-/// The third-party libraries only one workspace crate may name: the BVH builder belongs to the
-/// scene runtime, the file-format parsers and image decoders to the importers, the Python
-/// bindings to the Python module, the HTTP server of the live preview to the command.
+/// The third-party libraries only one workspace crate may name: the BVH builder and the complex
+/// arithmetic of conductors' Fresnel belong to the scene runtime, the file-format parsers and
+/// image decoders to the importers, the Python bindings to the Python module, the HTTP server of
+/// the live preview to the command.
 const OWNED_LIBRARIES: &[(&str, &[&str])] = &[
-    ("scene", &["obvhs"]),
+    ("scene", &["obvhs", "num-complex"]),
     ("cli", &["tiny_http"]),
     (
         "import",

@@ -41,6 +41,7 @@ mod material;
 mod ray;
 mod sampling;
 mod scene;
+pub mod spectral;
 mod summary;
 #[cfg(test)]
 mod test_util;
