@@ -356,6 +356,7 @@ impl Builder {
             cylinders: self.cylinders,
             lights: self.lights,
             environment: self.environment,
+            media: scene::Media::default(),
             render,
             notes: LoadNotes {
                 degenerate_triangles: self.degenerate_triangles,
