@@ -646,7 +646,10 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
                 rgb((diffuse / 0.96).min(Vec3::ONE).to_array())
             ),
             scene::MaterialKind::Interface(_) => {
-                bail!("material {}: media and their interfaces are not exported", m.name)
+                bail!(
+                    "material {}: media and their interfaces are not exported",
+                    m.name
+                )
             }
         };
         // A cut-out: Mitsuba's `mask` keeps the surface with probability = opacity (a stochastic

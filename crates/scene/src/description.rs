@@ -321,11 +321,14 @@ impl SceneDescription {
 }
 
 impl SceneDescription {
-    /// Whether the scene has participating media or a material that only bounds them
-    /// ([`MaterialKind::Interface`]): only an integrator that handles media renders it right.
+    /// Whether the scene has participating media that some path can be in ([`Media::are_used`])
+    /// or a material that only bounds them ([`MaterialKind::Interface`]): only an integrator
+    /// that handles media renders it right. Media that nothing refers to do not count.
+    ///
+    /// [`Media::are_used`]: crate::Media::are_used
     #[must_use]
     pub fn has_media(&self) -> bool {
-        !self.media.is_empty()
+        self.media.are_used()
             || self
                 .materials
                 .iter()

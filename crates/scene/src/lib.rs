@@ -60,8 +60,9 @@ pub use light::{
     LightSample, LightSampler,
 };
 pub use material::{
-    Bsdf, BsdfPdfs, BsdfSample, Dielectric, Diffuse, Glossy, Interface, Lobe, MaterialKind, MaterialParam,
-    Mirror, RoughDielectric, SMOOTH_ROUGHNESS, TransportMode, fresnel_dielectric, luminance,
+    Bsdf, BsdfPdfs, BsdfSample, Dielectric, Diffuse, Glossy, Interface, Lobe, MaterialKind,
+    MaterialParam, Mirror, RoughDielectric, SMOOTH_ROUGHNESS, TransportMode, fresnel_dielectric,
+    luminance,
 };
 pub use medium::{
     HenyeyGreenstein, Media, Medium, MediumShape, PhaseSample, ShapeMedia, medium_after,

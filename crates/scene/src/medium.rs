@@ -57,7 +57,11 @@ impl Medium {
 /// exp(−σ·d), with 0·∞ taken as no attenuation.
 #[inline]
 fn tr(sigma: f32, d: f32) -> f32 {
-    if sigma == 0.0 { 1.0 } else { (-sigma * d).exp() }
+    if sigma == 0.0 {
+        1.0
+    } else {
+        (-sigma * d).exp()
+    }
 }
 
 impl Fingerprint for Medium {
@@ -116,10 +120,17 @@ pub struct Media {
 }
 
 impl Media {
-    /// Whether anything here is set: the scene then needs an integrator that handles media.
+    /// Whether nothing is set (no medium, no shape media, no camera medium).
     #[must_use]
     pub fn is_empty(&self) -> bool {
         self.list.is_empty() && self.shapes.is_empty() && self.camera.is_none()
+    }
+
+    /// Whether some path can be in a medium: the camera sits in one, or a shape changes the
+    /// medium. Media that nothing refers to change nothing.
+    #[must_use]
+    pub fn are_used(&self) -> bool {
+        self.camera.is_some() || self.shapes.iter().any(ShapeMedia::is_transition)
     }
 }
 

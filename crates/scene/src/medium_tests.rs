@@ -35,7 +35,10 @@ fn phase_integrates_to_one_with_mean_cosine_g() {
             f64::from(hg.eval(wo, wi)) * f64::from(-wo.dot(wi))
         });
         assert!((total - 1.0).abs() < 2e-3, "g {g}: ∫p = {total}");
-        assert!((mean - f64::from(g)).abs() < 2e-3, "g {g}: ∫p cosθ = {mean}");
+        assert!(
+            (mean - f64::from(g)).abs() < 2e-3,
+            "g {g}: ∫p cosθ = {mean}"
+        );
         // The density is the value.
         let wi = Vec3::new(0.1, 0.7, -0.2).normalize();
         assert_eq!(hg.pdf(wo, wi), hg.eval(wo, wi));

@@ -438,7 +438,9 @@ fn closed(what: &str, triangles: &[crate::Triangle]) -> Result<(), Invalid> {
     for t in triangles {
         for k in 0..3 {
             let (a, b) = (key(t.positions[k]), key(t.positions[(k + 1) % 3]));
-            *edges.entry(if a < b { (a, b) } else { (b, a) }).or_default() += 1;
+            *edges
+                .entry(if a < b { (a, b) } else { (b, a) })
+                .or_default() += 1;
         }
     }
     match edges.iter().filter(|(_, n)| *n % 2 == 1).min() {

@@ -56,6 +56,10 @@ fn valid_media_pass_and_count_in_the_fingerprint() {
     let mut plain = d.clone();
     plain.media = Media::default();
     assert!(!plain.has_media());
+    // A medium nothing refers to changes nothing.
+    let mut unused = d.clone();
+    unused.media.shapes.clear();
+    assert!(!unused.has_media());
     assert_ne!(d.fingerprint(), plain.fingerprint());
     let mut thicker = d.clone();
     thicker.media.list[0].sigma_s.x = 0.6;
@@ -66,7 +70,10 @@ fn valid_media_pass_and_count_in_the_fingerprint() {
 fn bad_media_are_named_in_one_line() {
     let mut d = with_fog();
     d.media.list[0].sigma_a = Vec3::new(-1.0, 0.0, 0.0);
-    check(&d, "medium \"fog\" sigma_a must not be negative, got [-1, 0, 0]");
+    check(
+        &d,
+        "medium \"fog\" sigma_a must not be negative, got [-1, 0, 0]",
+    );
     let mut d = with_fog();
     d.media.list[0].sigma_s = Vec3::new(f32::NAN, 0.0, 0.0);
     check(&d, "medium \"fog\" sigma_s must be finite, got [NaN, 0, 0]");
@@ -99,8 +106,9 @@ fn bad_media_are_named_in_one_line() {
     d.media.shapes[0].shape = MediumShape::Triangles { start: 0, end: 10 };
     let got = super::description(&d).err().map(|e| e.to_string());
     assert!(
-        got.as_deref().is_some_and(|e| e
-            .starts_with("the mesh of triangles 0..10 bounds a medium but is not closed: its edge")),
+        got.as_deref().is_some_and(|e| e.starts_with(
+            "the mesh of triangles 0..10 bounds a medium but is not closed: its edge"
+        )),
         "{got:?}"
     );
     // The same open mesh with the same medium on both sides changes nothing: allowed.
@@ -108,5 +116,8 @@ fn bad_media_are_named_in_one_line() {
     assert_eq!(super::description(&d), Ok(()));
     let mut d = with_fog();
     d.materials[1].kind = crate::MaterialKind::Interface(crate::Interface);
-    check(&d, "material \"m\" is an interface and cannot emit or have textures");
+    check(
+        &d,
+        "material \"m\" is an interface and cannot emit or have textures",
+    );
 }

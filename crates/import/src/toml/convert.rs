@@ -74,8 +74,7 @@ impl Converter<'_> {
     ) -> Result<SceneDescription, LoadError> {
         let media = self.media(std::mem::take(&mut file.media))?;
         let camera_medium = file.camera.as_mut().and_then(|c| c.medium.take());
-        let camera_medium =
-            self.medium_ref(&media, "[camera] medium", camera_medium.as_deref())?;
+        let camera_medium = self.medium_ref(&media, "[camera] medium", camera_medium.as_deref())?;
         let mut shape_media = Vec::new();
         let camera = file.camera.map(|c| self.camera(c)).transpose()?;
         let film = match file.film {
@@ -117,10 +116,16 @@ impl Converter<'_> {
                     interior,
                     exterior,
                 } => {
-                    let interior =
-                        self.medium_ref(&media, &format!("{context} interior"), interior.as_deref())?;
-                    let exterior =
-                        self.medium_ref(&media, &format!("{context} exterior"), exterior.as_deref())?;
+                    let interior = self.medium_ref(
+                        &media,
+                        &format!("{context} interior"),
+                        interior.as_deref(),
+                    )?;
+                    let exterior = self.medium_ref(
+                        &media,
+                        &format!("{context} exterior"),
+                        exterior.as_deref(),
+                    )?;
                     if interior.is_some() || exterior.is_some() {
                         shape_media.push(ShapeMedia {
                             shape: MediumShape::Sphere(acc.spheres.len() as u32),
@@ -229,10 +234,16 @@ impl Converter<'_> {
                     interior,
                     exterior,
                 } => {
-                    let interior =
-                        self.medium_ref(&media, &format!("{context} interior"), interior.as_deref())?;
-                    let exterior =
-                        self.medium_ref(&media, &format!("{context} exterior"), exterior.as_deref())?;
+                    let interior = self.medium_ref(
+                        &media,
+                        &format!("{context} interior"),
+                        interior.as_deref(),
+                    )?;
+                    let exterior = self.medium_ref(
+                        &media,
+                        &format!("{context} exterior"),
+                        exterior.as_deref(),
+                    )?;
                     let start = acc.triangles.len() as u32;
                     let override_material =
                         material.map(|name| lookup(&context, &name)).transpose()?;
