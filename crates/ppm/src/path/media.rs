@@ -65,7 +65,7 @@ pub(super) fn trace(scene: &Scene, params: &RenderParams, ray: Ray, sampler: &mu
         if let Some(m) = medium.and_then(|m| media.get(m as usize)) {
             let sigma_t = m.sigma_t();
             let total = beta.x + beta.y + beta.z;
-            if !(total > 0.0) {
+            if total.is_nan() || total <= 0.0 {
                 break;
             }
             let q = beta / total;
@@ -86,7 +86,7 @@ pub(super) fn trace(scene: &Scene, params: &RenderParams, ray: Ray, sampler: &mu
                 // A medium vertex.
                 let tr = m.transmittance(t);
                 let pdf = (q * sigma_t * tr).element_sum();
-                if !(pdf > 0.0) {
+                if pdf.is_nan() || pdf <= 0.0 {
                     break;
                 }
                 beta *= m.sigma_s * tr / pdf;
@@ -133,7 +133,7 @@ pub(super) fn trace(scene: &Scene, params: &RenderParams, ray: Ray, sampler: &mu
             // probability of getting there.
             let tr = m.transmittance(t_surface);
             let survive = (q * tr).element_sum();
-            if !(survive > 0.0) {
+            if survive.is_nan() || survive <= 0.0 {
                 break;
             }
             beta *= tr / survive;
