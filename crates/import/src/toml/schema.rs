@@ -64,8 +64,6 @@ pub(super) enum MaterialToml {
         emission: Option<ColorToml>,
         cutout: Option<String>,
     },
-    /// Extension: no scattering, a boundary of media.
-    Interface {},
     Dielectric {
         ior: f32,
         /// Extension: GGX α of a rough dielectric (`docs/scene-format-extensions.md`).
@@ -78,6 +76,8 @@ pub(super) enum MaterialToml {
         emission: Option<ColorToml>,
         cutout: Option<String>,
     },
+    /// Extension: no scattering, a boundary of media.
+    Interface {},
 }
 
 /// A colour: `[r, g, b]`, or (extension, `docs/scene-format-extensions.md`) an image texture

@@ -116,7 +116,8 @@ interior = "water"
 
 #[test]
 fn a_file_without_media_has_none() {
-    let d = load(&crate::shared_scenes().join("cornell_box/cornell_box.toml")).unwrap();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/glass-caustic.toml");
+    let d = load(&path).unwrap();
     assert_eq!(d.media, Media::default());
     assert!(!d.has_media());
 }
