@@ -260,3 +260,31 @@ fn unused_media_render_bit_identically() {
         );
     }
 }
+
+/// A medium that neither absorbs nor scatters, around the camera, sends every path through the
+/// media code with nothing to do: the analytic scenes of `analytic.rs` then read what they read
+/// without it, the closed diffuse sphere around a point light (L = 1) and the emissive box
+/// bounded to k bounces (1 − 0.5^(k+1)), so surfaces, light sampling, MIS and the bounce count
+/// agree with the plain path tracer.
+#[test]
+fn a_clear_medium_changes_nothing() {
+    let clear = "[media.clear]\nsigma_a = [0.0, 0.0, 0.0]\nsigma_s = [0.0, 0.0, 0.0]\n";
+    let furnace =
+        crate::analytic::FURNACE.replace("fov_y = 70.0\n", "fov_y = 70.0\nmedium = \"clear\"\n");
+    assert!(scene(&format!("{furnace}{clear}")).has_media());
+    let m = channel_means(&path_render(&format!("{furnace}{clear}"), 16, 4, 64));
+    assert_close(m, [1.0; 3], 0.02, "furnace sphere in a clear medium");
+    let camera = "[camera]\nposition = [0.0, 0.0, 0.5]\nlook_at = [1.0, 0.0, 0.5]\nfov_y = 40.0\n\
+                  medium = \"clear\"";
+    let walls = format!("{}{clear}", crate::analytic::emissive_box(camera));
+    for k in 1..=3u32 {
+        let expected = 1.0 - 0.5f64.powi(k as i32 + 1);
+        let m = channel_means(&path_render(&walls, 16, 4, k));
+        assert_close(
+            m,
+            [expected; 3],
+            0.02,
+            &format!("emissive box, max_depth {k}"),
+        );
+    }
+}
