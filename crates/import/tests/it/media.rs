@@ -194,3 +194,111 @@ fn an_open_mesh_cannot_bound_a_medium() {
     );
     assert!(load(&path).is_ok());
 }
+
+const MITSUBA_HEAD: &str = r#"<scene version="3.0.0">
+    <medium type="homogeneous" id="smoke">
+        <rgb name="sigma_t" value="2, 1, 0.5"/>
+        <float name="albedo" value="0.25"/>
+        <float name="scale" value="2"/>
+        <phase type="hg"><float name="g" value="0.7"/></phase>
+    </medium>
+    <sensor type="perspective">
+        <float name="fov" value="40"/>
+        <ref name="medium" id="smoke"/>
+    </sensor>
+    <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+"#;
+
+/// Mitsuba 3's `homogeneous` medium: σa = (1 − albedo)·σt·scale and σs = albedo·σt·scale, an
+/// `hg` phase, `<ref>` and nested media on shapes and the sensor, a null BSDF as the interface.
+#[test]
+fn mitsuba_homogeneous_media_are_read() {
+    let xml = format!(
+        r#"{MITSUBA_HEAD}
+    <shape type="cube">
+        <bsdf type="null"/>
+        <ref name="interior" id="smoke"/>
+    </shape>
+    <shape type="sphere">
+        <float name="radius" value="0.5"/>
+        <bsdf type="dielectric"/>
+        <medium type="homogeneous" name="interior">
+            <float name="sigma_t" value="1"/>
+            <rgb name="albedo" value="0.5, 0.5, 0.5"/>
+        </medium>
+        <ref name="exterior" id="smoke"/>
+    </shape>
+</scene>"#
+    );
+    let path = fixture("mitsuba-media", &[("scene.xml", &xml)]);
+    let d = load(&path).unwrap();
+    let smoke = &d.media.list[0];
+    assert_eq!(smoke.name, "smoke");
+    assert!(
+        (smoke.sigma_a - Vec3::new(3.0, 1.5, 0.75))
+            .abs()
+            .max_element()
+            < 1e-6
+    );
+    assert!(
+        (smoke.sigma_s - Vec3::new(1.0, 0.5, 0.25))
+            .abs()
+            .max_element()
+            < 1e-6
+    );
+    assert_eq!(smoke.g, 0.7);
+    let inner = &d.media.list[1];
+    assert_eq!(
+        (inner.sigma_a, inner.sigma_s, inner.g),
+        (Vec3::splat(0.5), Vec3::splat(0.5), 0.0)
+    );
+    assert_eq!(d.media.camera, Some(0));
+    assert_eq!(
+        d.media.shapes,
+        vec![
+            ShapeMedia {
+                shape: MediumShape::Triangles { start: 0, end: 12 },
+                interior: Some(0),
+                exterior: None,
+            },
+            ShapeMedia {
+                shape: MediumShape::Sphere(0),
+                interior: Some(1),
+                exterior: Some(0),
+            },
+        ]
+    );
+    assert_eq!(
+        d.materials[d.triangles[0].material as usize].kind,
+        MaterialKind::Interface(scene::Interface)
+    );
+    assert!(scene::Scene::new(d).is_ok());
+}
+
+#[test]
+fn mitsuba_media_that_fppm_cannot_render_are_refused() {
+    for (body, needle) in [
+        (
+            r#"<shape type="rectangle"><bsdf type="null"/><ref name="interior" id="smoke"/></shape>"#,
+            "not closed",
+        ),
+        (
+            r#"<shape type="cylinder"><ref name="interior" id="smoke"/></shape>"#,
+            "cannot bound a medium",
+        ),
+        (
+            r#"<shape type="cube"><medium type="heterogeneous" name="interior"/></shape>"#,
+            "medium type \"heterogeneous\" is not supported",
+        ),
+        (
+            r#"<shape type="cube"><medium type="homogeneous" name="interior"><phase type="rayleigh"/></medium></shape>"#,
+            "phase function \"rayleigh\" is not supported",
+        ),
+    ] {
+        let xml = format!("{MITSUBA_HEAD}{body}\n</scene>");
+        let path = fixture("mitsuba-media-refused", &[("scene.xml", &xml)]);
+        let err = load(&path).unwrap_err();
+        assert_names_file(&err, &path);
+        assert!(err.to_string().contains(needle), "{err}");
+    }
+}
