@@ -149,6 +149,7 @@ fn description(input: &Input) -> SceneDescription {
         cylinders: Vec::new(),
         lights: Vec::new(),
         environment: None,
+        media: scene::Media::default(),
         render: RenderDefaults::default(),
         notes: LoadNotes::default(),
     };

@@ -118,6 +118,7 @@ fn write_mitsuba(scene: &SceneDescription, dir: &Path) -> PathBuf {
                 c3(reflectance / F0),
                 c3(diffuse / (1.0 - F0))
             ),
+            MaterialKind::Interface(_) => format!("<bsdf type=\"null\" id=\"m{i}\"/>"),
         };
         writeln!(x, "  {body}").unwrap();
     }

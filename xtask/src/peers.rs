@@ -645,6 +645,12 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
                 rgb((reflectance / 0.04).min(Vec3::ONE).to_array()),
                 rgb((diffuse / 0.96).min(Vec3::ONE).to_array())
             ),
+            scene::MaterialKind::Interface(_) => {
+                bail!(
+                    "material {}: media and their interfaces are not exported",
+                    m.name
+                )
+            }
         };
         // A cut-out: Mitsuba's `mask` keeps the surface with probability = opacity (a stochastic
         // cut-out); fppm's `MASK` thresholds it, which agrees where the mask is 0 or 1.

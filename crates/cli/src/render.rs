@@ -28,9 +28,20 @@ pub(crate) fn render(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Result<
     let scene = std::sync::Arc::new(scene::Scene::new(job.description.clone())?);
     in_pool(job.run.threads, || {
         let renderer = Renderer::new(std::sync::Arc::clone(&scene), job.params)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", job.description.source.display()))?;
+            .map_err(|e| renderer_error(&job.description.source, e))?;
         drive(&job, renderer, live)
     })
+}
+
+/// The error of starting a render of the scene from `path`: a scene the method cannot render
+/// (media) is a usage error (exit 2), every other problem a render error.
+pub(crate) fn renderer_error(path: &Path, e: ppm::ParamError) -> anyhow::Error {
+    let message = format!("{}: {e}", path.display());
+    if matches!(e, ppm::ParamError::MediaUnsupported { .. }) {
+        anyhow::Error::new(crate::UsageError(message))
+    } else {
+        anyhow::anyhow!(message)
+    }
 }
 
 /// `fppm resume CHECKPOINT`.

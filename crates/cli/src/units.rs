@@ -100,10 +100,10 @@ pub(crate) fn plan(args: PlanArgs) -> anyhow::Result<Outcome> {
     let clock = Instant::now();
     let bytes = in_pool(job.run.threads, || {
         let kernels = Renderer::pass_independent_kernels(std::sync::Arc::clone(&scene), job.params)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", job.description.source.display()))?;
+            .map_err(|e| crate::render::renderer_error(&job.description.source, e))?;
         let renderer =
             Renderer::with_kernels(std::sync::Arc::clone(&scene), job.params, kernels, 0)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", job.description.source.display()))?;
+                .map_err(|e| crate::render::renderer_error(&job.description.source, e))?;
         let note = PlanNote {
             render: settings::note_for(&job, 0.0),
             passes,

@@ -190,6 +190,8 @@ pub(crate) struct Builder {
     pub(crate) skipped_emitters: Vec<String>,
     /// The environment light (the first the file defines).
     pub(crate) environment: Option<scene::Environment>,
+    /// Participating media and the shapes that bound them.
+    pub(crate) media: scene::Media,
 }
 
 impl Builder {
@@ -356,6 +358,7 @@ impl Builder {
             cylinders: self.cylinders,
             lights: self.lights,
             environment: self.environment,
+            media: self.media,
             render,
             notes: LoadNotes {
                 degenerate_triangles: self.degenerate_triangles,

@@ -272,6 +272,7 @@ impl MeshData {
             cylinders: Vec::new(),
             lights: self.lights,
             environment: None,
+            media: scene::Media::default(),
             render: RenderDefaults::default(),
             notes: LoadNotes {
                 degenerate_triangles: self.degenerate_triangles,
@@ -361,6 +362,8 @@ pub(crate) struct SceneParts {
     pub(crate) cylinders: Vec<Cylinder>,
     pub(crate) lights: Vec<Light>,
     pub(crate) environment: Option<Environment>,
+    /// Participating media (none unless the file has some).
+    pub(crate) media: scene::Media,
     pub(crate) render: RenderDefaults,
     pub(crate) notes: LoadNotes,
     /// Material indices that lost at least one triangle as degenerate.
@@ -382,6 +385,7 @@ pub(crate) fn finish(
         cylinders,
         lights,
         mut environment,
+        media,
         render,
         mut notes,
         degenerate_materials,
@@ -469,10 +473,12 @@ pub(crate) fn finish(
         cylinders,
         lights,
         environment,
+        media,
         render,
         notes,
     };
     validate::primitives(&description).map_err(|e| invalid_in_file(e, path))?;
+    validate::media(&description).map_err(|e| invalid_in_file(e, path))?;
     Ok(description)
 }
 

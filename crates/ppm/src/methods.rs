@@ -23,6 +23,9 @@ struct Entry {
     build: Build,
     /// What the render holds for a film of this many pixels, the film itself aside.
     estimate: fn(u64, &RenderParams) -> MemoryEstimate,
+    /// Whether it renders participating media (`docs/media.md`); a scene with media is refused
+    /// by every other method rather than rendered wrongly.
+    media: bool,
 }
 
 fn entry(method: Method) -> Entry {
@@ -32,22 +35,27 @@ fn entry(method: Method) -> Entry {
             estimate: |pixels, params| {
                 photon_mapper::estimate(pixels, params, params.method.uses_frequency())
             },
+            media: false,
         },
         Method::Appm => Entry {
             build: |scene, params| Ok(Box::new(PassIndependent::new(scene, params)?)),
             estimate: independent::estimate,
+            media: false,
         },
         Method::Path => Entry {
             build: |scene, params| Ok(Box::new(PathTracer::new(scene, params))),
             estimate: path::estimate,
+            media: true,
         },
         Method::Light => Entry {
             build: |scene, params| Ok(Box::new(LightTracer::new(scene, params))),
             estimate: light_tracer::estimate,
+            media: false,
         },
         Method::Vcm | Method::Bdpt => Entry {
             build: |scene, params| Ok(Box::new(Vcm::new(scene, params))),
             estimate: vcm::estimate,
+            media: false,
         },
     }
 }
@@ -56,13 +64,28 @@ fn entry(method: Method) -> Entry {
 ///
 /// # Errors
 ///
-/// [`ParamError`] if a parameter is outside its domain or the film is too large.
+/// [`ParamError`] if a parameter is outside its domain, the film is too large, or the scene
+/// has media that the method does not render.
 pub(crate) fn integrator(
     scene: Arc<Scene>,
     params: RenderParams,
 ) -> Result<Box<dyn Integrator>, ParamError> {
     params.validate()?;
+    check_media(&scene, params.method)?;
     (entry(params.method).build)(scene, params)
+}
+
+/// Refuses a scene with participating media (or interface materials) for a method that does
+/// not render them.
+///
+/// # Errors
+///
+/// [`ParamError::MediaUnsupported`] for such a scene and method.
+pub(crate) fn check_media(scene: &Scene, method: Method) -> Result<(), ParamError> {
+    if scene.has_media() && !entry(method).media {
+        return Err(ParamError::MediaUnsupported { method });
+    }
+    Ok(())
 }
 
 impl MemoryEstimate {

@@ -1,7 +1,8 @@
 //! The reference integrator: unidirectional path tracing with next-event estimation and
 //! multiple importance sampling (power heuristic), sharing the scene, materials and lights of
 //! the photon mappers. It is deliberately simple: it is the independent ground truth the photon
-//! mappers are checked against, not a competitor.
+//! mappers are checked against, not a competitor. In scenes with participating media every
+//! camera path takes `path/media.rs` instead, which adds them; other scenes never reach it.
 
 use std::sync::Arc;
 
@@ -14,6 +15,8 @@ use crate::integrator::Integrator;
 use crate::params::RenderParams;
 use crate::rng::Sampler;
 use crate::stats::{MemoryEstimate, PassStats};
+
+mod media;
 
 /// Pixels per parallel work item; fixed so the work split does not depend on the thread count.
 const PIXEL_CHUNK: usize = 256;
@@ -96,6 +99,9 @@ impl PathTracer {
         let (x, y) = (pixel % self.width, pixel / self.width);
         let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
         let ray = self.scene.camera().generate_ray(film, sampler.next_2d());
+        if self.scene.has_media() {
+            return media::trace(&self.scene, &self.params, ray, &mut sampler);
+        }
         let Some(hit) = self.scene.intersect(&ray) else {
             return self.scene.lights().environment_radiance(ray.direction);
         };

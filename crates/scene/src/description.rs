@@ -40,6 +40,10 @@ pub struct SceneDescription {
     /// The environment light, if any (an extension to scene format 1, see
     /// `docs/scene-format-extensions.md`).
     pub environment: Option<crate::Environment>,
+    /// Participating media, the shapes that bound them and the camera's medium (an extension to
+    /// scene format 1, see `docs/scene-format-extensions.md` and `docs/media.md`); empty for a
+    /// scene without media.
+    pub media: crate::Media,
     /// Optional render defaults from the `[render]` table; flags override them.
     pub render: RenderDefaults,
     /// What the loader skipped or had to guess, for `fppm info` and reports.
@@ -296,7 +300,8 @@ impl SceneDescription {
     /// film, materials with their textures, triangles, spheres, cylinders, lights, environment;
     /// not the file name, the `[render]` defaults or the loader's notes), so that a checkpoint
     /// is never resumed on another scene. Textures count by file, size and use, not by texel;
-    /// an environment map by its texels.
+    /// an environment map by its texels. Media count only when there are some, so a scene
+    /// without media keeps the fingerprint it had before media existed.
     #[must_use]
     pub fn fingerprint(&self) -> u64 {
         let mut h = Fingerprinter::new();
@@ -308,7 +313,26 @@ impl SceneDescription {
         h.list(&self.cylinders);
         h.list(&self.lights);
         h.option(self.environment.as_ref(), |h, env| h.add(env));
+        if !self.media.is_empty() {
+            h.add(&self.media);
+        }
         h.finish()
+    }
+}
+
+impl SceneDescription {
+    /// Whether the scene has participating media that some path can be in ([`Media::are_used`])
+    /// or a material that only bounds them ([`MaterialKind::Interface`]): only an integrator
+    /// that handles media renders it right. Media that nothing refers to do not count.
+    ///
+    /// [`Media::are_used`]: crate::Media::are_used
+    #[must_use]
+    pub fn has_media(&self) -> bool {
+        self.media.are_used()
+            || self
+                .materials
+                .iter()
+                .any(|m| matches!(m.kind, MaterialKind::Interface(_)))
     }
 }
 

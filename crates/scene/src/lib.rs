@@ -38,6 +38,7 @@ pub mod fingerprint;
 mod frame;
 mod light;
 mod material;
+mod medium;
 mod ray;
 mod sampling;
 mod scene;
@@ -60,8 +61,12 @@ pub use light::{
     LightSample, LightSampler,
 };
 pub use material::{
-    Bsdf, BsdfPdfs, BsdfSample, Dielectric, Diffuse, Glossy, Lobe, MaterialKind, MaterialParam,
-    Mirror, RoughDielectric, SMOOTH_ROUGHNESS, TransportMode, fresnel_dielectric, luminance,
+    Bsdf, BsdfPdfs, BsdfSample, Dielectric, Diffuse, Glossy, Interface, Lobe, MaterialKind,
+    MaterialParam, Mirror, RoughDielectric, SMOOTH_ROUGHNESS, TransportMode, fresnel_dielectric,
+    luminance,
+};
+pub use medium::{
+    HenyeyGreenstein, Media, Medium, MediumShape, PhaseSample, ShapeMedia, medium_after,
 };
 pub use ray::{Hit, Primitive, Ray};
 pub use scene::{Scene, SceneError};

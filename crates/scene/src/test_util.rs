@@ -80,6 +80,7 @@ pub(crate) fn description(
         },
         materials: vec![diffuse(0.5, Vec3::ZERO), diffuse(0.0, Vec3::ONE)],
         environment: None,
+        media: crate::Media::default(),
         triangles,
         spheres,
         cylinders: Vec::new(),

@@ -258,7 +258,8 @@ pub fn description(d: &SceneDescription) -> Result<(), Invalid> {
     if let Some(env) = &d.environment {
         environment(env)?;
     }
-    primitives(d)
+    primitives(d)?;
+    media(d)
 }
 
 /// The environment light: a finite non-negative scale and rotation, a finite non-negative
@@ -358,6 +359,106 @@ pub fn primitives(d: &SceneDescription) -> Result<(), Invalid> {
     }
     Ok(())
 }
+
+/// The media and what refers to them: coefficients finite and non-negative, g in (−1, 1),
+/// every medium, triangle and sphere index in range, every mesh that bounds a medium closed
+/// (each edge shared by an even number of its triangles), and interface materials neither
+/// emitting nor textured.
+pub fn media(d: &SceneDescription) -> Result<(), Invalid> {
+    for m in &d.materials {
+        if matches!(m.kind, crate::MaterialKind::Interface(_))
+            && (m.emission != Vec3::ZERO || m.textures.is_some())
+        {
+            return Err(Invalid::value(
+                format!("material {:?}", m.name),
+                "is an interface and cannot emit or have textures",
+            ));
+        }
+    }
+    let media = &d.media;
+    for m in &media.list {
+        let key = |what: &str| format!("medium {:?} {what}", m.name);
+        colour(&key("sigma_a"), m.sigma_a)?;
+        colour(&key("sigma_s"), m.sigma_s)?;
+        if !(m.g > -1.0 && m.g < 1.0) {
+            return Err(Invalid::value(
+                key("g"),
+                format!("must be in (-1, 1), got {}", m.g),
+            ));
+        }
+    }
+    let count = media.list.len();
+    let index = |key: String, m: Option<u32>| match m {
+        Some(i) if i as usize >= count => Err(Invalid::value(
+            key,
+            format!("refers to medium {i} but there are {count} media"),
+        )),
+        _ => Ok(()),
+    };
+    index("camera medium".into(), media.camera)?;
+    for (i, entry) in media.shapes.iter().enumerate() {
+        let what = match entry.shape {
+            crate::MediumShape::Triangles { start, end } => format!("triangles {start}..{end}"),
+            crate::MediumShape::Sphere(s) => format!("sphere {s}"),
+        };
+        index(format!("{what} interior"), entry.interior)?;
+        index(format!("{what} exterior"), entry.exterior)?;
+        match entry.shape {
+            crate::MediumShape::Triangles { start, end } => {
+                if start >= end || end as usize > d.triangles.len() {
+                    return Err(Invalid::value(
+                        format!("media of shape {i}"),
+                        format!("name {what} but there are {} triangles", d.triangles.len()),
+                    ));
+                }
+                if entry.is_transition() {
+                    closed(&what, &d.triangles[start as usize..end as usize])?;
+                }
+            }
+            crate::MediumShape::Sphere(s) => {
+                if s as usize >= d.spheres.len() {
+                    return Err(Invalid::value(
+                        format!("media of shape {i}"),
+                        format!("name {what} but there are {} spheres", d.spheres.len()),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Whether the triangles close a volume: every edge (by the exact bits of its end points) is
+/// shared by an even number of them. Meshes whose copies of a vertex differ in position by
+/// rounding fail it; that is the documented limit (`docs/media.md`).
+fn closed(what: &str, triangles: &[crate::Triangle]) -> Result<(), Invalid> {
+    let key = |p: Vec3| p.to_array().map(|x| (x + 0.0).to_bits());
+    let mut edges: std::collections::HashMap<([u32; 3], [u32; 3]), u32> =
+        std::collections::HashMap::with_capacity(3 * triangles.len());
+    for t in triangles {
+        for k in 0..3 {
+            let (a, b) = (key(t.positions[k]), key(t.positions[(k + 1) % 3]));
+            *edges
+                .entry(if a < b { (a, b) } else { (b, a) })
+                .or_default() += 1;
+        }
+    }
+    match edges.iter().filter(|(_, n)| *n % 2 == 1).min() {
+        None => Ok(()),
+        Some(((a, b), n)) => Err(Invalid::value(
+            format!("the mesh of {what}"),
+            format!(
+                "bounds a medium but is not closed: its edge {} to {} belongs to {n} triangle(s)",
+                fmt_vec(Vec3::from_array(a.map(f32::from_bits))),
+                fmt_vec(Vec3::from_array(b.map(f32::from_bits)))
+            ),
+        )),
+    }
+}
+
+#[cfg(test)]
+#[path = "validate_media_tests.rs"]
+mod media_tests;
 
 #[cfg(test)]
 mod tests {

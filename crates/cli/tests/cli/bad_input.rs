@@ -561,3 +561,46 @@ fn bad_environment_maps() {
         &["nan.exr", "sky.hdr", "square.exr"],
     );
 }
+
+/// A scene with participating media asked of a method that does not render them: a usage
+/// error (exit 2) naming the scene and the method, and no output; the path tracer renders it.
+#[test]
+fn media_with_a_method_that_cannot_render_them() {
+    let dir = temp_dir("media_method");
+    let scene = r#"format = 1
+[camera]
+position = [0.0, 0.0, 5.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 30.0
+medium = "fog"
+[film]
+width = 8
+height = 8
+[media.fog]
+sigma_a = [0.1, 0.1, 0.1]
+sigma_s = [0.2, 0.2, 0.2]
+[materials.lamp]
+type = "diffuse"
+albedo = [0.0, 0.0, 0.0]
+emission = [1.0, 1.0, 1.0]
+[[shapes]]
+type = "quad"
+corner = [-1.0, -1.0, 0.0]
+edge1 = [2.0, 0.0, 0.0]
+edge2 = [0.0, 2.0, 0.0]
+material = "lamp"
+"#;
+    std::fs::write(dir.join("fog.toml"), scene).unwrap();
+    check_in(
+        &dir,
+        &["render", "fog.toml", "--method", "sppm", "--passes", "1"],
+        2,
+        &["fog.toml", "participating media", "sppm"],
+        &["fog.toml"],
+    );
+    fppm(
+        &dir,
+        &["render", "fog.toml", "--method", "path", "--passes", "1"],
+    )
+    .ok();
+}

@@ -12,11 +12,14 @@
 //!   opacity become image textures (`textures.rs`); other textured colours stand in as a
 //!   constant (`Importer::texture_standin`); environment emitters that fppm cannot render are
 //!   skipped with a warning ([`super::builder::environment_light_standin`]);
+//! - `homogeneous` media become fppm's media (`media.rs`), a `null` BSDF on a shape that bounds
+//!   them its interface;
 //! - the integrator's `max_depth` (longest path in segments, Mitsuba's convention) becomes
 //!   fppm's `max_depth` (scattering events) minus one; its `rr_depth` is carried as is.
 
 mod bsdfs;
 mod emitters;
+mod media;
 mod properties;
 mod sensor;
 mod shapes;
@@ -58,6 +61,7 @@ pub(crate) fn load_mitsuba(
         ids,
         builder: Builder::default(),
         bsdf_cache: HashMap::new(),
+        medium_cache: HashMap::new(),
         images: crate::image_file::TextureCache::default(),
     };
     let mut camera = None;
@@ -78,17 +82,19 @@ pub(crate) fn load_mitsuba(
                         .warn(format!("{}: only the first sensor is used", node.label()));
                 } else {
                     let (c, f) = importer.sensor(node)?;
+                    importer.builder.media.camera = importer.sensor_medium(node)?;
                     camera = Some(c);
                     film = f;
                 }
             }
             "integrator" => importer.integrator(node, &mut render)?,
             // Declarations used through <ref>, and elements with no bearing on the image.
-            "medium" | "volume" => {
-                return Err(doc.error(node, "participating media are not supported"));
+            "volume" => {
+                return Err(doc.error(node, "volume grids (heterogeneous media) are not supported"));
             }
-            "bsdf" | "texture" | "spectrum" | "phase" | "float" | "integer" | "boolean"
-            | "string" | "rgb" | "point" | "vector" | "alias" | "transform" | "ref" => {}
+            "bsdf" | "medium" | "texture" | "spectrum" | "phase" | "float" | "integer"
+            | "boolean" | "string" | "rgb" | "point" | "vector" | "alias" | "transform" | "ref" => {
+            }
             other => {
                 importer.builder.warn(format!(
                     "<{other}> at the top level of the scene is ignored"
@@ -133,6 +139,8 @@ struct Importer<'a> {
     builder: Builder,
     /// BSDFs by node address, so that shared BSDFs convert (and warn) once.
     bsdf_cache: HashMap<usize, ConvertedBsdf>,
+    /// Media by node address: each converted once, whoever refers to it.
+    medium_cache: HashMap<usize, u32>,
     /// The images of the scene's bitmaps, each decoded once.
     images: crate::image_file::TextureCache,
 }

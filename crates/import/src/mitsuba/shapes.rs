@@ -77,9 +77,16 @@ impl<'a> Importer<'a> {
                 textures: None,
             },
         };
-        let Some(kind) = bsdf.kind else {
+        let (interior, exterior) = self.shape_media(node)?;
+        let bounds_media = interior.is_some() || exterior.is_some();
+        // A null BSDF is invisible, unless the shape bounds media: then it is their interface.
+        let Some(kind) = bsdf
+            .kind
+            .or(bounds_media.then_some(MaterialKind::Interface(scene::Interface)))
+        else {
             return Ok(());
         };
+        let first_triangle = self.builder.triangles.len() as u32;
         let emitter = self.shape_emitter(node)?;
         let (name, emission) = match emitter {
             Some(e) => {
@@ -189,6 +196,13 @@ impl<'a> Importer<'a> {
                     self.builder
                         .warn(format!("{label}: flip_normals is ignored on a sphere"));
                 }
+                if bounds_media {
+                    self.builder.media.shapes.push(scene::ShapeMedia {
+                        shape: scene::MediumShape::Sphere(self.builder.spheres.len() as u32),
+                        interior,
+                        exterior,
+                    });
+                }
                 self.builder.sphere(center, radius, m, material, &label);
                 return Ok(());
             }
@@ -198,6 +212,9 @@ impl<'a> Importer<'a> {
                 let radius = self.float(node, "radius")?.unwrap_or(1.0) as f32;
                 if !(radius > 0.0 && radius.is_finite()) || (p1 - p0).length() <= 0.0 {
                     return Err(self.err(node, "a cylinder needs radius > 0 and p0 != p1"));
+                }
+                if bounds_media {
+                    return Err(self.err(node, "a cylinder is open: it cannot bound a medium"));
                 }
                 if flip {
                     self.builder
@@ -216,6 +233,17 @@ impl<'a> Importer<'a> {
             mesh.flip();
         }
         self.builder.mesh(&mesh, m, material);
+        let end = self.builder.triangles.len() as u32;
+        if bounds_media && end > first_triangle {
+            self.builder.media.shapes.push(scene::ShapeMedia {
+                shape: scene::MediumShape::Triangles {
+                    start: first_triangle,
+                    end,
+                },
+                interior,
+                exterior,
+            });
+        }
         Ok(())
     }
 }

@@ -3,7 +3,8 @@
 use crate::error::LoadError;
 use crate::{LoadOptions, MAX_FILM_SIDE, MeshData, SceneParts, fmt_vec};
 use scene::{
-    Camera, Cylinder, Film, LoadNotes, RenderDefaults, SceneDescription, Sphere, Triangle,
+    Camera, Cylinder, Film, LoadNotes, MediumShape, RenderDefaults, SceneDescription, ShapeMedia,
+    Sphere, Triangle,
 };
 
 use crate::image_file::TextureCache;
@@ -68,9 +69,13 @@ impl Converter<'_> {
 
     pub(super) fn convert(
         &self,
-        file: SceneFile,
+        mut file: SceneFile,
         options: &LoadOptions,
     ) -> Result<SceneDescription, LoadError> {
+        let media = self.media(std::mem::take(&mut file.media))?;
+        let camera_medium = file.camera.as_mut().and_then(|c| c.medium.take());
+        let camera_medium = self.medium_ref(&media, "[camera] medium", camera_medium.as_deref())?;
+        let mut shape_media = Vec::new();
         let camera = file.camera.map(|c| self.camera(c)).transpose()?;
         let film = match file.film {
             Some(f) => self.film(&f)?,
@@ -108,7 +113,26 @@ impl Converter<'_> {
                     center,
                     radius,
                     material,
+                    interior,
+                    exterior,
                 } => {
+                    let interior = self.medium_ref(
+                        &media,
+                        &format!("{context} interior"),
+                        interior.as_deref(),
+                    )?;
+                    let exterior = self.medium_ref(
+                        &media,
+                        &format!("{context} exterior"),
+                        exterior.as_deref(),
+                    )?;
+                    if interior.is_some() || exterior.is_some() {
+                        shape_media.push(ShapeMedia {
+                            shape: MediumShape::Sphere(acc.spheres.len() as u32),
+                            interior,
+                            exterior,
+                        });
+                    }
                     acc.spheres.push(Sphere {
                         center: self.finite(&format!("{context} center"), center)?,
                         radius: self.positive(&format!("{context} radius"), radius)?,
@@ -207,7 +231,20 @@ impl Converter<'_> {
                     file: mesh_file,
                     material,
                     transform,
+                    interior,
+                    exterior,
                 } => {
+                    let interior = self.medium_ref(
+                        &media,
+                        &format!("{context} interior"),
+                        interior.as_deref(),
+                    )?;
+                    let exterior = self.medium_ref(
+                        &media,
+                        &format!("{context} exterior"),
+                        exterior.as_deref(),
+                    )?;
+                    let start = acc.triangles.len() as u32;
                     let override_material =
                         material.map(|name| lookup(&context, &name)).transpose()?;
                     let matrix = match transform {
@@ -262,6 +299,14 @@ impl Converter<'_> {
                             .and_then(|t| crate::transform_tangents(t, matrix, flip));
                         acc.push(p, n, uv, tangents, material_of(t.material));
                     }
+                    let end = acc.triangles.len() as u32;
+                    if (interior.is_some() || exterior.is_some()) && end > start {
+                        shape_media.push(ShapeMedia {
+                            shape: MediumShape::Triangles { start, end },
+                            interior,
+                            exterior,
+                        });
+                    }
                 }
             }
         }
@@ -306,6 +351,11 @@ impl Converter<'_> {
             cylinders: acc.cylinders,
             lights,
             environment,
+            media: scene::Media {
+                list: media.list,
+                shapes: shape_media,
+                camera: camera_medium,
+            },
             render: render.unwrap_or_default(),
             notes: acc.notes,
             degenerate_materials: acc.degenerate_materials,

@@ -42,6 +42,7 @@ impl Converter<'_> {
                     emission,
                 )
             }
+            MaterialToml::Interface {} => (MaterialKind::Interface(scene::Interface), None),
             MaterialToml::Dielectric {
                 ior,
                 roughness,

@@ -13,7 +13,9 @@
 //! `FILE/NAME` in the scene; lights and cameras inside a mesh file are ignored (with a warning).
 //!
 //! Extensions (`docs/scene-format-extensions.md`): the `cylinder` shape, an analytic open
-//! cylinder cut to an optional arc; its material must not emit.
+//! cylinder cut to an optional arc; its material must not emit. Participating media:
+//! `[media.NAME]` tables, `interior`/`exterior` on mesh and sphere shapes, `[camera] medium`,
+//! and the `interface` material (`media.rs`).
 
 use std::path::Path;
 
@@ -25,6 +27,7 @@ mod convert;
 mod errors;
 mod lights;
 mod materials;
+mod media;
 mod schema;
 
 use self::convert::Converter;

@@ -16,7 +16,19 @@ pub(super) struct SceneFile {
     pub(super) shapes: Vec<ShapeToml>,
     #[serde(default)]
     pub(super) lights: Vec<LightToml>,
+    /// Extension: participating media by name (`docs/scene-format-extensions.md`).
+    #[serde(default)]
+    pub(super) media: BTreeMap<String, MediumToml>,
     pub(super) render: Option<RenderToml>,
+}
+
+/// A homogeneous medium (extension).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct MediumToml {
+    pub(super) sigma_a: [f32; 3],
+    pub(super) sigma_s: [f32; 3],
+    pub(super) g: Option<f32>,
 }
 
 #[derive(Deserialize)]
@@ -28,6 +40,8 @@ pub(super) struct CameraToml {
     pub(super) fov_y: f32,
     pub(super) aperture_radius: Option<f32>,
     pub(super) focus_distance: Option<f32>,
+    /// Extension: the medium the camera sits in.
+    pub(super) medium: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -62,6 +76,8 @@ pub(super) enum MaterialToml {
         emission: Option<ColorToml>,
         cutout: Option<String>,
     },
+    /// Extension: no scattering, a boundary of media.
+    Interface {},
 }
 
 /// A colour: `[r, g, b]`, or (extension, `docs/scene-format-extensions.md`) an image texture
@@ -119,11 +135,16 @@ pub(super) enum ShapeToml {
         file: String,
         material: Option<String>,
         transform: Option<TransformToml>,
+        /// Extension: the media inside and outside (`docs/scene-format-extensions.md`).
+        interior: Option<String>,
+        exterior: Option<String>,
     },
     Sphere {
         center: [f32; 3],
         radius: f32,
         material: String,
+        interior: Option<String>,
+        exterior: Option<String>,
     },
     Quad {
         corner: [f32; 3],

@@ -7,6 +7,7 @@ mod cylinder;
 mod fuzz_regressions;
 mod gltf;
 mod import_textures;
+mod media;
 mod mitsuba;
 mod obj;
 mod pbrt;

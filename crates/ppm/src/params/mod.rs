@@ -343,6 +343,14 @@ pub enum ParamError {
         /// The method asked for.
         method: Method,
     },
+    /// The scene has participating media, which this method does not render (`docs/media.md`).
+    #[error(
+        "the scene has participating media, which only the path tracer renders: use --method path, not {method}"
+    )]
+    MediaUnsupported {
+        /// The method asked for.
+        method: Method,
+    },
     /// The kernels of a pass-independent render are not one positive radius per slot.
     #[error("the kernels hold {found} radii for {expected} hitpoint slots, or one is not positive")]
     BadKernels {

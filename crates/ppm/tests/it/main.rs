@@ -17,6 +17,7 @@ mod frequency;
 mod kernels;
 mod light_tracer;
 mod light_tracing;
+mod media;
 mod memory;
 mod non_finite;
 mod pooling;

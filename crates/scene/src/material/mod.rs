@@ -4,7 +4,8 @@
 //! - `mirror.rs`: a perfect specular conductor of constant reflectance;
 //! - `dielectric.rs`: a smooth dielectric with exact unpolarised Fresnel;
 //! - `glossy.rs`: a GGX conductor over an optional Lambertian base;
-//! - `rough_dielectric.rs`: GGX microfacet reflection and refraction with exact Fresnel.
+//! - `rough_dielectric.rs`: GGX microfacet reflection and refraction with exact Fresnel;
+//! - `interface.rs`: no scattering at all, a boundary of participating media.
 //!
 //! [`MaterialKind`] is a material's model as a scene describes it, and [`Bsdf`] a model at one
 //! surface point. A new model is a module here implementing [`Model`], a variant of
@@ -28,9 +29,10 @@
 mod dielectric;
 mod diffuse;
 mod glossy;
+mod interface;
 mod mirror;
 #[cfg(test)]
-mod pdf_tests;
+pub(crate) mod pdf_tests;
 mod rough_dielectric;
 #[cfg(test)]
 mod rough_dielectric_tests;
@@ -42,6 +44,7 @@ use glam::{Vec2, Vec3};
 pub use self::dielectric::{Dielectric, fresnel_dielectric};
 pub use self::diffuse::Diffuse;
 pub use self::glossy::Glossy;
+pub use self::interface::Interface;
 pub use self::mirror::Mirror;
 pub use self::rough_dielectric::{RoughDielectric, SMOOTH_ROUGHNESS};
 use crate::{Frame, Hit, Material, Rgb};
@@ -131,6 +134,9 @@ pub enum MaterialKind {
     /// Rough dielectric: GGX microfacet reflection and refraction with exact unpolarised
     /// Fresnel (the smooth dielectric below [`SMOOTH_ROUGHNESS`]).
     RoughDielectric(RoughDielectric),
+    /// No scattering: a boundary of participating media that light crosses unchanged (an
+    /// extension, `docs/media.md`). Only integrators that handle media render it.
+    Interface(Interface),
 }
 
 /// Evaluates `$body` with `$model` bound to the model inside `$kind`, whichever it is: the one
@@ -143,6 +149,7 @@ macro_rules! with_model {
             MaterialKind::Dielectric($model) => $body,
             MaterialKind::Glossy($model) => $body,
             MaterialKind::RoughDielectric($model) => $body,
+            MaterialKind::Interface($model) => $body,
         }
     };
 }
@@ -290,7 +297,7 @@ impl MaterialKind {
     }
 
     /// The model's name in scene files and summaries: `diffuse`, `mirror`, `dielectric`,
-    /// `glossy`.
+    /// `glossy`, `interface`.
     #[must_use]
     #[inline]
     pub fn name(&self) -> &'static str {

@@ -91,7 +91,7 @@ pub(super) fn mirrored(w: Vec3) -> Vec3 {
 /// ∫ f dω over the sphere by the midpoint rule in (t, φ) about `axis`, with the polar angle
 /// θ = π t²: dω = 2π t sin(π t²) dt dφ, so the steps in θ are fine near the axis, where the
 /// sharp lobes are, and the rule is exact in φ for a lobe symmetric about the axis.
-pub(super) fn integrate(
+pub(crate) fn integrate(
     axis: Vec3,
     n_t: usize,
     n_phi: usize,
@@ -114,7 +114,7 @@ pub(super) fn integrate(
 }
 
 /// The world direction of (t, φ) about the frame's normal (θ = π t²).
-pub(super) fn warped(frame: &Frame, t: f64, phi: f64) -> Vec3 {
+pub(crate) fn warped(frame: &Frame, t: f64, phi: f64) -> Vec3 {
     let theta = PI64 * t * t;
     let (s, c) = theta.sin_cos();
     let local = Vec3::new((s * phi.cos()) as f32, (s * phi.sin()) as f32, c as f32);

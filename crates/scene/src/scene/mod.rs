@@ -103,6 +103,10 @@ pub struct Scene {
     variant_first: Vec<Option<u32>>,
     /// The variants, in index order.
     variants: Vec<Material>,
+    /// Which shape's media each primitive bounds; `None` in a scene without media.
+    medium_map: Option<crate::medium::MediumMap>,
+    /// Whether the scene has media or interface materials ([`SceneDescription::has_media`]).
+    has_media: bool,
 }
 
 impl Scene {
@@ -194,6 +198,14 @@ impl Scene {
             .iter()
             .any(|m| m.textures.as_ref().is_some_and(|t| t.normal.is_some()));
         let (variant_first, variants) = shading::material_variants(&description.materials);
+        let has_media = description.has_media();
+        let medium_map = has_media.then(|| {
+            crate::medium::MediumMap::new(
+                &description.media,
+                description.triangles.len(),
+                description.spheres.len(),
+            )
+        });
         Ok(Self {
             description,
             accel,
@@ -205,7 +217,37 @@ impl Scene {
             textured_hits: cutouts || normal_mapped || !variants.is_empty(),
             variant_first,
             variants,
+            medium_map,
+            has_media,
         })
+    }
+
+    /// Whether the scene has participating media or interface materials: only an integrator
+    /// that handles media renders it right.
+    #[inline]
+    pub fn has_media(&self) -> bool {
+        self.has_media
+    }
+
+    /// The scene's media, the shapes that bound them and the camera's medium.
+    #[inline]
+    pub fn media(&self) -> &crate::Media {
+        &self.description.media
+    }
+
+    /// The media on either side of the shape of `hit`, if crossing it changes the medium.
+    #[inline]
+    pub fn shape_media(&self, hit: &Hit) -> Option<&crate::ShapeMedia> {
+        let i = self.medium_map.as_ref()?.entry(hit.primitive)?;
+        self.description.media.shapes.get(i)
+    }
+
+    /// Whether the material at `hit` is an interface, which does not scatter
+    /// ([`crate::MaterialKind::Interface`]).
+    #[inline]
+    pub fn is_interface(&self, hit: &Hit) -> bool {
+        self.material(hit.material)
+            .is_some_and(|m| matches!(m.kind, crate::MaterialKind::Interface(_)))
     }
 
     /// The description the scene was built from.

@@ -1,0 +1,143 @@
+//! Participating media: `<medium type="homogeneous">` (Mitsuba 3's `sigma_t`, `albedo`,
+//! `scale`, or `sigma_a` and `sigma_s`; an `hg` or `isotropic` phase function), referred to
+//! by shapes as `interior` and `exterior` and by the sensor as its `medium` (`docs/media.md`).
+
+use super::*;
+
+/// Mitsuba 3's default `albedo` of a homogeneous medium.
+const DEFAULT_ALBEDO: f32 = 0.75;
+
+impl<'a> Importer<'a> {
+    /// The index of the medium `node` (an element or a `<ref>` to one), converted once.
+    pub(super) fn medium(&mut self, node: &'a Node) -> Result<u32, LoadError> {
+        let node = self.deref(node)?;
+        let key = std::ptr::from_ref(node) as usize;
+        if let Some(&i) = self.medium_cache.get(&key) {
+            return Ok(i);
+        }
+        if node.tag != "medium" {
+            return Err(self.err(node, "expected a <medium>"));
+        }
+        let ty = node.attr("type").unwrap_or("");
+        if ty != "homogeneous" {
+            return Err(self.err(
+                node,
+                format!("medium type \"{ty}\" is not supported (only homogeneous)"),
+            ));
+        }
+        let scale = self.float(node, "scale")?.unwrap_or(1.0) as f32;
+        let (sigma_a, sigma_s) = match (prop(node, "sigma_a"), prop(node, "sigma_s")) {
+            (None, None) => {
+                let sigma_t = self
+                    .colour(node, "sigma_t", SpectrumUse::Ior)?
+                    .unwrap_or(Rgb::ONE);
+                let albedo = self
+                    .colour(node, "albedo", SpectrumUse::Reflectance)?
+                    .unwrap_or(Rgb::splat(DEFAULT_ALBEDO));
+                (sigma_t * (Rgb::ONE - albedo), sigma_t * albedo)
+            }
+            _ => (
+                self.colour(node, "sigma_a", SpectrumUse::Ior)?
+                    .unwrap_or(Rgb::ZERO),
+                self.colour(node, "sigma_s", SpectrumUse::Ior)?
+                    .unwrap_or(Rgb::ZERO),
+            ),
+        };
+        let mut g = 0.0;
+        for child in &node.children {
+            let child = if child.tag == "ref" {
+                self.deref(child)?
+            } else {
+                child
+            };
+            if child.tag != "phase" {
+                continue;
+            }
+            match child.attr("type").unwrap_or("") {
+                "isotropic" => g = 0.0,
+                "hg" => g = self.float(child, "g")?.unwrap_or(0.8) as f32,
+                other => {
+                    return Err(self.err(
+                        child,
+                        format!(
+                            "phase function \"{other}\" is not supported (only hg and isotropic)"
+                        ),
+                    ));
+                }
+            }
+        }
+        let name = node.attr("id").map_or_else(
+            || format!("medium{}", self.builder.media.list.len()),
+            str::to_owned,
+        );
+        let index = self.builder.media.list.len() as u32;
+        self.builder.media.list.push(scene::Medium {
+            name,
+            sigma_a: sigma_a * scale,
+            sigma_s: sigma_s * scale,
+            g,
+        });
+        self.medium_cache.insert(key, index);
+        Ok(index)
+    }
+
+    /// The media a shape or sensor names: its `<medium name="…">` children and `<ref name="…">`
+    /// to media, by name (`interior`, `exterior`, `medium`).
+    pub(super) fn named_media(&mut self, node: &'a Node) -> Result<Vec<(&'a str, u32)>, LoadError> {
+        let mut media = Vec::new();
+        for child in &node.children {
+            let is_medium = match child.tag.as_str() {
+                "medium" => true,
+                "ref" => self.deref(child)?.tag == "medium",
+                _ => false,
+            };
+            if !is_medium {
+                continue;
+            }
+            let name = child.attr("name").ok_or_else(|| {
+                self.err(
+                    child,
+                    "a medium here needs a name (interior, exterior or medium)",
+                )
+            })?;
+            media.push((name, self.medium(child)?));
+        }
+        Ok(media)
+    }
+
+    /// A shape's interior and exterior media.
+    pub(super) fn shape_media(
+        &mut self,
+        node: &'a Node,
+    ) -> Result<(Option<u32>, Option<u32>), LoadError> {
+        let (mut interior, mut exterior) = (None, None);
+        for (name, m) in self.named_media(node)? {
+            match name {
+                "interior" => interior = Some(m),
+                "exterior" => exterior = Some(m),
+                other => {
+                    return Err(self.err(
+                        node,
+                        format!("a shape's medium is named interior or exterior, not \"{other}\""),
+                    ));
+                }
+            }
+        }
+        Ok((interior, exterior))
+    }
+
+    /// The sensor's medium, if it names one.
+    pub(super) fn sensor_medium(&mut self, node: &'a Node) -> Result<Option<u32>, LoadError> {
+        let mut medium = None;
+        for (name, m) in self.named_media(node)? {
+            if name != "medium" {
+                return Err(self.err(
+                    node,
+                    format!("a sensor's medium is named medium, not \"{name}\""),
+                ));
+            }
+            medium = Some(m);
+        }
+        Ok(medium)
+    }
+}

@@ -1,0 +1,303 @@
+//! The path tracer in scenes with participating media (`docs/media.md`): the same estimator as
+//! [`super::PathTracer::scattered`] (next-event estimation and BSDF sampling combined by the
+//! power heuristic, Russian roulette from `rr_depth`), with homogeneous media between surfaces.
+//!
+//! - The path knows the medium it travels in: the camera's to start with, then the side of each
+//!   shape it crosses ([`scene::medium_after`]): by a dielectric's refraction, or straight
+//!   through an interface, which does not scatter and does not count as a bounce.
+//! - Free-flight sampling is chromatic (pbrt-v4's and Mitsuba's spectral MIS over RGB): a
+//!   channel is picked with probability proportional to the path throughput, a distance drawn
+//!   from that channel's exp(−σt·t), and the density is the average of the channels' densities
+//!   under those probabilities, so every channel's estimate stays unbiased.
+//! - At a medium vertex the Henyey–Greenstein phase function scatters; its sampling is exact
+//!   (weight one). Next-event estimation from surfaces and medium vertices multiplies by the
+//!   transmittance of the shadow ray, computed exactly through every medium it crosses and
+//!   through interfaces (any other surface occludes).
+//! - MIS weights compare solid-angle densities of the direction only (light sampling against
+//!   phase or BSDF sampling); the transmittance is a factor both strategies share, which keeps
+//!   the combination unbiased.
+
+use glam::Vec3;
+use scene::{Hit, Ray, Rgb, Scene, TransportMode, medium_after};
+
+use super::power_heuristic;
+use crate::params::RenderParams;
+use crate::rng::Sampler;
+
+/// At most this many interfaces are crossed between two scattering events (or along one
+/// shadow ray); a path beyond it ends. It only guards against a ray caught between coincident
+/// surfaces: real scenes never come near it.
+const MAX_CROSSINGS: u32 = 256;
+
+/// The vertex a path last scattered at, for the MIS weight of emission found after it.
+#[derive(Clone, Copy)]
+struct Scatter {
+    /// Its position.
+    position: Vec3,
+    /// The geometric normal at a surface, zero in a medium (as the light sampler takes it).
+    normal: Vec3,
+    /// The solid-angle density of the direction it drew.
+    pdf: f32,
+    /// Whether that direction came from a delta lobe (or is the camera ray): emission then
+    /// counts in full.
+    specular: bool,
+}
+
+/// The radiance arriving along the camera ray `ray` in a scene with media.
+pub(super) fn trace(scene: &Scene, params: &RenderParams, ray: Ray, sampler: &mut Sampler) -> Rgb {
+    let lights = scene.lights();
+    let media = &scene.media().list;
+    let mut medium = scene.media().camera;
+    let mut ray = ray;
+    let mut radiance = Rgb::ZERO;
+    let mut beta = Rgb::ONE;
+    let mut depth = 0;
+    let mut crossings = 0;
+    let mut last = Scatter {
+        position: ray.origin,
+        normal: Vec3::ZERO,
+        pdf: 1.0,
+        specular: true,
+    };
+    loop {
+        let hit = scene.intersect(&ray);
+        let t_surface = hit.map_or(f32::INFINITY, |h| h.t);
+        if let Some(m) = medium.and_then(|m| media.get(m as usize)) {
+            let sigma_t = m.sigma_t();
+            let total = beta.x + beta.y + beta.z;
+            if total.is_nan() || total <= 0.0 {
+                break;
+            }
+            let q = beta / total;
+            let (u_channel, u_distance) = (sampler.next_f32(), sampler.next_f32());
+            let channel = if u_channel < q.x {
+                0
+            } else if u_channel < q.x + q.y {
+                1
+            } else {
+                2
+            };
+            let t = if sigma_t[channel] > 0.0 {
+                -(1.0 - u_distance).ln() / sigma_t[channel]
+            } else {
+                f32::INFINITY
+            };
+            if t < t_surface {
+                // A medium vertex.
+                let tr = m.transmittance(t);
+                let pdf = (q * sigma_t * tr).element_sum();
+                if pdf.is_nan() || pdf <= 0.0 {
+                    break;
+                }
+                beta *= m.sigma_s * tr / pdf;
+                let position = ray.at(t);
+                if depth >= params.budget.max_depth {
+                    break;
+                }
+                let phase = m.phase();
+                let outgoing = -ray.direction;
+                let (u_light, u_light_2d) = (sampler.next_f32(), sampler.next_2d());
+                if let Some(sample) =
+                    lights.sample_direct(position, Vec3::ZERO, u_light, u_light_2d)
+                    && sample.pdf > 0.0
+                {
+                    let p = phase.eval(outgoing, sample.incoming);
+                    let shadow = shadow_ray(position, sample.incoming, sample.distance);
+                    let tr = transmittance(scene, shadow, medium);
+                    if p > 0.0 && tr != Rgb::ZERO {
+                        let weight = if sample.is_delta {
+                            1.0
+                        } else {
+                            power_heuristic(sample.pdf, p)
+                        };
+                        radiance += beta * tr * sample.radiance * (p * weight / sample.pdf);
+                    }
+                }
+                let s = phase.sample(outgoing, sampler.next_2d());
+                let u_roulette = sampler.next_f32();
+                if !roulette(&mut beta, depth, params, u_roulette) {
+                    break;
+                }
+                last = Scatter {
+                    position,
+                    normal: Vec3::ZERO,
+                    pdf: s.pdf,
+                    specular: false,
+                };
+                ray = Ray::infinite(position, s.incoming);
+                depth += 1;
+                crossings = 0;
+                continue;
+            }
+            // The surface (or infinity) is reached: weight by the transmittance over the
+            // probability of getting there.
+            let tr = m.transmittance(t_surface);
+            let survive = (q * tr).element_sum();
+            if survive.is_nan() || survive <= 0.0 {
+                break;
+            }
+            beta *= tr / survive;
+        }
+        let Some(hit) = hit else {
+            if lights.has_environment() {
+                let weight = if last.specular {
+                    1.0
+                } else {
+                    power_heuristic(last.pdf, lights.pdf_environment(ray.direction))
+                };
+                radiance += beta * lights.environment_radiance(ray.direction) * weight;
+            }
+            break;
+        };
+        if scene.is_interface(&hit) {
+            crossings += 1;
+            if crossings > MAX_CROSSINGS {
+                break;
+            }
+            medium = medium_after(scene.shape_media(&hit), &hit, ray.direction, medium);
+            ray = hit.spawn_ray(ray.direction);
+            continue;
+        }
+        let emitted = scene.emitted(&hit);
+        if emitted != Rgb::ZERO {
+            let weight = if last.specular {
+                1.0
+            } else {
+                power_heuristic(
+                    last.pdf,
+                    lights.pdf_direct(last.position, last.normal, &hit),
+                )
+            };
+            radiance += beta * emitted * weight;
+        }
+        if depth >= params.budget.max_depth {
+            break;
+        }
+        let Some(bsdf) = scene.bsdf(&hit) else {
+            break;
+        };
+        let outgoing = -ray.direction;
+        let u_light = sampler.next_f32();
+        let u_light_2d = sampler.next_2d();
+        if !bsdf.is_specular() {
+            radiance += beta
+                * surface_next_event(scene, &hit, &bsdf, outgoing, medium, u_light, u_light_2d);
+        }
+        let u_lobe = sampler.next_f32();
+        let u = sampler.next_2d();
+        let u_roulette = sampler.next_f32();
+        let Some(sample) = bsdf.sample(outgoing, u_lobe, u, TransportMode::Radiance) else {
+            break;
+        };
+        beta *= sample.weight;
+        if !roulette(&mut beta, depth, params, u_roulette) {
+            break;
+        }
+        medium = medium_after(scene.shape_media(&hit), &hit, sample.incoming, medium);
+        last = Scatter {
+            position: hit.position,
+            normal: hit.geometric_normal,
+            pdf: sample.pdf,
+            specular: sample.is_specular,
+        };
+        ray = hit.spawn_ray(sample.incoming);
+        depth += 1;
+        crossings = 0;
+    }
+    radiance
+}
+
+/// Russian roulette after a scattering event at `depth` (the tracer's rule: from `rr_depth`
+/// on, survive with the throughput's largest channel, at most one, and divide by it); whether
+/// the path goes on.
+fn roulette(beta: &mut Rgb, depth: u32, params: &RenderParams, u: f32) -> bool {
+    if depth + 1 >= params.budget.rr_depth {
+        let survive = beta.max_element().min(1.0);
+        if survive <= 0.0 || u >= survive {
+            return false;
+        }
+        *beta /= survive;
+    }
+    *beta != Rgb::ZERO && beta.is_finite()
+}
+
+/// The shadow ray from a point in a medium toward a light sample at `distance` (∞ for an
+/// infinite light), stopping just short of a finite target as [`Hit::spawn_ray_to`] does.
+fn shadow_ray(origin: Vec3, direction: Vec3, distance: f32) -> Ray {
+    if distance.is_finite() {
+        Ray::new(origin, direction, distance * (1.0 - 1e-4))
+    } else {
+        Ray::infinite(origin, direction)
+    }
+}
+
+/// The transmittance along `ray` (to its `t_max`) starting in `medium`: the product of each
+/// medium's over its stretch, through interfaces; zero if any other surface is in the way.
+fn transmittance(scene: &Scene, mut ray: Ray, mut medium: Option<u32>) -> Rgb {
+    let media = &scene.media().list;
+    let target = ray.t_max.is_finite().then(|| ray.at(ray.t_max));
+    let mut tr = Rgb::ONE;
+    for _ in 0..=MAX_CROSSINGS {
+        let hit = scene.intersect(&ray);
+        if let Some(m) = medium.and_then(|m| media.get(m as usize)) {
+            tr *= m.transmittance(hit.map_or(ray.t_max, |h| h.t));
+        }
+        let Some(hit) = hit else {
+            return tr;
+        };
+        if tr == Rgb::ZERO || !scene.is_interface(&hit) {
+            return Rgb::ZERO;
+        }
+        medium = medium_after(scene.shape_media(&hit), &hit, ray.direction, medium);
+        ray = match target {
+            Some(target) => hit.spawn_ray_to(target),
+            None => hit.spawn_ray(ray.direction),
+        };
+    }
+    Rgb::ZERO
+}
+
+/// Light sampling at a non-specular surface vertex `hit` seen along −`outgoing`, in a scene
+/// with media: [`super::next_event`] with the shadow ray's transmittance for its visibility.
+/// `medium` is the medium the path arrived in; the shadow ray leaves in the medium of the side
+/// it leaves to.
+fn surface_next_event(
+    scene: &Scene,
+    hit: &Hit,
+    bsdf: &scene::Bsdf,
+    outgoing: Vec3,
+    medium: Option<u32>,
+    u_light: f32,
+    u: glam::Vec2,
+) -> Rgb {
+    let Some(sample) = scene
+        .lights()
+        .sample_direct(hit.position, hit.geometric_normal, u_light, u)
+    else {
+        return Rgb::ZERO;
+    };
+    if sample.pdf.is_nan() || sample.pdf <= 0.0 {
+        return Rgb::ZERO;
+    }
+    let f = bsdf.eval(outgoing, sample.incoming);
+    if f == Rgb::ZERO {
+        return Rgb::ZERO;
+    }
+    let shadow = if sample.distance.is_finite() {
+        hit.spawn_ray_to(hit.position + sample.incoming * sample.distance)
+    } else {
+        hit.spawn_ray(sample.incoming)
+    };
+    let start = medium_after(scene.shape_media(hit), hit, sample.incoming, medium);
+    let tr = transmittance(scene, shadow, start);
+    if tr == Rgb::ZERO {
+        return Rgb::ZERO;
+    }
+    let cos = sample.incoming.dot(hit.shading_normal).abs();
+    let weight = if sample.is_delta {
+        1.0
+    } else {
+        power_heuristic(sample.pdf, bsdf.pdf(outgoing, sample.incoming))
+    };
+    f * tr * sample.radiance * (cos * weight / sample.pdf)
+}
