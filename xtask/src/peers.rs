@@ -859,10 +859,15 @@ fn medium_id(index: u32) -> String {
 
 /// A homogeneous medium as Mitsuba 3's `homogeneous`: extinction σt = σa + σs and single-scattering
 /// albedo σs / σt per channel (0 in a channel with σt = 0, where it does not matter: nothing
-/// scatters there), and the Henyey–Greenstein phase function of the same g.
+/// scatters there), and the Henyey–Greenstein phase function of the same g. Mitsuba's RGB
+/// variants read an `<rgb>` as a reflectance and refuse values above 1, so σt is written as its
+/// largest channel (`scale`) times σt / that channel (each in [0, 1]).
 pub(crate) fn medium_xml(medium: &scene::Medium, index: u32) -> String {
-    let sigma_t = medium.sigma_t();
+    let largest = medium.sigma_t().max_element();
+    let scale = if largest > 0.0 { largest } else { 1.0 };
+    let sigma_t = medium.sigma_t() / scale;
     let albedo = |c: usize| {
+        let sigma_t = medium.sigma_t();
         if sigma_t[c] > 0.0 {
             medium.sigma_s[c] / sigma_t[c]
         } else {
@@ -870,7 +875,7 @@ pub(crate) fn medium_xml(medium: &scene::Medium, index: u32) -> String {
         }
     };
     format!(
-        "<medium type=\"homogeneous\" id=\"{}\"><rgb name=\"sigma_t\" value=\"{}, {}, {}\"/><rgb name=\"albedo\" value=\"{}, {}, {}\"/><float name=\"scale\" value=\"1\"/><phase type=\"hg\"><float name=\"g\" value=\"{}\"/></phase></medium>",
+        "<medium type=\"homogeneous\" id=\"{}\"><rgb name=\"sigma_t\" value=\"{}, {}, {}\"/><rgb name=\"albedo\" value=\"{}, {}, {}\"/><float name=\"scale\" value=\"{scale}\"/><phase type=\"hg\"><float name=\"g\" value=\"{}\"/></phase></medium>",
         medium_id(index),
         sigma_t.x,
         sigma_t.y,

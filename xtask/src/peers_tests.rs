@@ -164,13 +164,15 @@ material = "lamp"
     let xml = std::fs::read_to_string(&path).unwrap();
     let has = |needle: &str| assert!(xml.contains(needle), "no {needle} in\n{xml}");
     has(r#"<default name="integrator" value="volpath"/>"#);
-    // ink: σt = (0.3 + 0.1, 0, 0.1 + 0.3) = (0.4, 0, 0.4); albedo (0.1/0.4, 0, 0.3/0.4).
+    // ink: σt = (0.3 + 0.1, 0, 0.1 + 0.3) = 0.4 × (1, 0, 1); albedo (0.1/0.4, 0, 0.3/0.4).
     has(
-        r#"<medium type="homogeneous" id="medium-1"><rgb name="sigma_t" value="0.4, 0, 0.4"/><rgb name="albedo" value="0.25, 0, 0.75"/>"#,
+        r#"<medium type="homogeneous" id="medium-1"><rgb name="sigma_t" value="1, 0, 1"/><rgb name="albedo" value="0.25, 0, 0.75"/><float name="scale" value="0.4"/>"#,
     );
     has(r#"<phase type="hg"><float name="g" value="-0.25"/></phase>"#);
-    // haze: σt = σs = 0.05, albedo 1.
-    has(r#"<rgb name="sigma_t" value="0.05, 0.05, 0.05"/><rgb name="albedo" value="1, 1, 1"/>"#);
+    // haze: σt = σs = 0.05 × (1, 1, 1), albedo 1.
+    has(
+        r#"<rgb name="sigma_t" value="1, 1, 1"/><rgb name="albedo" value="1, 1, 1"/><float name="scale" value="0.05"/>"#,
+    );
     has(
         r#"<bsdf type="null"/><ref name="interior" id="medium-1"/><ref name="exterior" id="medium-0"/></shape>"#,
     );
