@@ -223,10 +223,10 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         // Mitsuba's `path` and `ptracer` ignore media: a scene with media is scored against
         // `volpath` and only `volpath` is a fair peer.
         let reference_integrator = reference_integrator(&description);
-        if reference_integrator == "volpath" {
-            if let Some(blind) = flags.peers.iter().find(|p| *p != "volpath") {
-                bail!("{name} has media, which Mitsuba's {blind} ignores: use --peers volpath");
-            }
+        if reference_integrator == "volpath"
+            && let Some(blind) = flags.peers.iter().find(|p| *p != "volpath")
+        {
+            bail!("{name} has media, which Mitsuba's {blind} ignores: use --peers volpath");
         }
         let scene = scene::Scene::new(description)?;
         let diffuse = crate::suite::first_hits(&scene, |m| {

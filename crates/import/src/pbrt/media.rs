@@ -4,6 +4,9 @@
 
 use super::*;
 
+/// The (interior, exterior) media of a shape: indices into the list, `None` for vacuum.
+pub(super) type Sides = (Option<u32>, Option<u32>);
+
 impl Parser {
     /// Converts `MakeNamedMedium "name" …` into a medium of the list. pbrt-v4's defaults: σa = σs = 1,
     /// scale 1, g 0.
@@ -83,10 +86,7 @@ impl Parser {
     }
 
     /// A shape's (interior, exterior) media if crossing it changes the medium, else `None`.
-    pub(super) fn shape_media(
-        &self,
-        state: &State,
-    ) -> Result<Option<(Option<u32>, Option<u32>)>, LoadError> {
+    pub(super) fn shape_media(&self, state: &State) -> Result<Option<Sides>, LoadError> {
         let Some(names) = &state.media else {
             return Ok(None);
         };
