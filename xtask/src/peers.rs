@@ -28,7 +28,8 @@ Renders every scene of scenes/peers/ (or those named: a name of scenes/peers/, `
 ../shared/scenes/pbrt-v4/veach-mis/veach-mis.pbrt, or the path of any scene file fppm reads,
 e.g. ../shared/scenes/cornell_box/CornellBox-Water.obj) with each fppm method and each Mitsuba 3
 integrator for the same wall-clock time, one renderer at a time, all with --threads threads,
-and scores them against a Mitsuba `path` reference (max_depth unlimited) rendered as two
+and scores them against a Mitsuba `path` reference (`volpath` for a scene with participating
+media; max_depth unlimited) rendered as two
 independent halves of --reference-seconds / 2 each (kept in DIR/SCENE/ and reused; delete them
 to re-render). Reports relMSE (mean of (x - ref)^2 / (ref^2 + 0.01)) over all pixels, over
 the pixels whose first hit is diffuse and over those whose first hit is a mirror or glass, the
@@ -219,6 +220,14 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         let (width, height) = (description.film.width, description.film.height);
         let dir = out.join(name);
         let xml = write_mitsuba(&description, &dir.join("mitsuba"))?;
+        // Mitsuba's `path` and `ptracer` ignore media: a scene with media is scored against
+        // `volpath` and only `volpath` is a fair peer.
+        let reference_integrator = reference_integrator(&description);
+        if reference_integrator == "volpath"
+            && let Some(blind) = flags.peers.iter().find(|p| *p != "volpath")
+        {
+            bail!("{name} has media, which Mitsuba's {blind} ignores: use --peers volpath");
+        }
         let scene = scene::Scene::new(description)?;
         let diffuse = crate::suite::first_hits(&scene, |m| {
             m.emission.max_element() == 0.0 && matches!(m.kind, scene::MaterialKind::Diffuse(_))
@@ -234,7 +243,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         for (seed, half) in halves.iter().enumerate() {
             if !half.exists() {
                 eprintln!(
-                    "{name}: Mitsuba path reference half {} ({} s)",
+                    "{name}: Mitsuba {reference_integrator} reference half {} ({} s)",
                     seed + 1,
                     flags.reference_seconds / 2.0
                 );
@@ -242,7 +251,7 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
                     &python,
                     &script,
                     &xml,
-                    "path",
+                    reference_integrator,
                     &(flags.reference_seconds / 2.0).to_string(),
                     half,
                     flags.threads,
@@ -527,7 +536,10 @@ fn run_mitsuba(
 /// `perspective` sensor with `fov_axis = y` and a box-filtered `hdrfilm`; a diffuse colour
 /// texture (with albedo 1) is a `bitmap` reflectance (sRGB-decoded by Mitsuba for 8-bit files,
 /// bilinear, with the same wrap mode), a cut-out a `mask` BSDF with the alpha as opacity
-/// (`raw`); the integrator is `$integrator` with unlimited depth; the environment is Mitsuba's
+/// (`raw`); a homogeneous medium is a `homogeneous` medium ([`medium_xml`]) that shapes refer
+/// to as `interior` and `exterior` and the sensor as its `medium`, the interface material a
+/// `null` BSDF; the integrator is `$integrator` with unlimited depth (by default `volpath`
+/// for a scene with media, else `path`); the environment is Mitsuba's
 /// `constant` or `envmap` ([`environment_emitter`]); a rough dielectric is `roughdielectric`
 /// (GGX), a glossy conductor a two-sided `roughconductor` of the η whose exact Fresnel fppm's
 /// Schlick approximates, a glossy coat over a diffuse base a two-sided `roughplastic`. Lights
@@ -537,7 +549,11 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut xml = String::new();
     writeln!(xml, "<scene version=\"3.0.0\">")?;
-    writeln!(xml, "  <default name=\"integrator\" value=\"path\"/>")?;
+    writeln!(
+        xml,
+        "  <default name=\"integrator\" value=\"{}\"/>",
+        reference_integrator(description)
+    )?;
     writeln!(xml, "  <default name=\"spp\" value=\"16\"/>")?;
     writeln!(
         xml,
@@ -571,7 +587,13 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
         "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"{}\"/><integer name=\"height\" value=\"{}\"/><rfilter type=\"box\"/><string name=\"pixel_format\" value=\"rgb\"/></film>",
         description.film.width, description.film.height
     )?;
+    if let Some(m) = description.media.camera {
+        writeln!(xml, "    <ref name=\"medium\" id=\"{}\"/>", medium_id(m))?;
+    }
     writeln!(xml, "  </sensor>")?;
+    for (index, medium) in description.media.list.iter().enumerate() {
+        writeln!(xml, "  {}", medium_xml(medium, index as u32))?;
+    }
 
     let rgb = |c: [f32; 3]| format!("{}, {}, {}", c[0], c[1], c[2]);
     let mut bsdfs = Vec::new();
@@ -645,12 +667,9 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
                 rgb((reflectance / 0.04).min(Vec3::ONE).to_array()),
                 rgb((diffuse / 0.96).min(Vec3::ONE).to_array())
             ),
-            scene::MaterialKind::Interface(_) => {
-                bail!(
-                    "material {}: media and their interfaces are not exported",
-                    m.name
-                )
-            }
+            // Bounds media without scattering: Mitsuba's `null` BSDF (media are attached to
+            // the shape, below).
+            scene::MaterialKind::Interface(_) => "<bsdf type=\"null\"/>".to_owned(),
         };
         // A cut-out: Mitsuba's `mask` keeps the surface with probability = opacity (a stochastic
         // cut-out); fppm's `MASK` thresholds it, which agrees where the mask is 0 or 1.
@@ -683,17 +702,59 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
         bsdfs.push((bsdf, emitter));
     }
 
-    // Triangles, one PLY per material.
-    for (index, (bsdf, emitter)) in bsdfs.iter().enumerate() {
+    // The media entry (index into `media.shapes`) of each triangle and sphere, if any.
+    let mut triangle_media = vec![None; description.triangles.len()];
+    let mut sphere_media = vec![None; description.spheres.len()];
+    for (entry, shape) in description.media.shapes.iter().enumerate() {
+        match shape.shape {
+            scene::MediumShape::Triangles { start, end } => {
+                let range = triangle_media
+                    .get_mut(start as usize..end as usize)
+                    .context("a media entry names triangles that do not exist")?;
+                range.fill(Some(entry));
+            }
+            scene::MediumShape::Sphere(i) => {
+                *sphere_media
+                    .get_mut(i as usize)
+                    .context("a media entry names a sphere that does not exist")? = Some(entry);
+            }
+        }
+    }
+    let media_refs = |entry: Option<usize>| -> String {
+        let Some(shape) = entry.map(|e| description.media.shapes[e]) else {
+            return String::new();
+        };
+        let mut refs = String::new();
+        for (name, side) in [("interior", shape.interior), ("exterior", shape.exterior)] {
+            if let Some(m) = side {
+                refs += &format!("<ref name=\"{name}\" id=\"{}\"/>", medium_id(m));
+            }
+        }
+        refs
+    };
+
+    // Triangles, one PLY per material and media entry.
+    let mut groups: Vec<(usize, Option<usize>)> = description
+        .triangles
+        .iter()
+        .zip(&triangle_media)
+        .map(|(t, &media)| (t.material as usize, media))
+        .collect();
+    groups.sort_unstable();
+    groups.dedup();
+    for (index, media) in groups {
+        let (bsdf, emitter) = &bsdfs[index];
         let triangles: Vec<_> = description
             .triangles
             .iter()
-            .filter(|t| t.material as usize == index)
+            .zip(&triangle_media)
+            .filter(|(t, m)| t.material as usize == index && **m == media)
+            .map(|(t, _)| t)
             .collect();
-        if triangles.is_empty() {
-            continue;
-        }
-        let file = format!("material-{index}.ply");
+        let file = match media {
+            None => format!("material-{index}.ply"),
+            Some(entry) => format!("material-{index}-media-{entry}.ply"),
+        };
         let mut ply = String::new();
         let normals = triangles.iter().all(|t| t.normals.is_some());
         // Texture coordinates as they are: Mitsuba's bitmap, like fppm, puts v = 0 at the
@@ -732,18 +793,20 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
         std::fs::write(dir.join(&file), ply)?;
         writeln!(
             xml,
-            "  <shape type=\"ply\"><string name=\"filename\" value=\"{file}\"/>{bsdf}{}</shape>",
-            emitter.as_deref().unwrap_or("")
+            "  <shape type=\"ply\"><string name=\"filename\" value=\"{file}\"/>{bsdf}{}{}</shape>",
+            emitter.as_deref().unwrap_or(""),
+            media_refs(media)
         )?;
     }
-    for s in &description.spheres {
+    for (s, &media) in description.spheres.iter().zip(&sphere_media) {
         let (bsdf, emitter) = &bsdfs[s.material as usize];
         writeln!(
             xml,
-            "  <shape type=\"sphere\"><point name=\"center\" value=\"{}\"/><float name=\"radius\" value=\"{}\"/>{bsdf}{}</shape>",
+            "  <shape type=\"sphere\"><point name=\"center\" value=\"{}\"/><float name=\"radius\" value=\"{}\"/>{bsdf}{}{}</shape>",
             v(s.center),
             s.radius,
-            emitter.as_deref().unwrap_or("")
+            emitter.as_deref().unwrap_or(""),
+            media_refs(media)
         )?;
     }
     for (index, cylinder) in description.cylinders.iter().enumerate() {
@@ -777,6 +840,51 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
     let path = dir.join("scene.xml");
     std::fs::write(&path, xml)?;
     Ok(path)
+}
+
+/// The Mitsuba integrator of a scene's references: `volpath` if some path can be in a medium
+/// (Mitsuba's `path` ignores media), else `path`.
+pub(crate) fn reference_integrator(description: &scene::SceneDescription) -> &'static str {
+    if description.media.are_used() {
+        "volpath"
+    } else {
+        "path"
+    }
+}
+
+/// The XML id of medium `index`.
+fn medium_id(index: u32) -> String {
+    format!("medium-{index}")
+}
+
+/// A homogeneous medium as Mitsuba 3's `homogeneous`: extinction σt = σa + σs and single-scattering
+/// albedo σs / σt per channel (0 in a channel with σt = 0, where it does not matter: nothing
+/// scatters there), and the Henyey–Greenstein phase function of the same g. Mitsuba's RGB
+/// variants read an `<rgb>` as a reflectance and refuse values above 1, so σt is written as its
+/// largest channel (`scale`) times σt / that channel (each in [0, 1]).
+pub(crate) fn medium_xml(medium: &scene::Medium, index: u32) -> String {
+    let largest = medium.sigma_t().max_element();
+    let scale = if largest > 0.0 { largest } else { 1.0 };
+    let sigma_t = medium.sigma_t() / scale;
+    let albedo = |c: usize| {
+        let sigma_t = medium.sigma_t();
+        if sigma_t[c] > 0.0 {
+            medium.sigma_s[c] / sigma_t[c]
+        } else {
+            0.0
+        }
+    };
+    format!(
+        "<medium type=\"homogeneous\" id=\"{}\"><rgb name=\"sigma_t\" value=\"{}, {}, {}\"/><rgb name=\"albedo\" value=\"{}, {}, {}\"/><float name=\"scale\" value=\"{scale}\"/><phase type=\"hg\"><float name=\"g\" value=\"{}\"/></phase></medium>",
+        medium_id(index),
+        sigma_t.x,
+        sigma_t.y,
+        sigma_t.z,
+        albedo(0),
+        albedo(1),
+        albedo(2),
+        medium.g
+    )
 }
 
 /// The environment as a Mitsuba emitter: `constant` (scale folded into the radiance) or

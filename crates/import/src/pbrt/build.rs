@@ -101,7 +101,12 @@ impl Parser {
                     k
                 }
             };
-            let Some((kind, textures)) = converted else {
+            let media = self.shape_media(&shape.state)?;
+            // `interface` is invisible, unless the shape bounds media: then it is their
+            // boundary.
+            let Some((kind, textures)) = converted
+                .or_else(|| media.map(|_| (MaterialKind::Interface(scene::Interface), None)))
+            else {
                 continue;
             };
             let emission = match &shape.state.area {
@@ -139,6 +144,11 @@ impl Parser {
                 textures,
             });
             let to_world = fix * shape.state.ctm;
+            let (triangles, spheres, cylinders) = (
+                builder.triangles.len(),
+                builder.spheres.len(),
+                builder.cylinders.len(),
+            );
             self.shape(
                 &mut builder,
                 shape,
@@ -146,6 +156,43 @@ impl Parser {
                 material,
                 emission.max_element() > 0.0,
             )?;
+            if let Some((inside, outside)) = media {
+                if builder.cylinders.len() > cylinders {
+                    return Err(self.err(
+                        shape.loc,
+                        "a cylinder cannot bound a medium (it is open); MediumInterface changes the medium here",
+                    ));
+                }
+                // pbrt's inside is behind the surface normal, fppm's interior behind the front
+                // face: the same side for meshes (their winding follows pbrt's normal). A sphere
+                // with ReverseOrientation has its normal inward, so its inside is the outer side.
+                if builder.spheres.len() > spheres {
+                    let (interior, exterior) = if shape.state.reverse {
+                        (outside, inside)
+                    } else {
+                        (inside, outside)
+                    };
+                    builder.media.shapes.push(scene::ShapeMedia {
+                        shape: scene::MediumShape::Sphere(spheres as u32),
+                        interior,
+                        exterior,
+                    });
+                }
+                if builder.triangles.len() > triangles {
+                    builder.media.shapes.push(scene::ShapeMedia {
+                        shape: scene::MediumShape::Triangles {
+                            start: triangles as u32,
+                            end: builder.triangles.len() as u32,
+                        },
+                        interior: inside,
+                        exterior: outside,
+                    });
+                }
+            }
+        }
+        builder.media.list = std::mem::take(&mut self.media);
+        if let Some((name, loc)) = self.camera_medium.take() {
+            builder.media.camera = self.medium_named(&name, loc)?;
         }
         for light in std::mem::take(&mut self.lights) {
             let p = light.params.clone();

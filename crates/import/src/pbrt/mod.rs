@@ -22,6 +22,7 @@
 mod build;
 mod loop_subdiv;
 mod materials;
+mod media;
 mod params;
 mod parser;
 mod shapes;
@@ -67,6 +68,9 @@ pub(crate) fn load_pbrt(path: &Path, options: &LoadOptions) -> Result<SceneDescr
         warnings: Vec::new(),
         include_stack: Vec::new(),
         active: Active::All,
+        media: Vec::new(),
+        medium_index: HashMap::new(),
+        camera_medium: None,
     };
     parser.parse_file(path, None)?;
     parser.build(path, options)
@@ -126,6 +130,17 @@ struct State {
     reverse: bool,
     material: MaterialRef,
     area: Option<AreaLight>,
+    /// `MediumInterface "inside" "outside"`: the media's names ("" is vacuum) and where it was
+    /// written, `None` before any.
+    media: Option<MediumNames>,
+}
+
+/// The names of a `MediumInterface` (an empty name is vacuum) and where it was written.
+#[derive(Clone, Debug)]
+struct MediumNames {
+    inside: String,
+    outside: String,
+    loc: Loc,
 }
 
 impl Default for State {
@@ -135,6 +150,7 @@ impl Default for State {
             reverse: false,
             material: MaterialRef::Default,
             area: None,
+            media: None,
         }
     }
 }
@@ -200,6 +216,12 @@ struct Parser {
     warnings: Vec<String>,
     include_stack: Vec<PathBuf>,
     active: Active,
+    /// `MakeNamedMedium`, in the order of definition.
+    media: Vec<scene::Medium>,
+    /// Index into `media` by name.
+    medium_index: HashMap<String, u32>,
+    /// The outside medium's name at the `Camera` directive (pbrt-v4's camera medium).
+    camera_medium: Option<(String, Loc)>,
 }
 
 fn err_at(files: &[PathBuf], loc: Loc, message: impl Into<String>) -> LoadError {

@@ -353,6 +353,12 @@ impl Parser {
                 let lens = self.float(&p, "lensradius")?.unwrap_or(0.0);
                 let focal = self.float(&p, "focaldistance")?.unwrap_or(1e6);
                 self.camera = Some((world_from_camera, fov, lens, focal));
+                // pbrt-v4: the camera sits in the current outside medium.
+                self.camera_medium = self
+                    .state
+                    .media
+                    .as_ref()
+                    .map(|m| (m.outside.clone(), m.loc));
             }
             "Film" => {
                 let _kind = self.string(tokens, i, loc, d)?;
@@ -404,15 +410,24 @@ impl Parser {
                     .insert("world".to_owned(), DMat4::IDENTITY);
             }
             "WorldEnd" => {}
-            "MakeNamedMedium" | "MediumInterface" => {
-                if d == "MakeNamedMedium" {
-                    return Err(self.err(loc, "participating media are not supported"));
-                }
-                // MediumInterface "inside" "outside" (or one name).
-                self.string(tokens, i, loc, d)?;
-                if matches!(tokens.get(*i).map(|t| &t.tok), Some(Tok::Str(_))) {
-                    *i += 1;
-                }
+            "MakeNamedMedium" => {
+                let name = self.string(tokens, i, loc, d)?;
+                let params = self.params(tokens, i)?;
+                self.named_medium(name, &params, loc)?;
+            }
+            "MediumInterface" => {
+                // MediumInterface "inside" "outside", or one name for both sides.
+                let inside = self.string(tokens, i, loc, d)?;
+                let outside = if matches!(tokens.get(*i).map(|t| &t.tok), Some(Tok::Str(_))) {
+                    self.string(tokens, i, loc, d)?
+                } else {
+                    inside.clone()
+                };
+                self.state.media = Some(MediumNames {
+                    inside,
+                    outside,
+                    loc,
+                });
             }
             "Material" => {
                 let kind = self.string(tokens, i, loc, d)?;

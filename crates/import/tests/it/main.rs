@@ -11,6 +11,7 @@ mod media;
 mod mitsuba;
 mod obj;
 mod pbrt;
+mod pbrt_media;
 mod rough_dielectric;
 mod shared_scenes;
 mod toml_scene;
