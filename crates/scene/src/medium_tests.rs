@@ -2,14 +2,11 @@
 //! the mean cosine g, the sampled directions' χ² against the density, and the homogeneous
 //! medium's transmittance.
 
-use std::f64::consts::PI as PI64;
-
 use glam::Vec3;
 
 use super::{HenyeyGreenstein, Medium};
-use crate::Frame;
-use crate::material::pdf_tests::{integrate, warped};
-use crate::test_util::{Rng, pearson_chi_square};
+use crate::material::pdf_tests::{directional_chi_square, integrate};
+use crate::test_util::Rng;
 
 const GS: [f32; 5] = [0.0, 0.3, -0.5, 0.85, -0.95];
 
@@ -49,17 +46,11 @@ fn phase_integrates_to_one_with_mean_cosine_g() {
 /// (t, φ) about the lobe's peak (θ = π t²), and the pdf each sample reports against `eval`.
 #[test]
 fn sampling_matches_the_density_chi_square() {
-    const N_T: usize = 24;
-    const N_PHI: usize = 24;
-    const SUB: usize = 8;
-    const N: u32 = 200_000;
     let wo = outgoing();
     for (k, g) in GS.into_iter().enumerate() {
         let hg = HenyeyGreenstein { g };
-        let frame = Frame::from_normal(peak(wo, g));
-        let mut observed = vec![0.0f64; N_T * N_PHI];
         let mut rng = Rng::new(40 + k as u64);
-        for _ in 0..N {
+        let draw = || {
             let s = hg.sample(wo, rng.vec2());
             assert!((s.incoming.length() - 1.0).abs() < 1e-4);
             let eval = hg.eval(wo, s.incoming);
@@ -68,32 +59,10 @@ fn sampling_matches_the_density_chi_square() {
                 "g {g}: pdf {} against eval {eval}",
                 s.pdf
             );
-            let l = frame.to_local(s.incoming);
-            let t = (f64::from(l.z.clamp(-1.0, 1.0)).acos() / PI64).sqrt();
-            let phi = f64::from(l.y).atan2(f64::from(l.x)).rem_euclid(2.0 * PI64);
-            let i = ((t * N_T as f64) as usize).min(N_T - 1);
-            let j = ((phi / (2.0 * PI64) * N_PHI as f64) as usize).min(N_PHI - 1);
-            observed[i * N_PHI + j] += 1.0;
-        }
-        let mut expected = vec![0.0f64; N_T * N_PHI];
-        for i in 0..N_T {
-            for j in 0..N_PHI {
-                let mut sum = 0.0;
-                for a in 0..SUB {
-                    let t = (i as f64 + (a as f64 + 0.5) / SUB as f64) / N_T as f64;
-                    let jacobian = 2.0 * PI64 * t * (PI64 * t * t).sin();
-                    for c in 0..SUB {
-                        let phi =
-                            2.0 * PI64 * (j as f64 + (c as f64 + 0.5) / SUB as f64) / N_PHI as f64;
-                        sum += f64::from(hg.eval(wo, warped(&frame, t, phi))) * jacobian;
-                    }
-                }
-                let cell = (1.0 / (N_T * SUB) as f64) * (2.0 * PI64 / (N_PHI * SUB) as f64);
-                expected[i * N_PHI + j] = sum * cell * f64::from(N);
-            }
-        }
-        let (chi2, dof) = pearson_chi_square(&observed, &expected, "phase samples");
-        let dof = dof as f64;
+            Some(s.incoming)
+        };
+        let (chi2, dof) =
+            directional_chi_square(peak(wo, g), draw, |wi| hg.eval(wo, wi), "phase samples");
         // Mean dof, standard deviation √(2 dof): allow 5 of them.
         let limit = dof + 5.0 * (2.0 * dof).sqrt();
         assert!(chi2 < limit, "g {g}: χ² {chi2:.1} with {dof} dof");

@@ -205,21 +205,35 @@ pub(super) fn chi_square(
     seed: u64,
     density: impl Fn(Vec3) -> f32,
 ) -> (f64, f64) {
+    let mut rng = Rng::new(seed);
+    let draw = || {
+        let s = b.sample(from, rng.f32(), rng.vec2(), TransportMode::Importance)?;
+        (!s.is_specular).then_some(s.incoming)
+    };
+    directional_chi_square(axis, draw, density, "sampled directions")
+}
+
+/// Pearson χ² of 200 000 draws of `draw` (a direction, or `None` for a draw that counts but
+/// lands nowhere, such as a delta lobe's) against `density`, over bins of (t, φ) about `axis`
+/// (θ = π t², 24 × 24) whose expectations integrate `density` by a midpoint rule of 8 × 8
+/// points; bins expecting fewer than 5 samples are pooled. Returns (χ², degrees of freedom).
+pub(crate) fn directional_chi_square(
+    axis: Vec3,
+    mut draw: impl FnMut() -> Option<Vec3>,
+    density: impl Fn(Vec3) -> f32,
+    what: &str,
+) -> (f64, f64) {
     const N_T: usize = 24;
     const N_PHI: usize = 24;
     const SUB: usize = 8;
     const N: u32 = 200_000;
     let frame = Frame::from_normal(axis);
     let mut observed = vec![0.0f64; N_T * N_PHI];
-    let mut rng = Rng::new(seed);
     for _ in 0..N {
-        let Some(s) = b.sample(from, rng.f32(), rng.vec2(), TransportMode::Importance) else {
+        let Some(incoming) = draw() else {
             continue;
         };
-        if s.is_specular {
-            continue;
-        }
-        let l = frame.to_local(s.incoming);
+        let l = frame.to_local(incoming);
         let t = (f64::from(l.z.clamp(-1.0, 1.0)).acos() / PI64).sqrt();
         let phi = f64::from(l.y).atan2(f64::from(l.x)).rem_euclid(2.0 * PI64);
         let i = ((t * N_T as f64) as usize).min(N_T - 1);
@@ -243,7 +257,7 @@ pub(super) fn chi_square(
             expected[i * N_PHI + j] = sum * cell * f64::from(N);
         }
     }
-    let (chi2, dof) = pearson_chi_square(&observed, &expected, "sampled directions");
+    let (chi2, dof) = pearson_chi_square(&observed, &expected, what);
     (chi2, dof as f64)
 }
 
