@@ -71,5 +71,6 @@ pub use medium::{
 pub use ray::{Hit, Primitive, Ray};
 pub use scene::{Scene, SceneError};
 pub use summary::{
-    Bounds, CameraSummary, LightCounts, MaterialSummary, SceneSummary, TextureSummary,
+    Bounds, CameraSummary, LightCounts, MaterialSummary, MediumSummary, SceneSummary,
+    TextureSummary,
 };

@@ -50,6 +50,32 @@ pub struct SceneSummary {
     /// The texture images, once each (left out of snapshots when there are none).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub textures: Vec<TextureSummary>,
+    /// The participating media, each with its coefficients and what it fills (left out of
+    /// snapshots when there are none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub media: Vec<MediumSummary>,
+}
+
+/// One participating medium of a [`SceneSummary`].
+#[derive(Clone, Debug, Serialize)]
+pub struct MediumSummary {
+    /// Name in the scene file.
+    pub name: String,
+    /// Absorption coefficient σa per channel.
+    #[serde(serialize_with = "rounded3")]
+    pub sigma_a: Vec3,
+    /// Scattering coefficient σs per channel.
+    #[serde(serialize_with = "rounded3")]
+    pub sigma_s: Vec3,
+    /// Henyey–Greenstein asymmetry.
+    #[serde(serialize_with = "rounded")]
+    pub g: f32,
+    /// Shapes (triangle ranges and spheres) with this medium on their interior side.
+    pub interior_of: usize,
+    /// Shapes with this medium on their exterior side.
+    pub exterior_of: usize,
+    /// Whether the camera sits in it.
+    pub around_camera: bool,
 }
 
 /// Number of delta lights of each kind.
@@ -280,7 +306,33 @@ impl SceneDescription {
             camera_framed: self.notes.camera_framed,
             warnings: self.notes.warnings.clone(),
             textures: summarize_textures(&self.materials),
+            media: self.summarize_media(),
         }
+    }
+
+    fn summarize_media(&self) -> Vec<MediumSummary> {
+        let media = &self.media;
+        let count = |i: usize, side: fn(&crate::ShapeMedia) -> Option<u32>| {
+            media
+                .shapes
+                .iter()
+                .filter(|s| side(s) == Some(i as u32))
+                .count()
+        };
+        media
+            .list
+            .iter()
+            .enumerate()
+            .map(|(i, m)| MediumSummary {
+                name: m.name.clone(),
+                sigma_a: m.sigma_a,
+                sigma_s: m.sigma_s,
+                g: m.g,
+                interior_of: count(i, |s| s.interior),
+                exterior_of: count(i, |s| s.exterior),
+                around_camera: media.camera == Some(i as u32),
+            })
+            .collect()
     }
 }
 
@@ -359,6 +411,26 @@ impl fmt::Display for SceneSummary {
                 write!(f, ", {} cylinders", m.cylinders)?;
             }
             writeln!(f, ")")?;
+        }
+        if !self.media.is_empty() {
+            writeln!(f, "media      {}", self.media.len())?;
+            for m in &self.media {
+                writeln!(
+                    f,
+                    "  {:?} homogeneous sigma_a {} sigma_s {} g {} (interior of {}, exterior of {} shapes{})",
+                    m.name,
+                    Show3(m.sigma_a),
+                    Show3(m.sigma_s),
+                    Show(m.g),
+                    m.interior_of,
+                    m.exterior_of,
+                    if m.around_camera {
+                        "; around the camera"
+                    } else {
+                        ""
+                    }
+                )?;
+            }
         }
         if !self.textures.is_empty() {
             let bytes: usize = self.textures.iter().map(|t| t.bytes).sum();

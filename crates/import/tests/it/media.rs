@@ -108,6 +108,32 @@ interior = "water"
         }
     );
     assert!(d.has_media());
+    // `fppm info` lists each medium with what it fills: water inside the sphere and the cube,
+    // air outside the sphere and around the camera.
+    let summary = d.summary();
+    let media: Vec<_> = summary
+        .media
+        .iter()
+        .map(|m| {
+            (
+                m.name.as_str(),
+                m.interior_of,
+                m.exterior_of,
+                m.around_camera,
+            )
+        })
+        .collect();
+    assert_eq!(media, [("air", 0, 1, true), ("water", 2, 0, false)]);
+    let shown = summary.to_string();
+    assert!(shown.contains("media      2\n"), "{shown}");
+    assert!(
+        shown.contains(
+            "\"water\" homogeneous sigma_a [0.3, 0.1, 0.05] sigma_s [0.2, 0.2, 0.2] g 0.9 \
+             (interior of 2, exterior of 0 shapes)"
+        ),
+        "{shown}"
+    );
+    assert!(shown.contains("(interior of 0, exterior of 1 shapes; around the camera)"));
     let boundary = d.materials.iter().find(|m| m.name == "boundary").unwrap();
     assert_eq!(boundary.kind, MaterialKind::Interface(scene::Interface));
     assert_eq!(boundary.kind.name(), "interface");
