@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use glam::Vec2;
 use rayon::prelude::*;
-use scene::{Bsdf, BsdfSample, Hit, Ray, Rgb, Scene, TransportMode};
+use scene::{Bsdf, BsdfSample, Hit, LightSample, Ray, Rgb, Scene, TransportMode};
 
 use crate::checkpoint::codec::{Reader, StateError, Writer};
 use crate::integrator::Integrator;
@@ -141,14 +141,7 @@ impl PathTracer {
                 break;
             };
             beta *= sample.weight;
-            if depth + 1 >= self.params.budget.rr_depth {
-                let survive = beta.max_element().min(1.0);
-                if survive <= 0.0 || u_roulette >= survive {
-                    break;
-                }
-                beta /= survive;
-            }
-            if beta == Rgb::ZERO || !beta.is_finite() {
+            if !roulette(&mut beta, depth, &self.params, u_roulette) {
                 break;
             }
             let ray = hit.spawn_ray(sample.incoming);
@@ -187,13 +180,37 @@ pub(crate) fn next_event(
     u_light: f32,
     u: Vec2,
 ) -> Rgb {
+    next_event_through(scene, hit, bsdf, outgoing, u_light, u, |sample| {
+        if scene.light_visible(hit, sample) {
+            Rgb::ONE
+        } else {
+            Rgb::ZERO
+        }
+    })
+}
+
+/// [`next_event`] with the light sample's visibility given by `transmittance` (one or zero
+/// without media; what the shadow ray lets through with them).
+fn next_event_through(
+    scene: &Scene,
+    hit: &Hit,
+    bsdf: &Bsdf,
+    outgoing: glam::Vec3,
+    u_light: f32,
+    u: Vec2,
+    transmittance: impl FnOnce(&LightSample) -> Rgb,
+) -> Rgb {
     let Some(sample) = scene
         .lights()
         .sample_direct(hit.position, hit.geometric_normal, u_light, u)
     else {
         return Rgb::ZERO;
     };
-    if sample.pdf.is_nan() || sample.pdf <= 0.0 || !scene.light_visible(hit, &sample) {
+    if sample.pdf.is_nan() || sample.pdf <= 0.0 {
+        return Rgb::ZERO;
+    }
+    let tr = transmittance(&sample);
+    if tr == Rgb::ZERO {
         return Rgb::ZERO;
     }
     let f = bsdf.eval(outgoing, sample.incoming);
@@ -206,7 +223,21 @@ pub(crate) fn next_event(
     } else {
         power_heuristic(sample.pdf, bsdf.pdf(outgoing, sample.incoming))
     };
-    f * sample.radiance * (cos * weight / sample.pdf)
+    f * tr * sample.radiance * (cos * weight / sample.pdf)
+}
+
+/// Russian roulette after a scattering event at `depth`: from `rr_depth` on, the path survives
+/// with the throughput's largest channel (at most one) and is divided by it; whether it goes on
+/// (a zero or non-finite throughput ends it too).
+fn roulette(beta: &mut Rgb, depth: u32, params: &RenderParams, u: f32) -> bool {
+    if depth + 1 >= params.budget.rr_depth {
+        let survive = beta.max_element().min(1.0);
+        if survive <= 0.0 || u >= survive {
+            return false;
+        }
+        *beta /= survive;
+    }
+    *beta != Rgb::ZERO && beta.is_finite()
 }
 
 /// The MIS weight of emission that BSDF sample `sample` at `hit` found along `ray`: at the

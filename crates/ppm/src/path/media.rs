@@ -20,7 +20,7 @@
 use glam::Vec3;
 use scene::{Hit, Ray, Rgb, Scene, TransportMode, medium_after};
 
-use super::power_heuristic;
+use super::{next_event_through, power_heuristic, roulette};
 use crate::params::RenderParams;
 use crate::rng::Sampler;
 
@@ -207,20 +207,6 @@ pub(super) fn trace(scene: &Scene, params: &RenderParams, ray: Ray, sampler: &mu
     radiance
 }
 
-/// Russian roulette after a scattering event at `depth` (the tracer's rule: from `rr_depth`
-/// on, survive with the throughput's largest channel, at most one, and divide by it); whether
-/// the path goes on.
-fn roulette(beta: &mut Rgb, depth: u32, params: &RenderParams, u: f32) -> bool {
-    if depth + 1 >= params.budget.rr_depth {
-        let survive = beta.max_element().min(1.0);
-        if survive <= 0.0 || u >= survive {
-            return false;
-        }
-        *beta /= survive;
-    }
-    *beta != Rgb::ZERO && beta.is_finite()
-}
-
 /// The shadow ray from a point in a medium toward a light sample at `distance` (∞ for an
 /// infinite light), stopping just short of a finite target as [`Hit::spawn_ray_to`] does.
 fn shadow_ray(origin: Vec3, direction: Vec3, distance: f32) -> Ray {
@@ -270,34 +256,13 @@ fn surface_next_event(
     u_light: f32,
     u: glam::Vec2,
 ) -> Rgb {
-    let Some(sample) = scene
-        .lights()
-        .sample_direct(hit.position, hit.geometric_normal, u_light, u)
-    else {
-        return Rgb::ZERO;
-    };
-    if sample.pdf.is_nan() || sample.pdf <= 0.0 {
-        return Rgb::ZERO;
-    }
-    let f = bsdf.eval(outgoing, sample.incoming);
-    if f == Rgb::ZERO {
-        return Rgb::ZERO;
-    }
-    let shadow = if sample.distance.is_finite() {
-        hit.spawn_ray_to(hit.position + sample.incoming * sample.distance)
-    } else {
-        hit.spawn_ray(sample.incoming)
-    };
-    let start = medium_after(scene.shape_media(hit), hit, sample.incoming, medium);
-    let tr = transmittance(scene, shadow, start);
-    if tr == Rgb::ZERO {
-        return Rgb::ZERO;
-    }
-    let cos = sample.incoming.dot(hit.shading_normal).abs();
-    let weight = if sample.is_delta {
-        1.0
-    } else {
-        power_heuristic(sample.pdf, bsdf.pdf(outgoing, sample.incoming))
-    };
-    f * tr * sample.radiance * (cos * weight / sample.pdf)
+    next_event_through(scene, hit, bsdf, outgoing, u_light, u, |sample| {
+        let shadow = if sample.distance.is_finite() {
+            hit.spawn_ray_to(hit.position + sample.incoming * sample.distance)
+        } else {
+            hit.spawn_ray(sample.incoming)
+        };
+        let start = medium_after(scene.shape_media(hit), hit, sample.incoming, medium);
+        transmittance(scene, shadow, start)
+    })
 }
