@@ -37,7 +37,10 @@ pub(crate) fn render(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Result<
 /// (media) is a usage error (exit 2), every other problem a render error.
 pub(crate) fn renderer_error(path: &Path, e: ppm::ParamError) -> anyhow::Error {
     let message = format!("{}: {e}", path.display());
-    if matches!(e, ppm::ParamError::MediaUnsupported { .. }) {
+    if matches!(
+        e,
+        ppm::ParamError::MediaUnsupported { .. } | ppm::ParamError::MediaDirectLighting
+    ) {
         anyhow::Error::new(crate::UsageError(message))
     } else {
         anyhow::anyhow!(message)

@@ -150,6 +150,22 @@ pub(crate) fn lens_radiance(
     power: Rgb,
     connection: &LensConnection,
 ) -> Option<Rgb> {
+    lens_radiance_through(hit, bsdf, incoming, power, connection, |lens| {
+        scene.visible(hit, lens).then_some(Rgb::ONE)
+    })
+}
+
+/// [`lens_radiance`] with the visibility of the lens point given by `transmittance`: the
+/// fraction of light that reaches it (`None` or zero where none does), for scenes with media.
+#[inline]
+pub(crate) fn lens_radiance_through(
+    hit: &Hit,
+    bsdf: &Bsdf,
+    incoming: Vec3,
+    power: Rgb,
+    connection: &LensConnection,
+    transmittance: impl FnOnce(Vec3) -> Option<Rgb>,
+) -> Option<Rgb> {
     let to_lens = connection.lens - hit.position;
     let distance = to_lens.length();
     if distance.is_nan() || distance <= 0.0 {
@@ -157,11 +173,12 @@ pub(crate) fn lens_radiance(
     }
     let toward = to_lens / distance;
     let f = bsdf.eval(toward, incoming);
-    if f == Rgb::ZERO || !scene.visible(hit, connection.lens) {
+    if f == Rgb::ZERO {
         return None;
     }
+    let tr = transmittance(connection.lens).filter(|&tr| tr != Rgb::ZERO)?;
     let cos = toward.dot(hit.geometric_normal).abs();
-    Some(f * power * (cos * connection.density))
+    Some(f * power * tr * (cos * connection.density))
 }
 
 /// Veach's correction for shading normals on light paths (thesis §5.3; pbrt's
@@ -181,6 +198,6 @@ fn shading_normal_correction(hit: &Hit, from: Vec3, to: Vec3) -> f32 {
     }
 }
 
-fn luminance(c: Rgb) -> f32 {
+pub(crate) fn luminance(c: Rgb) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
 }

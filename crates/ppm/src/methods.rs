@@ -35,7 +35,7 @@ fn entry(method: Method) -> Entry {
             estimate: |pixels, params| {
                 photon_mapper::estimate(pixels, params, params.method.uses_frequency())
             },
-            media: false,
+            media: true,
         },
         Method::Appm => Entry {
             build: |scene, params| Ok(Box::new(PassIndependent::new(scene, params)?)),
@@ -71,7 +71,7 @@ pub(crate) fn integrator(
     params: RenderParams,
 ) -> Result<Box<dyn Integrator>, ParamError> {
     params.validate()?;
-    check_media(&scene, params.method)?;
+    check_media(&scene, &params)?;
     (entry(params.method).build)(scene, params)
 }
 
@@ -80,10 +80,16 @@ pub(crate) fn integrator(
 ///
 /// # Errors
 ///
-/// [`ParamError::MediaUnsupported`] for such a scene and method.
-pub(crate) fn check_media(scene: &Scene, method: Method) -> Result<(), ParamError> {
+/// [`ParamError::MediaUnsupported`] for such a scene and method, and
+/// [`ParamError::MediaDirectLighting`] for the photon mappers' `direct_lighting` in it (its
+/// light samples do not yet weigh the transmittance).
+pub(crate) fn check_media(scene: &Scene, params: &RenderParams) -> Result<(), ParamError> {
+    let method = params.method;
     if scene.has_media() && !entry(method).media {
         return Err(ParamError::MediaUnsupported { method });
+    }
+    if scene.has_media() && method != Method::Path && params.connections.direct_lighting {
+        return Err(ParamError::MediaDirectLighting);
     }
     Ok(())
 }

@@ -17,6 +17,7 @@ use crate::rng::Sampler;
 use crate::stats::{MemoryEstimate, PassStats};
 
 mod media;
+pub(crate) use self::media::{MAX_CROSSINGS, transmittance};
 
 /// Pixels per parallel work item; fixed so the work split does not depend on the thread count.
 const PIXEL_CHUNK: usize = 256;

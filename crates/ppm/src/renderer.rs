@@ -52,7 +52,7 @@ impl Renderer {
     ) -> Result<Vec<f64>, ParamError> {
         let scene = scene.into();
         params.validate()?;
-        crate::methods::check_media(&scene, params.method)?;
+        crate::methods::check_media(&scene, &params)?;
         if matches!(params.method, Method::Vcm | Method::Bdpt) {
             return Ok(Vec::new());
         }
@@ -76,7 +76,7 @@ impl Renderer {
         first_pass: u32,
     ) -> Result<Self, ParamError> {
         let scene = scene.into();
-        crate::methods::check_media(&scene, params.method)?;
+        crate::methods::check_media(&scene, &params)?;
         let integrator: Box<dyn Integrator> = if matches!(params.method, Method::Vcm | Method::Bdpt)
         {
             if !kernels.is_empty() {

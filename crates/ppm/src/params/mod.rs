@@ -345,12 +345,17 @@ pub enum ParamError {
     },
     /// The scene has participating media, which this method does not render (`docs/media.md`).
     #[error(
-        "the scene has participating media, which only the path tracer renders: use --method path, not {method}"
+        "the scene has participating media, which {method} does not render: use the default method, sppm, ppm or path"
     )]
     MediaUnsupported {
         /// The method asked for.
         method: Method,
     },
+    /// `direct_lighting` in a scene with media, which its light samples do not render.
+    #[error(
+        "direct_lighting is not available in a scene with participating media: leave it off (photons carry the direct light)"
+    )]
+    MediaDirectLighting,
     /// The kernels of a pass-independent render are not one positive radius per slot.
     #[error("the kernels hold {found} radii for {expected} hitpoint slots, or one is not positive")]
     BadKernels {

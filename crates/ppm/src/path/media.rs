@@ -27,7 +27,7 @@ use crate::rng::Sampler;
 /// At most this many interfaces are crossed between two scattering events (or along one
 /// shadow ray); a path beyond it ends. It only guards against a ray caught between coincident
 /// surfaces: real scenes never come near it.
-const MAX_CROSSINGS: u32 = 256;
+pub(crate) const MAX_CROSSINGS: u32 = 256;
 
 /// The vertex a path last scattered at, for the MIS weight of emission found after it.
 #[derive(Clone, Copy)]
@@ -219,7 +219,7 @@ fn shadow_ray(origin: Vec3, direction: Vec3, distance: f32) -> Ray {
 
 /// The transmittance along `ray` (to its `t_max`) starting in `medium`: the product of each
 /// medium's over its stretch, through interfaces; zero if any other surface is in the way.
-fn transmittance(scene: &Scene, mut ray: Ray, mut medium: Option<u32>) -> Rgb {
+pub(crate) fn transmittance(scene: &Scene, mut ray: Ray, mut medium: Option<u32>) -> Rgb {
     let media = &scene.media().list;
     let target = ray.t_max.is_finite().then(|| ray.at(ray.t_max));
     let mut tr = Rgb::ONE;

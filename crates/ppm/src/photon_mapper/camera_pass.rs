@@ -5,11 +5,12 @@
 use glam::{Vec2, Vec3};
 use photon::{HitPoints, NewHitPoint};
 use rayon::prelude::*;
-use scene::{Bsdf, Hit, Rgb, TransportMode};
+use scene::{Bsdf, Hit, Rgb, TransportMode, medium_after};
 
 use super::frequency::SlotFrequency;
+use super::volume::Segment;
 use super::{NO_VISIBLE_POINT, PhotonMapper, SLOT_CHUNK, Setup};
-use crate::path::{bsdf_emission_weight, next_event};
+use crate::path::{MAX_CROSSINGS, bsdf_emission_weight, next_event};
 use crate::rng::{CAMERA_STREAM, Sampler};
 
 /// A camera path up to its first non-specular hit ([`PhotonMapper::camera_chain`]).
@@ -34,13 +35,15 @@ pub(crate) struct ChainEnd {
 }
 
 /// What one camera path produced.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 struct CameraSample {
     /// Emission seen along the path (and direct lighting), already weighted by 1/spp.
     direct: Rgb,
     visible: Option<VisiblePoint>,
     /// Values dropped for being NaN or infinite: the direct sum, the visible point's weight.
     non_finite: u64,
+    /// Its stretches through media, for the volume gather (empty without media).
+    segments: Vec<Segment>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -73,6 +76,17 @@ impl PhotonMapper {
         let first = self.slots.is_empty();
         let pass = self.pass;
         if !update_hitpoints && !first {
+            if setup.scene.has_media() && !self.volume.segments_traced {
+                // A restored PPM render: its visible points' stretches through media, as the
+                // first pass traced them.
+                let segments: Vec<Vec<Segment>> = (0..n_slots)
+                    .into_par_iter()
+                    .with_min_len(SLOT_CHUNK)
+                    .map(|slot| setup.trace_camera_path(slot as u32, 0, true).segments)
+                    .collect();
+                self.volume.segments = segments.concat();
+                self.volume.segments_traced = true;
+            }
             // Only the directly seen emission changes: accumulate it in place, in parallel.
             let non_finite = self
                 .direct
@@ -80,7 +94,7 @@ impl PhotonMapper {
                 .enumerate()
                 .with_min_len(SLOT_CHUNK)
                 .map(|(slot, sum)| {
-                    let sample = setup.trace_camera_path(slot as u32, pass);
+                    let sample = setup.trace_camera_path(slot as u32, pass, false);
                     for (c, sum) in sum.iter_mut().enumerate() {
                         *sum += f64::from(sample.direct[c]);
                     }
@@ -93,7 +107,7 @@ impl PhotonMapper {
         let traced: Vec<CameraSample> = (0..n_slots)
             .into_par_iter()
             .with_min_len(SLOT_CHUNK)
-            .map(|slot| setup.trace_camera_path(slot as u32, pass))
+            .map(|slot| setup.trace_camera_path(slot as u32, pass, true))
             .collect();
         if first {
             self.slots = HitPoints::with_capacity(n_slots);
@@ -107,8 +121,11 @@ impl PhotonMapper {
         // bits, whatever the thread count (this loop is serial).
         let inv_passes = 1.0 / self.weight_passes as f32;
         let mut non_finite = 0;
+        self.volume.segments.clear();
+        self.volume.segments_traced = true;
         for (slot, sample) in traced.into_iter().enumerate() {
             non_finite += sample.non_finite;
+            self.volume.segments.extend_from_slice(&sample.segments);
             for c in 0..3 {
                 self.direct[slot][c] += f64::from(sample.direct[c]);
             }
@@ -160,9 +177,16 @@ impl PhotonMapper {
 }
 
 impl Setup {
-    fn trace_camera_path(&self, slot: u32, pass: u32) -> CameraSample {
+    /// The camera path of `slot` in `pass`: what it sees directly and its visible point, and
+    /// with `segments` (in a scene with media) its stretches through media.
+    fn trace_camera_path(&self, slot: u32, pass: u32, segments: bool) -> CameraSample {
         let weight_scale = 1.0 / self.params.film.samples_per_pixel as f32;
-        let chain = self.camera_chain(slot, pass);
+        let mut stretches = Vec::new();
+        let chain = self.camera_chain_in_media(
+            slot,
+            pass,
+            (segments && self.scene.has_media()).then_some(&mut stretches),
+        );
         let mut direct = chain.direct;
         let mut non_finite = 0;
         let visible = chain.end.and_then(|mut end| {
@@ -219,6 +243,7 @@ impl Setup {
             direct,
             visible,
             non_finite,
+            segments: stretches,
         }
     }
 
@@ -234,6 +259,19 @@ impl Setup {
     }
 
     fn camera_chain(&self, slot: u32, pass: u32) -> CameraChain {
+        self.camera_chain_in_media(slot, pass, None)
+    }
+
+    /// [`Setup::camera_chain`], which in a scene with media also crosses interfaces, weights
+    /// the path by the transmittance of every stretch through a medium and, with `segments`,
+    /// records those stretches for the volume gather (`volume.rs`). The camera path does not
+    /// scatter in media: what media scatter toward it is the volume photons' part.
+    fn camera_chain_in_media(
+        &self,
+        slot: u32,
+        pass: u32,
+        mut segments: Option<&mut Vec<Segment>>,
+    ) -> CameraChain {
         let spp = self.params.film.samples_per_pixel;
         let pixel = slot / spp;
         let (x, y) = (pixel % self.width, pixel / self.width);
@@ -242,17 +280,53 @@ impl Setup {
         let mut ray = self.scene.camera().generate_ray(film, sampler.next_2d());
         let mut throughput = Rgb::ONE;
         let mut direct = Rgb::ZERO;
+        let max_depth = self.params.budget.max_depth;
+        let has_media = self.scene.has_media();
+        let mut medium = if has_media {
+            self.scene.media().camera
+        } else {
+            None
+        };
+        let mut crossings = 0;
         // `bounces`: scattering events of the camera path before this hit. Emission seen here
         // ends a light path with that many; a hitpoint adds one (its own scattering) to the
         // photon's, so it needs bounces < max_depth.
-        for bounces in 0..=self.params.budget.max_depth {
-            let Some(hit) = self.scene.intersect(&ray) else {
+        let mut bounces = 0;
+        loop {
+            let hit = self.scene.intersect(&ray);
+            if let Some(m) = medium.and_then(|m| self.scene.media().list.get(m as usize)) {
+                let t = hit.map_or(f32::INFINITY, |h| h.t);
+                if let Some(segments) = segments.as_deref_mut()
+                    && bounces < max_depth
+                {
+                    segments.push(Segment {
+                        origin: ray.origin,
+                        direction: ray.direction.normalize(),
+                        t_max: t,
+                        medium: medium.unwrap_or_default(),
+                        budget: max_depth - 1 - bounces,
+                        slot,
+                        weight: throughput,
+                    });
+                }
+                throughput *= m.transmittance(t);
+            }
+            let Some(hit) = hit else {
                 // An escaped camera path sees the environment (zero without one).
                 direct += throughput * self.scene.lights().environment_radiance(ray.direction);
                 break;
             };
+            if has_media && self.scene.is_interface(&hit) {
+                crossings += 1;
+                if crossings > MAX_CROSSINGS {
+                    break;
+                }
+                medium = medium_after(self.scene.shape_media(&hit), &hit, ray.direction, medium);
+                ray = hit.spawn_ray(ray.direction);
+                continue;
+            }
             direct += throughput * self.scene.emitted(&hit);
-            if bounces == self.params.budget.max_depth {
+            if bounces == max_depth {
                 break;
             }
             let Some(material) = self.scene.material(hit.material) else {
@@ -270,7 +344,13 @@ impl Setup {
                 if throughput == Rgb::ZERO {
                     break;
                 }
+                if has_media {
+                    medium =
+                        medium_after(self.scene.shape_media(&hit), &hit, sample.incoming, medium);
+                    crossings = 0;
+                }
                 ray = hit.spawn_ray(sample.incoming);
+                bounces += 1;
                 continue;
             }
             return CameraChain {

@@ -80,15 +80,17 @@ impl PhotonMapper {
         use std::mem::size_of;
         let (photon_buffers, hitpoint_buffers) = self.photons.heap_bytes();
         let (frequency_records, frequency_per_entry) = self.frequency.heap_bytes();
+        let (volume_pass, volume_sums) = self.volume.heap_bytes();
         MemoryUse {
             hitpoints: self.slots.len(),
             records: self.slots.heap_bytes(),
             slot_columns: self.photon_bounces.capacity() * size_of::<u16>()
                 + self.direct.capacity() * size_of::<[f64; 3]>()
-                + self.mean_weight.capacity() * size_of::<glam::Vec3>(),
+                + self.mean_weight.capacity() * size_of::<glam::Vec3>()
+                + volume_sums,
             grid: self.index.heap_bytes(),
             pass_hitpoint_buffers: hitpoint_buffers + frequency_per_entry,
-            pass_photon_buffers: photon_buffers + frequency_records,
+            pass_photon_buffers: photon_buffers + frequency_records + volume_pass,
         }
     }
 }

@@ -17,6 +17,7 @@
 mod camera_pass;
 mod frequency;
 mod index;
+mod media;
 mod memory;
 mod photon_pass;
 mod pool;
@@ -25,6 +26,7 @@ mod state;
 mod tests;
 mod trace;
 mod update;
+mod volume;
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -94,6 +96,8 @@ pub(crate) struct PhotonMapper {
     /// function of the scene, the parameters and the pass, recomputed where missing (after a
     /// restore), so that it is not part of a checkpoint.
     block_discs: Vec<Option<frequency::BlockDisc>>,
+    /// The volume photons' gather, in a scene with media (`volume.rs`).
+    volume: volume::Volume,
 }
 
 /// `photon_bounces` of a slot without a visible point (budgets are below `max_depth` ≤ 1024).
@@ -161,6 +165,7 @@ impl PhotonMapper {
             photons: PhotonPass::default(),
             frequency: FrequencyDeposits::default(),
             block_discs: Vec::new(),
+            volume: volume::Volume::default(),
         })
     }
 
@@ -283,6 +288,9 @@ impl PhotonMapper {
         );
         let index = clock.elapsed().as_secs_f64() - camera;
         self.photon_pass(&mut stats);
+        if self.setup.scene.has_media() {
+            stats.non_finite += self.volume_gather();
+        }
         let photons_done = clock.elapsed().as_secs_f64();
         after_photons(self, &mut stats);
         let timings = &mut stats.timings;
@@ -292,6 +300,20 @@ impl PhotonMapper {
         timings.update = clock.elapsed().as_secs_f64() - photons_done;
         self.pass += 1;
         stats
+    }
+
+    /// Gathers the pass's volume photons into the camera paths' stretches through media;
+    /// returns the contributions dropped for being NaN or infinite.
+    fn volume_gather(&mut self) -> u64 {
+        let setup = &self.setup;
+        self.volume.gather_pass(
+            &setup.scene,
+            self.photons.traced.iter().map(|t| t.volume.as_slice()),
+            (setup.kernel_scale, setup.params.kernel.alpha),
+            u64::from(setup.params.budget.photons_per_pass),
+            setup.params.film.samples_per_pixel,
+            self.n_slots(),
+        )
     }
 
     /// A per-slot quantity averaged over each pixel's valid slots: radius, photon count,
@@ -393,6 +415,7 @@ impl Integrator for PhotonMapper {
         // Times a reciprocal: three f64 quotients a pixel were a tenth of a pooled read-out.
         let per_camera_pass = 1.0 / f64::from(self.camera_passes.max(1));
         let width = self.setup.width as usize;
+        let has_media = self.setup.scene.has_media();
         // Band by band, each pixel's slots summed in f64: the image is the only image-sized
         // buffer a read-out writes.
         self.pool_bands(&mut image, width, |first_slot, band, photons, _| {
@@ -400,9 +423,17 @@ impl Integrator for PhotonMapper {
             for (pixel, out) in band.iter_mut().enumerate() {
                 let slots = pixel * spp..(pixel + 1) * spp;
                 let mut sum = [0.0f64; 3];
-                for (photons, direct) in photons[slots.clone()].iter().zip(&direct[slots]) {
+                for (photons, direct) in photons[slots.clone()].iter().zip(&direct[slots.clone()]) {
                     for c in 0..3 {
                         sum[c] += photons[c] + direct[c] * per_camera_pass;
+                    }
+                }
+                if has_media {
+                    for slot in slots {
+                        let volume = self.volume.radiance(first_slot + slot);
+                        for c in 0..3 {
+                            sum[c] += volume[c];
+                        }
                     }
                 }
                 *out = sum.map(|v| v as f32);

@@ -71,6 +71,7 @@ impl PhotonPass {
                 t.photons.capacity() * size_of::<Photon>()
                     + t.frequency.capacity() * size_of::<FrequencyPhoton>()
                     + t.splats.capacity() * size_of::<(u32, [f32; 3])>()
+                    + t.volume.capacity() * size_of::<super::volume::VolumePhoton>()
             })
             .sum::<usize>()
             + (self.traced.capacity() + self.connect_only.capacity()) * size_of::<TracedPhotons>();
@@ -105,6 +106,7 @@ impl PhotonMapper {
             .frequency
             .layout(n_chunks, setup.params.budget.max_depth);
         let textured_hits = setup.scene.textured_hits();
+        let has_media = setup.scene.has_media();
         let connect_only = setup.params.connect_only_paths();
         let light = setup
             .params
@@ -134,10 +136,19 @@ impl PhotonMapper {
                     let tag_base = layout.chunk_base(chunk);
                     for idx in start..end {
                         let index = first_index + idx;
-                        if textured_hits {
-                            setup.trace_photon::<true, true>(pass, index, tag_base, light, out);
-                        } else {
-                            setup.trace_photon::<false, true>(pass, index, tag_base, light, out);
+                        match (textured_hits, has_media) {
+                            (true, true) => setup.trace_photon::<true, true, true>(
+                                pass, index, tag_base, light, out,
+                            ),
+                            (true, false) => setup.trace_photon::<true, true, false>(
+                                pass, index, tag_base, light, out,
+                            ),
+                            (false, true) => setup.trace_photon::<false, true, true>(
+                                pass, index, tag_base, light, out,
+                            ),
+                            (false, false) => setup.trace_photon::<false, true, false>(
+                                pass, index, tag_base, light, out,
+                            ),
                         }
                     }
                 } else {
@@ -145,10 +156,20 @@ impl PhotonMapper {
                     let end = (start + PHOTON_CHUNK).min(connect_only);
                     for idx in start..end {
                         let index = CONNECT_ONLY_STREAM | idx;
-                        if textured_hits {
-                            setup.trace_photon::<true, false>(pass, index, 0, light, out);
-                        } else {
-                            setup.trace_photon::<false, false>(pass, index, 0, light, out);
+                        match (textured_hits, has_media) {
+                            (true, true) => {
+                                setup.trace_photon::<true, false, true>(pass, index, 0, light, out);
+                            }
+                            (true, false) => {
+                                setup
+                                    .trace_photon::<true, false, false>(pass, index, 0, light, out);
+                            }
+                            (false, true) => {
+                                setup
+                                    .trace_photon::<false, false, true>(pass, index, 0, light, out);
+                            }
+                            (false, false) => setup
+                                .trace_photon::<false, false, false>(pass, index, 0, light, out),
                         }
                     }
                 }

@@ -1,6 +1,6 @@
 //! What a checkpoint keeps of a photon mapper: every hitpoint slot's record, its photon-bounce
-//! budget, directly seen emission and mean visible-point weight, and the photon and camera-pass
-//! counts.
+//! budget, directly seen emission and mean visible-point weight, the photon and camera-pass
+//! counts, and in a scene with media the volume gather's sums.
 
 use glam::Vec3;
 use photon::{HitPoints, NewHitPoint};
@@ -15,7 +15,7 @@ const SLOT_RECORD_MAX: usize = 5 * 12 + 4 + 4 + 8 + 8 + 24 + 4 + 4 + 4 + 4 + 32 
 
 /// The most bytes [`PhotonMapper::write_state`] writes for `n_slots` slots.
 pub(super) fn bound(n_slots: usize) -> usize {
-    8 + 4 + 4 + 8 + n_slots.saturating_mul(SLOT_RECORD_MAX)
+    8 + 4 + 4 + 8 + n_slots.saturating_mul(SLOT_RECORD_MAX) + 4 + 8 + n_slots.saturating_mul(24)
 }
 
 impl PhotonMapper {
@@ -69,6 +69,12 @@ impl PhotonMapper {
             });
             p.direct[i].iter().for_each(|&c| w.f64(c));
             p.mean_weight[i].to_array().iter().for_each(|&c| w.f32(c));
+        }
+        // The volume gather's sums (none without media); its radius follows from the count.
+        w.u32(p.volume.gathers);
+        w.u64(p.volume.sum.len() as u64);
+        for sum in &p.volume.sum {
+            sum.iter().for_each(|&c| w.f64(c));
         }
     }
 
@@ -156,6 +162,17 @@ impl PhotonMapper {
             columns.photon_count[i] = photon_count;
             columns.flux[i] = flux;
         }
+        let gathers = r.u32()?;
+        let n_volume = r.len()?;
+        if gathers > passes || (n_volume != 0 && n_volume != n) {
+            return Err(StateError::Corrupt);
+        }
+        let mut volume_sum = Vec::with_capacity(n_volume);
+        for _ in 0..n_volume {
+            volume_sum.push([r.f64()?, r.f64()?, r.f64()?]);
+        }
+        p.volume.gathers = gathers;
+        p.volume.sum = volume_sum;
         p.pass = passes;
         p.n_emitted = n_emitted;
         p.camera_passes = camera_passes;

@@ -3,11 +3,14 @@
 
 use glam::Vec3;
 use photon::Photon;
-use scene::{Bsdf, Hit, Rgb};
+use scene::{Bsdf, Hit, Rgb, medium_after};
 
 use super::Setup;
 use super::frequency::{FrequencyPhoton, arrived, scatter_spectrum};
-use crate::light_path::{Scatter, emit, lens_point, lens_radiance, scatter};
+use super::media::Flight;
+use super::volume::VolumePhoton;
+use crate::light_path::{Scatter, emit, lens_point, lens_radiance, lens_radiance_through, scatter};
+use crate::path::{MAX_CROSSINGS, transmittance};
 use crate::rng::Sampler;
 
 /// Photons of one chunk, in trace order.
@@ -26,6 +29,8 @@ pub(super) struct TracedPhotons {
     pub(super) splats: Vec<(u32, [f32; 3])>,
     /// Photons connected to the camera.
     pub(super) connections: u64,
+    /// Photons stored where they scattered in a medium (`volume.rs`), in trace order.
+    pub(super) volume: Vec<VolumePhoton>,
 }
 
 /// What light tracing needs of the current pass: every slot's gather radius, which its MIS
@@ -80,6 +85,7 @@ impl TracedPhotons {
         self.non_finite = 0;
         self.splats.clear();
         self.connections = 0;
+        self.volume.clear();
     }
 }
 
@@ -101,8 +107,13 @@ impl Setup {
     /// scene keeps the texture work of hits out of the untextured one. Not inlined itself (one
     /// call per path), so that it stays visible in profiles; docs/performance.md says where
     /// its time goes.
+    ///
+    /// `MEDIA` must be the scene's `Scene::has_media`: in media the path draws free flights
+    /// (`media.rs`), stores a volume photon where it scatters, and crosses interfaces without a
+    /// bounce; a frequency photon loses its spectrum when it scatters in a medium or crosses an
+    /// interface (the spectrum's operators for media are not implemented).
     #[inline(never)]
-    pub(super) fn trace_photon<const TEXTURED_HITS: bool, const STORE: bool>(
+    pub(super) fn trace_photon<const TEXTURED_HITS: bool, const STORE: bool, const MEDIA: bool>(
         &self,
         pass: u32,
         index: u64,
@@ -131,12 +142,69 @@ impl Setup {
         let max_depth = self.params.budget.max_depth;
         let rr_depth = self.params.budget.rr_depth;
         let direct_lighting = self.params.connections.direct_lighting;
+        let mut medium = if MEDIA {
+            self.medium_at(ray.origin)
+        } else {
+            None
+        };
+        let mut crossings = 0;
         // `depth`: the photon's bounces before this hit. A hitpoint adds one more, so hits at
         // depth max_depth − 1 are the last that can count.
-        for depth in 0..max_depth {
-            let Some(hit) = self.scene.intersect_inlined::<TEXTURED_HITS>(&ray) else {
+        let mut depth = 0;
+        while depth < max_depth {
+            let hit = self.scene.intersect_inlined::<TEXTURED_HITS>(&ray);
+            if MEDIA && let Some(id) = medium {
+                match self.fly(id, &ray, hit.as_ref(), power, &mut sampler) {
+                    Flight::Through(p) => power = p,
+                    Flight::End => break,
+                    Flight::NonFinite => {
+                        out.non_finite += 1;
+                        break;
+                    }
+                    Flight::Scatter { position, power: p } => {
+                        spectrum = None;
+                        if STORE {
+                            out.volume.push(VolumePhoton {
+                                position,
+                                incoming: -ray.direction,
+                                power: p,
+                                medium: id,
+                                bounces: depth,
+                            });
+                        }
+                        if depth + 1 == max_depth {
+                            break;
+                        }
+                        let Some(next) = self.scatter_in_medium(
+                            id,
+                            &ray,
+                            position,
+                            (power, p),
+                            depth + 1 >= rr_depth,
+                            &mut sampler,
+                        ) else {
+                            break;
+                        };
+                        (ray, power) = next;
+                        depth += 1;
+                        crossings = 0;
+                        continue;
+                    }
+                }
+            }
+            let Some(hit) = hit else {
                 break;
             };
+            if MEDIA && self.scene.is_interface(&hit) {
+                crossings += 1;
+                if crossings > MAX_CROSSINGS {
+                    break;
+                }
+                spectrum = None;
+                medium = medium_after(self.scene.shape_media(&hit), &hit, ray.direction, medium);
+                ray = hit.spawn_ray(ray.direction);
+                continue;
+            }
             let Some(material) = self.scene.material(hit.material) else {
                 break;
             };
@@ -152,8 +220,8 @@ impl Setup {
             let counted_by_light_sampling = direct_lighting && depth == 0;
             if !bsdf.is_specular() && !counted_by_light_sampling && !STORE {
                 if let Some(light) = light {
-                    self.connect_to_camera(
-                        &hit, &bsdf, incoming, power, &sampler, depth, light, out,
+                    self.connect_to_camera::<MEDIA>(
+                        &hit, &bsdf, incoming, power, medium, &sampler, depth, light, out,
                     );
                 }
             } else if !bsdf.is_specular() && !counted_by_light_sampling {
@@ -175,8 +243,8 @@ impl Setup {
                     tag,
                 });
                 if let Some(light) = light {
-                    self.connect_to_camera(
-                        &hit, &bsdf, incoming, power, &sampler, depth, light, out,
+                    self.connect_to_camera::<MEDIA>(
+                        &hit, &bsdf, incoming, power, medium, &sampler, depth, light, out,
                     );
                 }
             }
@@ -201,7 +269,12 @@ impl Setup {
                     s, &hit, incoming, &sample, &bsdf, material, &self.caps,
                 ));
             }
+            if MEDIA {
+                medium = medium_after(self.scene.shape_media(&hit), &hit, sample.incoming, medium);
+                crossings = 0;
+            }
             ray = hit.spawn_ray(sample.incoming);
+            depth += 1;
         }
     }
 }
@@ -219,13 +292,18 @@ impl Setup {
     /// stored, divided by q, by k and by spp; a merge at a directly seen hitpoint takes
     /// N/(kq + N) with ρ and q at the hitpoint (`photon_pass.rs`), so that the two weights of a
     /// path sum to one as the kernel shrinks onto it.
+    ///
+    /// With `MEDIA`, the light reaching the lens is weighted by the transmittance of the way
+    /// there, starting in the medium on the lens's side of `hit` (`medium` is the one the
+    /// photon arrived in).
     #[allow(clippy::too_many_arguments)]
-    fn connect_to_camera(
+    fn connect_to_camera<const MEDIA: bool>(
         &self,
         hit: &Hit,
         bsdf: &Bsdf,
         incoming: Vec3,
         power: Rgb,
+        medium: Option<u32>,
         sampler: &Sampler,
         depth: u32,
         light: LightTracing<'_>,
@@ -242,8 +320,16 @@ impl Setup {
         if rate == 0.0 {
             return;
         }
-        let Some(value) = lens_radiance(&self.scene, hit, bsdf, incoming, power, &connection)
-        else {
+        let value = if MEDIA {
+            lens_radiance_through(hit, bsdf, incoming, power, &connection, |lens| {
+                let scene = &*self.scene;
+                let start = medium_after(scene.shape_media(hit), hit, lens - hit.position, medium);
+                Some(transmittance(scene, hit.spawn_ray_to(lens), start))
+            })
+        } else {
+            lens_radiance(&self.scene, hit, bsdf, incoming, power, &connection)
+        };
+        let Some(value) = value else {
             return;
         };
         if !value.is_finite() {

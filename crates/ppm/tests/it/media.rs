@@ -162,41 +162,7 @@ irradiance = [1.0, 1.0, 1.0]
 /// whatever the scattering every path ends on a wall and every pixel reads L in every channel.
 #[test]
 fn white_furnace_of_an_albedo_one_medium_reads_the_wall_radiance() {
-    let mut toml = String::from(
-        r#"
-format = 1
-[camera]
-position = [0.0, 0.0, 0.5]
-look_at = [1.0, 0.2, 0.5]
-fov_y = 70.0
-medium = "fog"
-[film]
-width = 8
-height = 8
-[media.fog]
-sigma_a = [0.0, 0.0, 0.0]
-sigma_s = [0.5, 1.0, 2.0]
-g = 0.6
-[materials.wall]
-type = "diffuse"
-albedo = [0.0, 0.0, 0.0]
-emission = [1.0, 1.0, 1.0]
-"#,
-    );
-    // Corner and edges of each face, edge1 × edge2 pointing into the cube.
-    let faces: [[[f64; 3]; 3]; 6] = [
-        [[-1.0, -1.0, -1.0], [0.0, 0.0, 2.0], [2.0, 0.0, 0.0]],
-        [[-1.0, 1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]],
-        [[-1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]],
-        [[1.0, -1.0, -1.0], [0.0, 0.0, 2.0], [0.0, 2.0, 0.0]],
-        [[-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
-        [[-1.0, -1.0, 1.0], [0.0, 2.0, 0.0], [2.0, 0.0, 0.0]],
-    ];
-    for [corner, edge1, edge2] in faces {
-        toml += &format!(
-            "[[shapes]]\ntype = \"quad\"\ncorner = {corner:?}\nedge1 = {edge1:?}\nedge2 = {edge2:?}\nmaterial = \"wall\"\n"
-        );
-    }
+    let toml = furnace_fog_box();
     let image = path_render(&toml, 64, 4, 1024);
     assert_close(channel_means(&image), [1.0; 3], 0.015, "furnace mean");
     for (i, px) in image.iter().enumerate() {
@@ -209,13 +175,13 @@ emission = [1.0, 1.0, 1.0]
     }
 }
 
-/// Every method but the path tracer refuses a scene with media with one typed error.
+/// The methods that do not render media (light tracing, the bidirectional ones, `appm`) refuse
+/// a scene with media with one typed error; the path tracer and the progressive photon mappers
+/// take it, but not with the photon mappers' `direct_lighting`.
 #[test]
 fn other_methods_refuse_media() {
     let scene = scene(&through_sphere("type = \"interface\""));
-    let mut methods = PHOTON_METHODS.to_vec();
-    methods.extend([Method::Light, Method::Vcm, Method::Bdpt, Method::Appm]);
-    for method in methods {
+    for method in [Method::Light, Method::Vcm, Method::Bdpt, Method::Appm] {
         let err = Renderer::new(std::sync::Arc::clone(&scene), params(method, 1000))
             .err()
             .unwrap_or_else(|| panic!("{method} rendered a scene with media"));
@@ -226,10 +192,19 @@ fn other_methods_refuse_media() {
         assert_eq!(
             err.to_string(),
             format!(
-                "the scene has participating media, which only the path tracer renders: use \
-                 --method path, not {method}"
+                "the scene has participating media, which {method} does not render: use the \
+                 default method, sppm, ppm or path"
             )
         );
+    }
+    for method in PHOTON_METHODS.into_iter().filter(|&m| m != Method::Appm) {
+        assert!(Renderer::new(std::sync::Arc::clone(&scene), params(method, 1)).is_ok());
+        let mut p = params(method, 1);
+        p.connections.direct_lighting = true;
+        assert!(matches!(
+            Renderer::new(std::sync::Arc::clone(&scene), p).err(),
+            Some(ParamError::MediaDirectLighting)
+        ));
     }
     assert!(Renderer::new(scene, params(Method::Path, 1)).is_ok());
 }
@@ -285,6 +260,171 @@ fn a_clear_medium_changes_nothing() {
             [expected; 3],
             0.02,
             &format!("emissive box, max_depth {k}"),
+        );
+    }
+}
+
+/// The haze of [`single_scattering_matches_the_slab_integral`] under the same light, rendered by
+/// the photon mappers: the volume photons of the first scattering, gathered along the camera
+/// rays, read the same closed form (with the default's light tracing and frequency photons on).
+#[test]
+fn photon_mappers_match_the_single_scattering_integral() {
+    let toml = r#"
+format = 1
+[camera]
+position = [0.0, 0.0, 5.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 0.5
+[film]
+width = 4
+height = 4
+[media.haze]
+sigma_a = [0.05, 0.05, 0.05]
+sigma_s = [0.1, 0.2, 0.4]
+g = 0.3
+[materials.boundary]
+type = "interface"
+[[shapes]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+material = "boundary"
+interior = "haze"
+[[lights]]
+type = "directional"
+direction = [0.0, 0.0, -1.0]
+irradiance = [1.0, 1.0, 1.0]
+"#;
+    let g: f64 = 0.3;
+    let p = (1.0 - g * g) / (4.0 * PI * (1.0 + g).powi(3));
+    let expected = [0.1, 0.2, 0.4].map(|s: f64| {
+        let t = s + 0.05;
+        s * p * (1.0 - (-4.0 * t).exp()) / (2.0 * t)
+    });
+    for method in [Method::Sppm, Method::FreqSppm, Method::Ppm] {
+        let mut params = params(method, 200_000);
+        params.budget.max_depth = 1;
+        params.kernel.initial_radius = Some(0.05);
+        let image = render(&scene(toml), params, 16);
+        assert_close(
+            channel_means(&image),
+            expected,
+            0.03,
+            &format!("{method}: single scattering"),
+        );
+    }
+}
+
+/// The albedo-one furnace of [`white_furnace_of_an_albedo_one_medium_reads_the_wall_radiance`]
+/// rendered by the photon mappers: the walls seen through the fog plus the light the fog
+/// scatters toward the camera (volume photons after any number of scattering events, chromatic
+/// free flights) make L = 1 in every channel.
+#[test]
+fn photon_mappers_read_the_furnace_of_an_albedo_one_medium() {
+    let toml = furnace_fog_box();
+    for method in [Method::Sppm, Method::FreqSppm] {
+        let mut params = params(method, 50_000);
+        params.kernel.initial_radius = Some(0.1);
+        let image = render(&scene(&toml), params, 12);
+        assert_close(
+            channel_means(&image),
+            [1.0; 3],
+            0.03,
+            &format!("{method}: furnace"),
+        );
+    }
+}
+
+/// A closed box whose black walls all emit L = 1 inward, filled with a medium of albedo one
+/// and seen from inside.
+fn furnace_fog_box() -> String {
+    let mut toml = String::from(
+        r#"
+format = 1
+[camera]
+position = [0.0, 0.0, 0.5]
+look_at = [1.0, 0.2, 0.5]
+fov_y = 70.0
+medium = "fog"
+[film]
+width = 8
+height = 8
+[media.fog]
+sigma_a = [0.0, 0.0, 0.0]
+sigma_s = [0.5, 1.0, 2.0]
+g = 0.6
+[materials.wall]
+type = "diffuse"
+albedo = [0.0, 0.0, 0.0]
+emission = [1.0, 1.0, 1.0]
+"#,
+    );
+    // Corner and edges of each face, edge1 × edge2 pointing into the cube.
+    let faces: [[[f64; 3]; 3]; 6] = [
+        [[-1.0, -1.0, -1.0], [0.0, 0.0, 2.0], [2.0, 0.0, 0.0]],
+        [[-1.0, 1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]],
+        [[-1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]],
+        [[1.0, -1.0, -1.0], [0.0, 0.0, 2.0], [0.0, 2.0, 0.0]],
+        [[-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
+        [[-1.0, -1.0, 1.0], [0.0, 2.0, 0.0], [2.0, 0.0, 0.0]],
+    ];
+    for [corner, edge1, edge2] in faces {
+        toml += &format!(
+            "[[shapes]]\ntype = \"quad\"\ncorner = {corner:?}\nedge1 = {edge1:?}\nedge2 = {edge2:?}\nmaterial = \"wall\"\n"
+        );
+    }
+    toml
+}
+
+/// The repository's fog box (`scenes/peers/fog-box.toml`: a fog bounded by an interface mesh in
+/// a diffuse room) at `size`².
+fn fog_box(size: u32) -> std::sync::Arc<scene::Scene> {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/peers/fog-box.toml");
+    let mut description = import::load(&path).unwrap();
+    description.film = scene::Film {
+        width: size,
+        height: size,
+    };
+    std::sync::Arc::new(scene::Scene::new(description).unwrap())
+}
+
+/// In a scene with media the photon mappers' images are the same bits for any thread count and
+/// across a checkpoint (the volume gather's sums are saved; PPM's stretches through the fog,
+/// traced once, are traced again after a restore).
+#[test]
+fn photon_mappers_in_media_are_deterministic_and_resume_exactly() {
+    let scene = fog_box(20);
+    for method in [Method::Sppm, Method::FreqSppm, Method::Ppm] {
+        let p = params(method, 4_000);
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| render(&scene, p, 4))
+        };
+        let one = run(1);
+        assert!(one.iter().flatten().any(|&v| v > 0.0), "{method}: black");
+        let bits = |image: &[[f32; 3]]| -> Vec<u32> {
+            image.iter().flatten().map(|v| v.to_bits()).collect()
+        };
+        assert_eq!(
+            bits(&one),
+            bits(&run(2)),
+            "{method}: 1 and 2 threads differ"
+        );
+        let mut first = Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
+        first.iterate();
+        first.iterate();
+        let bytes = first.save_state("fog");
+        let mut resumed = Renderer::restore(std::sync::Arc::clone(&scene), &bytes).unwrap();
+        resumed.iterate();
+        resumed.iterate();
+        assert_eq!(
+            bits(&one),
+            bits(&resumed.image()),
+            "{method}: resume differs"
         );
     }
 }
