@@ -121,6 +121,7 @@ impl Progress {
                 "frequency_held": finite_or_null(stats.frequency_held),
                 "photons_stored": stats.photons_stored,
                 "light_connections": stats.light_connections,
+                "volume_photons": stats.volume_photons,
                 "non_finite": stats.non_finite,
                 "timings": {
                     "camera": stats.timings.camera,
@@ -129,6 +130,7 @@ impl Progress {
                     "gather": stats.timings.gather,
                     "update": stats.timings.update,
                     "frequency": stats.timings.frequency,
+                    "volume": stats.timings.volume,
                 },
                 "photons_emitted": renderer.photons_emitted(),
                 "elapsed_seconds": elapsed.as_secs_f64(),

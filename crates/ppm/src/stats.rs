@@ -33,6 +33,9 @@ pub struct PassStats {
     /// Stored photons connected to the camera (`light_tracing`): visible from the lens, on
     /// the film, with a non-zero BSDF toward it.
     pub light_connections: u64,
+    /// Photons stored where they scattered in a participating medium this pass (zero in a scene
+    /// without media).
+    pub volume_photons: u64,
     /// Values dropped this pass because they were NaN or infinite where they would have entered
     /// a sum: photon powers (the path ends), photon–hitpoint fluxes, directly seen emission and
     /// camera weights (the visible point is dropped), path-tracer samples. Zero in a healthy
@@ -63,6 +66,10 @@ pub struct PassTimings {
     /// The rest of the bookkeeping, spectra and occlusion probes along photon paths, is inside
     /// `trace`.
     pub frequency: f64,
+    /// The volume photons' gather inside `gather` (already counted there): building their
+    /// tree and gathering them along the camera rays' stretches through media. Zero in a scene
+    /// without media.
+    pub volume: f64,
 }
 
 impl PassStats {
@@ -82,6 +89,7 @@ impl PassStats {
             frequency_held: 0.0,
             photons_stored: 0,
             light_connections: 0,
+            volume_photons: 0,
             non_finite: 0,
             timings: PassTimings::default(),
         }

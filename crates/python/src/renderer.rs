@@ -489,6 +489,7 @@ fn pass_dict<'py>(py: Python<'py>, s: &PassStats) -> PyResult<Bound<'py, PyAny>>
         "frequency_held": finite(s.frequency_held),
         "photons_stored": s.photons_stored,
         "light_connections": s.light_connections,
+        "volume_photons": s.volume_photons,
         "non_finite": s.non_finite,
         "timings": {
             "camera": s.timings.camera,
@@ -497,6 +498,7 @@ fn pass_dict<'py>(py: Python<'py>, s: &PassStats) -> PyResult<Bound<'py, PyAny>>
             "gather": s.timings.gather,
             "update": s.timings.update,
             "frequency": s.timings.frequency,
+            "volume": s.timings.volume,
             "total": s.timings.total(),
         },
     });

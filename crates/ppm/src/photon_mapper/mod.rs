@@ -289,7 +289,10 @@ impl PhotonMapper {
         let index = clock.elapsed().as_secs_f64() - camera;
         self.photon_pass(&mut stats);
         if self.setup.scene.has_media() {
+            let volume_clock = Instant::now();
+            stats.volume_photons = self.photons.traced.iter().map(|t| t.volume.len() as u64).sum();
             stats.non_finite += self.volume_gather();
+            stats.timings.volume = volume_clock.elapsed().as_secs_f64();
         }
         let photons_done = clock.elapsed().as_secs_f64();
         after_photons(self, &mut stats);
