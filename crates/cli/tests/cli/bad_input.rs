@@ -562,8 +562,9 @@ fn bad_environment_maps() {
     );
 }
 
-/// A scene with participating media asked of a method that does not render them: a usage
-/// error (exit 2) naming the scene and the method, and no output; the path tracer renders it.
+/// A scene with participating media asked of a method that does not render them (`vcm`), or of
+/// a photon mapper with `--direct-lighting`: a usage error (exit 2) naming the scene and the
+/// method or the switch, and no output; the path tracer and the default method render it.
 #[test]
 fn media_with_a_method_that_cannot_render_them() {
     let dir = temp_dir("media_method");
@@ -593,9 +594,16 @@ material = "lamp"
     std::fs::write(dir.join("fog.toml"), scene).unwrap();
     check_in(
         &dir,
-        &["render", "fog.toml", "--method", "sppm", "--passes", "1"],
+        &["render", "fog.toml", "--method", "vcm", "--passes", "1"],
         2,
-        &["fog.toml", "participating media", "sppm"],
+        &["fog.toml", "participating media", "vcm"],
+        &["fog.toml"],
+    );
+    check_in(
+        &dir,
+        &["render", "fog.toml", "--direct-lighting", "--passes", "1"],
+        2,
+        &["fog.toml", "direct_lighting", "participating media"],
         &["fog.toml"],
     );
     fppm(
@@ -603,4 +611,5 @@ material = "lamp"
         &["render", "fog.toml", "--method", "path", "--passes", "1"],
     )
     .ok();
+    fppm(&dir, &["render", "fog.toml", "--passes", "1"]).ok();
 }
