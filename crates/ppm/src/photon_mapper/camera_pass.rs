@@ -288,6 +288,8 @@ impl Setup {
             None
         };
         let mut crossings = 0;
+        // The geometric normal of the surface the current ray left (zero: the camera).
+        let mut left = Vec3::ZERO;
         // `bounces`: scattering events of the camera path before this hit. Emission seen here
         // ends a light path with that many; a hitpoint adds one (its own scattering) to the
         // photon's, so it needs bounces < max_depth.
@@ -307,6 +309,8 @@ impl Setup {
                         budget: max_depth - 1 - bounces,
                         slot,
                         weight: throughput,
+                        entry_normal: left,
+                        exit_normal: hit.map_or(Vec3::ZERO, |h| h.geometric_normal),
                     });
                 }
                 throughput *= m.transmittance(t);
@@ -323,6 +327,7 @@ impl Setup {
                 }
                 medium = medium_after(self.scene.shape_media(&hit), &hit, ray.direction, medium);
                 ray = hit.spawn_ray(ray.direction);
+                left = hit.geometric_normal;
                 continue;
             }
             direct += throughput * self.scene.emitted(&hit);
@@ -348,6 +353,7 @@ impl Setup {
                     medium =
                         medium_after(self.scene.shape_media(&hit), &hit, sample.incoming, medium);
                     crossings = 0;
+                    left = hit.geometric_normal;
                 }
                 ray = hit.spawn_ray(sample.incoming);
                 bounces += 1;

@@ -7,15 +7,17 @@
 //! One pass's estimate for a camera stretch (origin o, unit direction ω, length t_max, weight β
 //! of the camera path at o) is
 //!
-//!   L = β / (π r² N) · Σᵢ T(o, xᵢ′) · p(−ω, ωᵢ) · Φᵢ
+//!   L = β / N · Σᵢ T(o, xᵢ′) · p(−ω, ωᵢ) · Φᵢ / A(xᵢ′)
 //!
 //! over the photons i of the same medium whose distance to the stretch is below r, where xᵢ′ is
 //! the photon's projection onto the stretch, T the transmittance from o to it, p the phase
 //! function, ωᵢ the photon's direction back toward where it came from, N the photons emitted in
 //! the pass and Φᵢ the photon's power times σs·T/pdf of the free flight that stopped it (so that
-//! the photons' density is σs times the radiance arriving there, per photon emitted). The 2D
-//! kernel 1/(πr²) in the plane across the stretch blurs the in-scattered radiance as a surface
-//! kernel does, so the same radius schedule applies: r²ₖ₊₁ = r²ₖ (k + α)/(k + 1).
+//! the photons' density is σs times the radiance arriving there, per photon emitted) and A the
+//! area of the disc of radius r across the stretch at xᵢ′ that lies inside the medium (πr² but
+//! near the surfaces the stretch starts and ends on, [`inside_area`]). The 2D kernel in the plane
+//! across the stretch blurs the in-scattered radiance as a surface kernel does, so the same
+//! radius schedule applies: r²ₖ₊₁ = r²ₖ (k + α)/(k + 1).
 //!
 //! Stretches are found by a tree over the photons (sorted in Morton order, leaves of
 //! [`LEAF`] photons, boxes grown by r), walked in a fixed order: the sums, hence the image, do
@@ -59,6 +61,47 @@ pub(crate) struct Segment {
     /// The camera path's weight at `origin`: specular throughput and transmittance so far
     /// (not yet divided by the slots per pixel).
     pub(crate) weight: Rgb,
+    /// The geometric normal of the surface the stretch starts on, zero if it starts at the
+    /// camera: the medium's boundary there, for the kernel's correction ([`inside_area`]).
+    pub(crate) entry_normal: Vec3,
+    /// The geometric normal of the surface it ends on, zero if it leaves the scene.
+    pub(crate) exit_normal: Vec3,
+}
+
+/// The area of the disc of radius `r` across the stretch at distance `t` along it that lies
+/// inside the medium, taking the surfaces the stretch starts and ends on as planes: the kernel's
+/// normalization. Dividing by πr² instead would count the part of the disc beyond the medium's
+/// boundary, where no photon can be, and darken every stretch by a share of about r/length
+/// (4.6 % in the middle of the fog box at 64² with R₀, measured against the path tracer): the
+/// boundary bias of density estimation, here corrected to first order by renormalising the
+/// kernel over the region photons can occupy.
+fn inside_area(segment: &Segment, t: f32, r: f32) -> f32 {
+    let full = std::f32::consts::PI * r * r;
+    let d = segment.direction;
+    // The area of the disc beyond a plane of unit normal `n` at signed distance `h` from its
+    // centre, measured along n toward the medium.
+    let outside = |n: Vec3, h: f32| -> f32 {
+        let cos = n.dot(d);
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        if n == Vec3::ZERO || sin < 1e-6 {
+            return 0.0;
+        }
+        let a = (h / sin).clamp(-r, r);
+        if a >= r {
+            return 0.0;
+        }
+        r * r * (a / r).acos() - a * (r * r - a * a).max(0.0).sqrt()
+    };
+    let n_entry = segment.entry_normal;
+    let entry = outside(n_entry, t * n_entry.dot(d).abs());
+    let exit = if segment.t_max.is_finite() {
+        let n_exit = segment.exit_normal;
+        outside(n_exit, (segment.t_max - t) * n_exit.dot(d).abs())
+    } else {
+        0.0
+    };
+    // Never below a tenth of the disc: a stretch that grazes a boundary keeps a bounded weight.
+    (full - entry - exit).max(0.1 * full)
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -286,8 +329,7 @@ impl Volume {
         self.gathers += 1;
         let media = &scene.media().list;
         let tree = &self.tree;
-        let normalization = 1.0
-            / (std::f32::consts::PI * radius * radius * emitted as f32 * samples_per_pixel as f32);
+        let normalization = 1.0 / (emitted as f32 * samples_per_pixel as f32);
         let estimates: Vec<Rgb> = self
             .segments
             .par_iter()
@@ -303,7 +345,8 @@ impl Volume {
                     if photon.medium == segment.medium && photon.bounces <= segment.budget {
                         sum += medium.transmittance(t)
                             * photon.power
-                            * phase.eval(outgoing, photon.incoming);
+                            * (phase.eval(outgoing, photon.incoming)
+                                / inside_area(segment, t, radius));
                     }
                 });
                 sum * segment.weight * normalization
@@ -378,6 +421,8 @@ mod tests {
                 budget: 0,
                 slot: 0,
                 weight: Rgb::ONE,
+                entry_normal: Vec3::ZERO,
+                exit_normal: Vec3::ZERO,
             };
             let mut found = Vec::new();
             tree.gather(&segment, radius, |p, _| found.push(p.position.to_array()));
