@@ -182,6 +182,9 @@ pub struct Kernel {
     /// prediction coming from a freq-sppm pilot (`vcm/radius.rs`); off, every merge of a pass
     /// has the pass's radius.
     pub freq_radius: bool,
+    /// The photon mappers' volume gather in participating media (`docs/media.md`): its initial
+    /// radius as a multiple of the initial gather radius.
+    pub volume_radius: f64,
 }
 
 /// The estimators the photon mappers combine with merging.
@@ -424,6 +427,7 @@ impl RenderParams {
             },
             kernel: Kernel {
                 alpha: 0.7,
+                volume_radius: 1.0,
                 initial_radius: None,
                 freq_radius: false,
             },
@@ -478,6 +482,9 @@ impl RenderParams {
         }
         if !(self.kernel.alpha > 0.0 && self.kernel.alpha <= 1.0) {
             return Err(out("alpha", self.kernel.alpha, "(0, 1]"));
+        }
+        if !(self.kernel.volume_radius > 0.0 && self.kernel.volume_radius <= 64.0) {
+            return Err(out("volume_radius", self.kernel.volume_radius, "(0, 64]"));
         }
         if let Some(r) = self.kernel.initial_radius
             && !(r > 0.0 && r.is_finite())

@@ -166,6 +166,20 @@ pub const PARAMS: &[Param] = &[
         },
     },
     Param {
+        name: "volume_radius",
+        flag: "volume-radius",
+        help: "Photon mappers in participating media: the volume gather's initial radius as a multiple of the initial gather radius, in (0, 64] [default: scene, else 1]",
+        kind: ParamKind::Value {
+            value_name: "SCALE",
+            choices: &[],
+        },
+        get: |p| p.kernel.volume_radius.to_string(),
+        set: |p, v| {
+            p.kernel.volume_radius = parse_number(v)?;
+            Ok(())
+        },
+    },
+    Param {
         name: "vcm_freq_radius",
         flag: "vcm-freq-radius",
         help: "vcm: merge with the frequency prediction's radius where it is below the pass's radius (a freq-sppm pilot of --freq-pilot passes, at least one, predicts it; MIS weights use the radius used)",
@@ -661,6 +675,7 @@ mod tests {
         let mut params = RenderParams::preview();
         params.method = Method::FreqSppm;
         params.kernel.initial_radius = Some(0.125);
+        params.kernel.volume_radius = 2.5;
         params.frequency.merge = MergePolicy::PosterMax;
         params.frequency.floor = FrequencyFloor::Clamp;
         params.frequency.geometry = false;

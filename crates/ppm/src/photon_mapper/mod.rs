@@ -312,7 +312,10 @@ impl PhotonMapper {
         self.volume.gather_pass(
             &setup.scene,
             self.photons.traced.iter().map(|t| t.volume.as_slice()),
-            (setup.kernel_scale, setup.params.kernel.alpha),
+            (
+                setup.kernel_scale * setup.params.kernel.volume_radius,
+                setup.params.kernel.alpha,
+            ),
             u64::from(setup.params.budget.photons_per_pass),
             setup.params.film.samples_per_pixel,
             self.n_slots(),
