@@ -40,7 +40,7 @@ fn entry(method: Method) -> Entry {
         Method::Appm => Entry {
             build: |scene, params| Ok(Box::new(PassIndependent::new(scene, params)?)),
             estimate: independent::estimate,
-            media: false,
+            media: true,
         },
         Method::Path => Entry {
             build: |scene, params| Ok(Box::new(PathTracer::new(scene, params))),

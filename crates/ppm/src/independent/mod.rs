@@ -167,8 +167,9 @@ fn schedule_radii(kernels: &[f64], mapper: &mut PhotonMapper, pass: u32) {
         .for_each(|(radius, &r0)| *radius = r0 * g);
 }
 
-/// After the photon pass: the pass image (emission seen by this pass's camera paths, plus the
-/// photons each slot gathered within its radius), added to the exact sums.
+/// After the photon pass: the pass image (emission seen by this pass's camera paths, the
+/// photons each slot gathered within its radius, and in media the volume photons gathered along
+/// its stretches through them), added to the exact sums.
 fn add_pass_image(
     sums: &mut PassSums,
     kernels: &[f64],
@@ -189,10 +190,11 @@ fn add_pass_image(
             for slot in pixel * spp..(pixel + 1) * spp {
                 let (_, flux) = deposits.deposit_of(slot);
                 let light = deposits.light_of(slot);
+                let volume = mapper.volume_of_pass(slot);
                 let area = std::f64::consts::PI * radius[slot] * radius[slot];
                 let gathered = bounces[slot] != NO_VISIBLE_POINT && area > 0.0;
                 for c in 0..3 {
-                    image[c] += direct[slot][c] + light[c] / photons;
+                    image[c] += direct[slot][c] + light[c] / photons + volume[c];
                     if gathered {
                         image[c] += flux[c] / (area * photons);
                     }

@@ -348,7 +348,7 @@ pub enum ParamError {
     },
     /// The scene has participating media, which this method does not render (`docs/media.md`).
     #[error(
-        "the scene has participating media, which {method} does not render: use the default method, sppm, ppm or path"
+        "the scene has participating media, which {method} does not render: use the default method, sppm, ppm, appm or path"
     )]
     MediaUnsupported {
         /// The method asked for.

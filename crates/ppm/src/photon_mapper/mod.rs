@@ -256,6 +256,12 @@ impl PhotonMapper {
             .collect()
     }
 
+    /// Slot `slot`'s in-scattered radiance estimated by the last pass alone (weighted by
+    /// 1/spp; zero in a scene without media).
+    pub(crate) fn volume_of_pass(&self, slot: usize) -> [f64; 3] {
+        self.volume.last.get(slot).copied().unwrap_or([0.0; 3])
+    }
+
     /// Forgets the directly seen emission summed so far.
     pub(crate) fn clear_direct(&mut self) {
         for d in &mut self.direct {
@@ -290,7 +296,12 @@ impl PhotonMapper {
         self.photon_pass(&mut stats);
         if self.setup.scene.has_media() {
             let volume_clock = Instant::now();
-            stats.volume_photons = self.photons.traced.iter().map(|t| t.volume.len() as u64).sum();
+            stats.volume_photons = self
+                .photons
+                .traced
+                .iter()
+                .map(|t| t.volume.len() as u64)
+                .sum();
             stats.non_finite += self.volume_gather();
             stats.timings.volume = volume_clock.elapsed().as_secs_f64();
         }
@@ -316,6 +327,7 @@ impl PhotonMapper {
                 setup.kernel_scale * setup.params.kernel.volume_radius,
                 setup.params.kernel.alpha,
             ),
+            self.pass,
             u64::from(setup.params.budget.photons_per_pass),
             setup.params.film.samples_per_pixel,
             self.n_slots(),

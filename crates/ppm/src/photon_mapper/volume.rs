@@ -273,11 +273,11 @@ fn morton(x: u32, y: u32, z: u32) -> u32 {
     spread(x) | (spread(y) << 1) | (spread(z) << 2)
 }
 
-/// The volume gather's radius after `gathers` gathers from `initial`: r²ₖ₊₁ = r²ₖ (k + α)/(k + 1)
+/// The volume gather's radius in pass `pass` (0-based) from `initial`: r²ₖ₊₁ = r²ₖ (k + α)/(k + 1)
 /// (Knaus and Zwicker 2011, for a kernel over two dimensions), k counted from 1.
-pub(crate) fn radius_after(initial: f64, alpha: f64, gathers: u32) -> f64 {
+pub(crate) fn radius_after(initial: f64, alpha: f64, pass: u32) -> f64 {
     let mut r2 = initial * initial;
-    for k in 1..=gathers {
+    for k in 1..=pass {
         let k = f64::from(k);
         r2 *= (k + alpha) / (k + 1.0);
     }
@@ -293,6 +293,9 @@ pub(crate) struct Volume {
     pub(crate) sum: Vec<[f64; 3]>,
     /// The passes whose estimates `sum` holds.
     pub(crate) gathers: u32,
+    /// Per slot: the last pass's estimate (weighted by 1/spp), for the pass-independent
+    /// estimator, which sums pass images of its own; empty in a scene without media.
+    pub(crate) last: Vec<[f64; 3]>,
     /// The stretches of the camera paths of the last camera pass that placed visible points,
     /// in slot order.
     pub(crate) segments: Vec<Segment>,
@@ -307,25 +310,31 @@ impl Volume {
         use std::mem::size_of;
         (
             self.segments.capacity() * size_of::<Segment>() + self.tree.heap_bytes(),
-            self.sum.capacity() * size_of::<[f64; 3]>(),
+            (self.sum.capacity() + self.last.capacity()) * size_of::<[f64; 3]>(),
         )
     }
 
-    /// Gathers this pass's photons (`photons`, `emitted` of them emitted) into every
-    /// stretch, with the radius of the pass, and adds each slot's estimate to its sum; returns
-    /// the contributions dropped for being NaN or infinite.
+    /// Gathers the photons of pass `pass` (`photons`, `emitted` of them emitted) into every
+    /// stretch, with the radius of that pass, keeps each slot's estimate as `last` and adds it
+    /// to its sum; returns the contributions dropped for being NaN or infinite. The radius
+    /// depends on the pass's index alone, so that the pass-independent estimator's passes can be
+    /// rendered apart.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn gather_pass<'a>(
         &mut self,
         scene: &Scene,
         photons: impl Iterator<Item = &'a [VolumePhoton]>,
         (initial_radius, alpha): (f64, f64),
+        pass: u32,
         emitted: u64,
         samples_per_pixel: u32,
         n_slots: usize,
     ) -> u64 {
-        let radius = radius_after(initial_radius, alpha, self.gathers) as f32;
+        let radius = radius_after(initial_radius, alpha, pass) as f32;
         self.tree.build(photons, radius);
         self.sum.resize(n_slots, [0.0; 3]);
+        self.last.clear();
+        self.last.resize(n_slots, [0.0; 3]);
         self.gathers += 1;
         let media = &scene.media().list;
         let tree = &self.tree;
@@ -358,9 +367,14 @@ impl Volume {
                 non_finite += 1;
                 continue;
             }
-            let sum = &mut self.sum[segment.slot as usize];
+            let last = &mut self.last[segment.slot as usize];
             for c in 0..3 {
-                sum[c] += f64::from(estimate[c]);
+                last[c] += f64::from(estimate[c]);
+            }
+        }
+        for (sum, last) in self.sum.iter_mut().zip(&self.last) {
+            for c in 0..3 {
+                sum[c] += last[c];
             }
         }
         non_finite

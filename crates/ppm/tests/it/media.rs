@@ -175,13 +175,13 @@ fn white_furnace_of_an_albedo_one_medium_reads_the_wall_radiance() {
     }
 }
 
-/// The methods that do not render media (light tracing, the bidirectional ones, `appm`) refuse
-/// a scene with media with one typed error; the path tracer and the progressive photon mappers
-/// take it, but not with the photon mappers' `direct_lighting`.
+/// The methods that do not render media (light tracing, the bidirectional ones) refuse a scene
+/// with media with one typed error; the path tracer and the photon mappers take it, but not
+/// with the photon mappers' `direct_lighting`.
 #[test]
 fn other_methods_refuse_media() {
     let scene = scene(&through_sphere("type = \"interface\""));
-    for method in [Method::Light, Method::Vcm, Method::Bdpt, Method::Appm] {
+    for method in [Method::Light, Method::Vcm, Method::Bdpt] {
         let err = Renderer::new(std::sync::Arc::clone(&scene), params(method, 1000))
             .err()
             .unwrap_or_else(|| panic!("{method} rendered a scene with media"));
@@ -193,11 +193,11 @@ fn other_methods_refuse_media() {
             err.to_string(),
             format!(
                 "the scene has participating media, which {method} does not render: use the \
-                 default method, sppm, ppm or path"
+                 default method, sppm, ppm, appm or path"
             )
         );
     }
-    for method in PHOTON_METHODS.into_iter().filter(|&m| m != Method::Appm) {
+    for method in PHOTON_METHODS {
         assert!(Renderer::new(std::sync::Arc::clone(&scene), params(method, 1)).is_ok());
         let mut p = params(method, 1);
         p.connections.direct_lighting = true;
@@ -301,7 +301,7 @@ irradiance = [1.0, 1.0, 1.0]
         let t = s + 0.05;
         s * p * (1.0 - (-4.0 * t).exp()) / (2.0 * t)
     });
-    for method in [Method::Sppm, Method::FreqSppm, Method::Ppm] {
+    for method in [Method::Sppm, Method::FreqSppm, Method::Ppm, Method::Appm] {
         let mut params = params(method, 200_000);
         params.budget.max_depth = 1;
         params.kernel.initial_radius = Some(0.05);
@@ -395,7 +395,7 @@ fn fog_box(size: u32) -> std::sync::Arc<scene::Scene> {
 #[test]
 fn photon_mappers_in_media_are_deterministic_and_resume_exactly() {
     let scene = fog_box(20);
-    for method in [Method::Sppm, Method::FreqSppm, Method::Ppm] {
+    for method in [Method::Sppm, Method::FreqSppm, Method::Ppm, Method::Appm] {
         let p = params(method, 4_000);
         let run = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new()
@@ -427,4 +427,40 @@ fn photon_mappers_in_media_are_deterministic_and_resume_exactly() {
             "{method}: resume differs"
         );
     }
+}
+
+/// `appm` in media cut into work units: the exact sums of disjoint ranges of passes, each
+/// started at its first pass, add up to those of one render of all of them (the volume gather's
+/// radius depends on the pass's index alone), and the in-scattered light is in them.
+#[test]
+fn appm_units_in_media_merge_into_the_single_render_bit_for_bit() {
+    let scene = fog_box(12);
+    let mut p = params(Method::Appm, 3_000);
+    p.frequency.pilot = 1;
+    let mut single = Renderer::new(std::sync::Arc::clone(&scene), p).unwrap();
+    for _ in 0..5 {
+        single.iterate();
+    }
+    let whole = single.pass_sums().unwrap().clone();
+    let kernels = single.kernels().unwrap().to_vec();
+    let unit = |first: u32, count: u32| {
+        let mut r =
+            Renderer::with_kernels(std::sync::Arc::clone(&scene), p, kernels.clone(), first)
+                .unwrap();
+        for _ in 0..count {
+            r.iterate();
+        }
+        r.pass_sums().unwrap().clone()
+    };
+    let mut merged = ppm::PassSums::new(whole.sums.len());
+    for (first, count) in [(3, 2), (0, 1), (1, 2)] {
+        assert!(merged.add(&unit(first, count)));
+    }
+    assert_eq!(merged, whole, "merged sums differ");
+    // Without the volume photons the fog would be black where no surface shows through it.
+    let mut no_volume = p;
+    no_volume.kernel.volume_radius = 1e-9;
+    let dark = render(&scene, no_volume, 5);
+    let mean = |image: &[[f32; 3]]| image.iter().flatten().map(|&v| f64::from(v)).sum::<f64>();
+    assert!(mean(&single.image()) > 1.05 * mean(&dark));
 }
