@@ -288,6 +288,7 @@ impl Setup {
             None
         };
         let mut crossings = 0;
+        let pinhole = self.scene.camera().aperture_radius() == 0.0;
         // The geometric normal of the surface the current ray left (zero: the camera).
         let mut left = Vec3::ZERO;
         // `bounces`: scattering events of the camera path before this hit. Emission seen here
@@ -311,6 +312,7 @@ impl Setup {
                         weight: throughput,
                         entry_normal: left,
                         exit_normal: hit.map_or(Vec3::ZERO, |h| h.geometric_normal),
+                        primary: bounces == 0 && pinhole,
                     });
                 }
                 throughput *= m.transmittance(t);

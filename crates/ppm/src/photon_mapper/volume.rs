@@ -23,7 +23,7 @@
 //! [`LEAF`] photons, boxes grown by r), walked in a fixed order: the sums, hence the image, do
 //! not depend on the number of threads.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use scene::{Rgb, Scene};
 
@@ -66,6 +66,9 @@ pub(crate) struct Segment {
     pub(crate) entry_normal: Vec3,
     /// The geometric normal of the surface it ends on, zero if it leaves the scene.
     pub(crate) exit_normal: Vec3,
+    /// Whether it lies on the slot's primary ray through a pinhole (no bounce before it), so
+    /// that [`ScreenIndex`] finds its photons by the pixel it crosses.
+    pub(crate) primary: bool,
 }
 
 /// The area of the disc of radius `r` across the stretch at distance `t` along it that lies
@@ -147,12 +150,8 @@ pub(crate) struct VolumeTree {
 
 impl VolumeTree {
     /// Rebuilds the tree over `photons` (in trace order) for gathers of radius `radius`.
-    pub(crate) fn build<'a>(
-        &mut self,
-        photons: impl Iterator<Item = &'a [VolumePhoton]>,
-        radius: f32,
-    ) {
-        let mut unsorted: Vec<VolumePhoton> = photons.flatten().copied().collect();
+    pub(crate) fn build(&mut self, photons: impl Iterator<Item = VolumePhoton>, radius: f32) {
+        let mut unsorted: Vec<VolumePhoton> = photons.collect();
         self.levels.clear();
         self.photons.clear();
         if unsorted.is_empty() {
@@ -215,8 +214,8 @@ impl VolumeTree {
         let Some(top) = self.levels.len().checked_sub(1) else {
             return;
         };
-        let (origin, direction) = (segment.origin, segment.direction);
-        let inverse = direction.recip();
+        let origin = segment.origin;
+        let inverse = segment.direction.recip();
         let r2 = radius * radius;
         let mut stack: Vec<(usize, usize)> = Vec::with_capacity(2 * self.levels.len());
         stack.push((top, 0));
@@ -227,14 +226,7 @@ impl VolumeTree {
             if level == 0 {
                 let end = ((node + 1) * LEAF).min(self.photons.len());
                 for photon in &self.photons[node * LEAF..end] {
-                    let v = photon.position - origin;
-                    let t = v.dot(direction);
-                    if !(0.0..=segment.t_max).contains(&t) {
-                        continue;
-                    }
-                    if v.length_squared() - t * t <= r2 {
-                        visit(photon, t);
-                    }
+                    test(segment, r2, photon, &mut visit);
                 }
                 continue;
             }
@@ -258,6 +250,138 @@ impl VolumeTree {
                 .iter()
                 .map(|l| l.capacity() * size_of::<Aabb>())
                 .sum::<usize>()
+    }
+}
+
+/// Calls `visit(photon, t)` if `photon` lies within √`r2` of the stretch `segment` and its
+/// projection t onto it lies on it.
+#[inline]
+fn test(
+    segment: &Segment,
+    r2: f32,
+    photon: &VolumePhoton,
+    visit: &mut impl FnMut(&VolumePhoton, f32),
+) {
+    let v = photon.position - segment.origin;
+    let t = v.dot(segment.direction);
+    if (0.0..=segment.t_max).contains(&t) && v.length_squared() - t * t <= r2 {
+        visit(photon, t);
+    }
+}
+
+/// The photons of a pass by the pixels whose primary rays pass within the radius of them, for
+/// the stretches that lie on primary rays through a pinhole: a long stretch through a thin
+/// medium meets few photons, and a tree walked along it tests fifty times more than it finds,
+/// where a pixel's list holds little more than what its rays find. A photon that
+/// appears wider than [`SCREEN_RADIUS_CAP`] pixels (near the camera, or behind it) goes to a
+/// small tree of its own, which those stretches also walk.
+#[derive(Default)]
+struct ScreenIndex {
+    width: usize,
+    /// Per pixel, where its entries start in `entries` (one more than the pixels).
+    offsets: Vec<u32>,
+    /// Indices into the main tree's photons, pixel by pixel, each pixel's in the tree's order.
+    entries: Vec<u32>,
+    near: VolumeTree,
+    /// Per photon: its film position and the distance from it within which pixel centres list
+    /// it, or `None` for the near tree.
+    discs: Vec<Option<(Vec2, f32)>>,
+}
+
+/// The widest a photon's disc may appear on the film, in pixels, to be listed by pixel.
+const SCREEN_RADIUS_CAP: f32 = 12.0;
+
+impl ScreenIndex {
+    /// Lists `photons` (the main tree's, in its order) by the pixels of `camera`'s film whose
+    /// primary rays may pass within `radius` of them.
+    fn build(&mut self, camera: &scene::CameraModel, photons: &[VolumePhoton], radius: f32) {
+        let (width, height) = camera.resolution();
+        let (w, h) = (width as usize, height as usize);
+        self.width = w;
+        let focal = camera.focal_pixels();
+        // The ray of pixel g passes at least z·|Δfilm|·cos θ/F from a photon at depth z whose
+        // film position is Δfilm away (θ the ray's angle to the view axis, at most the film
+        // corner's): a photon within `radius` of it is at most radius·F/(z·cos θ) pixels away,
+        // plus the slot's jitter within its pixel.
+        let half = Vec2::new(width as f32, height as f32) / (2.0 * focal);
+        let cos_max = 1.0 / (1.0 + half.length_squared()).sqrt();
+        let reach = radius * focal / cos_max;
+        self.discs.clear();
+        self.discs.par_extend(photons.par_iter().map(|p| {
+            let (film, z) = camera.film_point(p.position)?;
+            let rho = reach / z;
+            // Pixel centres within rho + √½ of the film position (a slot's ray crosses its
+            // pixel anywhere).
+            (rho <= SCREEN_RADIUS_CAP).then_some((film, rho + std::f32::consts::FRAC_1_SQRT_2))
+        }));
+        let last = Vec2::new(width as f32 - 1.0, height as f32 - 1.0);
+        // Calls `list(pixel)` for every pixel whose centre lies in the disc.
+        let pixels = |(film, span): (Vec2, f32), list: &mut dyn FnMut(usize)| {
+            let lo = (film - span).floor().max(Vec2::ZERO);
+            let hi = (film + span).floor().min(last);
+            if lo.x > hi.x || lo.y > hi.y {
+                return;
+            }
+            for y in lo.y as usize..=hi.y as usize {
+                let dy = y as f32 + 0.5 - film.y;
+                for x in lo.x as usize..=hi.x as usize {
+                    let dx = x as f32 + 0.5 - film.x;
+                    if dx * dx + dy * dy <= span * span {
+                        list(y * w + x);
+                    }
+                }
+            }
+        };
+        self.offsets.clear();
+        self.offsets.resize(w * h + 1, 0);
+        for disc in self.discs.iter().flatten() {
+            pixels(*disc, &mut |pixel| self.offsets[pixel + 1] += 1);
+        }
+        for i in 1..self.offsets.len() {
+            self.offsets[i] += self.offsets[i - 1];
+        }
+        self.entries.clear();
+        self.entries.resize(self.offsets[w * h] as usize, 0);
+        let mut next: Vec<u32> = self.offsets[..w * h].to_vec();
+        for (i, disc) in self.discs.iter().enumerate() {
+            if let Some(disc) = disc {
+                pixels(*disc, &mut |pixel| {
+                    self.entries[next[pixel] as usize] = i as u32;
+                    next[pixel] += 1;
+                });
+            }
+        }
+        let near = photons
+            .iter()
+            .zip(&self.discs)
+            .filter(|(_, disc)| disc.is_none())
+            .map(|(p, _)| *p);
+        self.near.build(near, radius);
+    }
+
+    /// [`VolumeTree::gather`] for a primary stretch of the slot of pixel `pixel`.
+    fn gather(
+        &self,
+        photons: &[VolumePhoton],
+        segment: &Segment,
+        pixel: usize,
+        radius: f32,
+        mut visit: impl FnMut(&VolumePhoton, f32),
+    ) {
+        let r2 = radius * radius;
+        if let Some(range) = self.offsets.get(pixel..pixel + 2) {
+            for &i in &self.entries[range[0] as usize..range[1] as usize] {
+                test(segment, r2, &photons[i as usize], &mut visit);
+            }
+        }
+        self.near.gather(segment, radius, visit);
+    }
+
+    fn heap_bytes(&self) -> usize {
+        use std::mem::size_of;
+        (self.offsets.capacity() + self.entries.capacity()) * size_of::<u32>()
+            + self.discs.capacity() * size_of::<Option<(Vec2, f32)>>()
+            + self.near.heap_bytes()
     }
 }
 
@@ -302,6 +426,7 @@ pub(crate) struct Volume {
     /// Whether `segments` were traced by this renderer (a restored one has none yet).
     pub(crate) segments_traced: bool,
     tree: VolumeTree,
+    screen: ScreenIndex,
 }
 
 impl Volume {
@@ -309,7 +434,9 @@ impl Volume {
     pub(crate) fn heap_bytes(&self) -> (usize, usize) {
         use std::mem::size_of;
         (
-            self.segments.capacity() * size_of::<Segment>() + self.tree.heap_bytes(),
+            self.segments.capacity() * size_of::<Segment>()
+                + self.tree.heap_bytes()
+                + self.screen.heap_bytes(),
             (self.sum.capacity() + self.last.capacity()) * size_of::<[f64; 3]>(),
         )
     }
@@ -331,13 +458,18 @@ impl Volume {
         n_slots: usize,
     ) -> u64 {
         let radius = radius_after(initial_radius, alpha, pass) as f32;
-        self.tree.build(photons, radius);
+        self.tree.build(photons.flatten().copied(), radius);
+        let primary = self.segments.iter().any(|s| s.primary);
+        if primary {
+            self.screen
+                .build(scene.camera(), &self.tree.photons, radius);
+        }
         self.sum.resize(n_slots, [0.0; 3]);
         self.last.clear();
         self.last.resize(n_slots, [0.0; 3]);
         self.gathers += 1;
         let media = &scene.media().list;
-        let tree = &self.tree;
+        let (tree, screen) = (&self.tree, &self.screen);
         let normalization = 1.0 / (emitted as f32 * samples_per_pixel as f32);
         let estimates: Vec<Rgb> = self
             .segments
@@ -350,14 +482,20 @@ impl Volume {
                 let phase = medium.phase();
                 let outgoing = -segment.direction;
                 let mut sum = Rgb::ZERO;
-                tree.gather(segment, radius, |photon, t| {
+                let visit = |photon: &VolumePhoton, t: f32| {
                     if photon.medium == segment.medium && photon.bounces <= segment.budget {
                         sum += medium.transmittance(t)
                             * photon.power
                             * (phase.eval(outgoing, photon.incoming)
                                 / inside_area(segment, t, radius));
                     }
-                });
+                };
+                if segment.primary {
+                    let pixel = (segment.slot / samples_per_pixel) as usize;
+                    screen.gather(&tree.photons, segment, pixel, radius, visit);
+                } else {
+                    tree.gather(segment, radius, visit);
+                }
                 sum * segment.weight * normalization
             })
             .collect();
@@ -418,7 +556,7 @@ mod tests {
             .collect();
         let radius = 0.07;
         let mut tree = VolumeTree::default();
-        tree.build([photons.as_slice()].into_iter(), radius);
+        tree.build(photons.iter().copied(), radius);
         for _ in 0..200 {
             let origin = Vec3::new(next(), next(), next()) * 4.0 - 2.0;
             let direction = (Vec3::new(next(), next(), next()) - 0.5).normalize();
@@ -437,6 +575,7 @@ mod tests {
                 weight: Rgb::ONE,
                 entry_normal: Vec3::ZERO,
                 exit_normal: Vec3::ZERO,
+                primary: false,
             };
             let mut found = Vec::new();
             tree.gather(&segment, radius, |p, _| found.push(p.position.to_array()));
@@ -453,6 +592,75 @@ mod tests {
             found.sort_by_key(key);
             expected.sort_by_key(key);
             assert_eq!(found, expected);
+        }
+    }
+
+    /// The pixel lists (with their near tree) find, for a stretch on a pixel's primary ray,
+    /// exactly the photons a brute-force scan finds, each once: photons all around the camera,
+    /// some behind it and some off the film.
+    #[test]
+    fn screen_index_matches_brute_force() {
+        let mut state = 999u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((state >> 40) as f32) / (1u64 << 24) as f32
+        };
+        let camera = scene::CameraModel::new(
+            &scene::Camera {
+                position: Vec3::new(0.1, 0.2, 3.0),
+                look_at: Vec3::new(0.0, 0.0, 0.0),
+                up: Vec3::Y,
+                fov_y: 50f32.to_radians(),
+                aperture_radius: 0.0,
+                focus_distance: 1.0,
+            },
+            &scene::Film {
+                width: 40,
+                height: 30,
+            },
+        )
+        .unwrap();
+        let photons: Vec<VolumePhoton> = (0..20_000)
+            .map(|_| photon(Vec3::new(next(), next(), next() * 1.2) * 4.0 - 2.0))
+            .collect();
+        let radius = 0.05;
+        let mut tree = VolumeTree::default();
+        tree.build(photons.iter().copied(), radius);
+        let mut screen = ScreenIndex::default();
+        screen.build(&camera, &tree.photons, radius);
+        assert!(!screen.near.photons.is_empty() && !screen.entries.is_empty());
+        for pixel in 0..40 * 30 {
+            let (x, y) = (pixel % 40, pixel / 40);
+            let film = Vec2::new(x as f32 + next(), y as f32 + next());
+            let ray = camera.generate_ray(film, Vec2::ZERO);
+            let segment = Segment {
+                origin: ray.origin + ray.direction.normalize() * 0.3 * next(),
+                direction: ray.direction.normalize(),
+                t_max: 1.0 + 4.0 * next(),
+                medium: 0,
+                budget: 0,
+                slot: pixel as u32,
+                weight: Rgb::ONE,
+                entry_normal: Vec3::ZERO,
+                exit_normal: Vec3::ZERO,
+                primary: true,
+            };
+            let mut found = Vec::new();
+            screen.gather(&tree.photons, &segment, pixel, radius, |p, _| {
+                found.push(p.position.to_array());
+            });
+            let mut expected = Vec::new();
+            for p in &photons {
+                test(&segment, radius * radius, p, &mut |p, _| {
+                    expected.push(p.position.to_array());
+                });
+            }
+            let key = |a: &[f32; 3]| a.map(f32::to_bits);
+            found.sort_by_key(key);
+            expected.sort_by_key(key);
+            assert_eq!(found, expected, "pixel {pixel}");
         }
     }
 

@@ -96,6 +96,16 @@ impl CameraModel {
     /// The film position (in pixels) where `point` appears through the lens centre, or `None` if it is
     /// behind the camera or outside the film.
     pub fn project(&self, point: Vec3) -> Option<Vec2> {
+        let (film, _) = self.film_point(point)?;
+        let inside =
+            film.x >= 0.0 && film.x <= self.width && film.y >= 0.0 && film.y <= self.height;
+        inside.then_some(film)
+    }
+
+    /// The film position (in pixels, possibly off the film) where `point` appears through the
+    /// lens centre, and its depth along the view direction; `None` if it is not in front of the
+    /// camera.
+    pub fn film_point(&self, point: Vec3) -> Option<(Vec2, f32)> {
         let v = point - self.position;
         let z = v.dot(self.forward);
         if z.is_nan() || z <= 0.0 {
@@ -107,9 +117,7 @@ impl CameraModel {
             0.5 * (sx + 1.0) * self.width,
             0.5 * (1.0 - sy) * self.height,
         );
-        let inside =
-            film.x >= 0.0 && film.x <= self.width && film.y >= 0.0 && film.y <= self.height;
-        inside.then_some(film)
+        Some((film, z))
     }
 
     /// Film pixels per unit area of a surface at `point` with normal `normal`, as seen through
