@@ -55,6 +55,7 @@ mod polygon;
 mod serialized;
 mod spectrum;
 mod toml;
+mod vol;
 
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -73,6 +74,7 @@ pub use frame::FRAMED_FOV_Y_DEGREES;
 pub(crate) use frame::frame_camera;
 pub use guard::containing_a_panic;
 pub use obj::DEFAULT_ALBEDO;
+pub use vol::write_vol;
 pub(crate) use scene::validate::fmt_vec;
 
 /// Film width used when the scene file gives none.

@@ -33,6 +33,7 @@
 mod aabb;
 mod bvh;
 mod camera;
+mod density_grid;
 mod description;
 pub mod fingerprint;
 mod frame;
@@ -65,12 +66,16 @@ pub use material::{
     MaterialParam, Mirror, RoughDielectric, SMOOTH_ROUGHNESS, TransportMode, fresnel_dielectric,
     luminance,
 };
+pub use density_grid::{
+    DensityGrid, GridEdge, GridError, MAX_GRID_VOXELS, check_grid_size,
+};
 pub use medium::{
-    HenyeyGreenstein, Media, Medium, MediumShape, PhaseSample, ShapeMedia, medium_after,
+    FreeFlight, HenyeyGreenstein, Media, Medium, MediumShape, PhaseSample, ShapeMedia,
+    medium_after,
 };
 pub use ray::{Hit, Primitive, Ray};
 pub use scene::{Scene, SceneError};
 pub use summary::{
-    Bounds, CameraSummary, LightCounts, MaterialSummary, MediumSummary, SceneSummary,
+    Bounds, CameraSummary, GridSummary, LightCounts, MaterialSummary, MediumSummary, SceneSummary,
     TextureSummary,
 };

@@ -83,12 +83,14 @@ interior = "water"
                     sigma_a: Vec3::ZERO,
                     sigma_s: Vec3::new(0.01, 0.02, 0.03),
                     g: 0.0,
+                    density: None,
                 },
                 Medium {
                     name: "water".into(),
                     sigma_a: Vec3::new(0.3, 0.1, 0.05),
                     sigma_s: Vec3::splat(0.2),
                     g: 0.9,
+                    density: None,
                 },
             ],
             shapes: vec![
