@@ -74,8 +74,8 @@ pub use frame::FRAMED_FOV_Y_DEGREES;
 pub(crate) use frame::frame_camera;
 pub use guard::containing_a_panic;
 pub use obj::DEFAULT_ALBEDO;
-pub use vol::write_vol;
 pub(crate) use scene::validate::fmt_vec;
+pub use vol::write_vol;
 
 /// Film width used when the scene file gives none.
 pub const DEFAULT_FILM_WIDTH: u32 = 512;

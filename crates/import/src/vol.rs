@@ -147,17 +147,28 @@ mod tests {
         let good = write_vol([2, 2, 2], Vec3::ZERO, Vec3::ONE, &[1.0; 8]);
         let cases: Vec<(Vec<u8>, &str)> = vec![
             (good[..40].to_vec(), "shorter than"),
-            (good[..good.len() - 4].to_vec(), "needs 80 bytes, the file has 76"),
+            (
+                good[..good.len() - 4].to_vec(),
+                "needs 80 bytes, the file has 76",
+            ),
             ([good.clone(), vec![0; 4]].concat(), "the file has 84"),
             (
-                write_vol([2, 2, 2], Vec3::ZERO, Vec3::ONE, &[1.0, -1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0]),
+                write_vol(
+                    [2, 2, 2],
+                    Vec3::ZERO,
+                    Vec3::ONE,
+                    &[1.0, -1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0],
+                ),
                 "density value 1 is -1",
             ),
             (
                 write_vol([1, 1, 1], Vec3::ZERO, Vec3::ONE, &[f32::NAN]),
                 "density value 0 is NaN",
             ),
-            (write_vol([0, 2, 2], Vec3::ZERO, Vec3::ONE, &[]), "zero dimension"),
+            (
+                write_vol([0, 2, 2], Vec3::ZERO, Vec3::ONE, &[]),
+                "zero dimension",
+            ),
             (
                 write_vol([100_000, 100_000, 100_000], Vec3::ZERO, Vec3::ONE, &[]),
                 "exceeds the limit",

@@ -84,20 +84,36 @@ fn lookups_are_trilinear_between_voxel_centres() {
         ))
         .unwrap();
     assert!((placed.density(Vec3::new(6.0, 1.0, 1.0)) - 2.0).abs() < 1e-5);
-    assert_eq!(placed.clip(Vec3::new(0.0, 1.0, 1.0), Vec3::X, 100.0), Some((5.0, 7.0)));
+    assert_eq!(
+        placed.clip(Vec3::new(0.0, 1.0, 1.0), Vec3::X, 100.0),
+        Some((5.0, 7.0))
+    );
 }
 
 #[test]
 fn bad_grids_are_refused() {
     let make = |size: [u32; 3], data: Vec<f32>| {
-        DensityGrid::new(size, data, GridEdge::Clamp, Vec3::ZERO, Vec3::ONE, Affine3A::IDENTITY)
+        DensityGrid::new(
+            size,
+            data,
+            GridEdge::Clamp,
+            Vec3::ZERO,
+            Vec3::ONE,
+            Affine3A::IDENTITY,
+        )
     };
-    assert!(matches!(make([0, 1, 1], vec![]), Err(GridError::ZeroSize(..))));
+    assert!(matches!(
+        make([0, 1, 1], vec![]),
+        Err(GridError::ZeroSize(..))
+    ));
     assert!(matches!(
         make([1 << 10, 1 << 10, 1 << 10], vec![]),
         Err(GridError::TooLarge(..))
     ));
-    assert!(matches!(make([2, 1, 1], vec![1.0]), Err(GridError::Count { .. })));
+    assert!(matches!(
+        make([2, 1, 1], vec![1.0]),
+        Err(GridError::Count { .. })
+    ));
     assert!(matches!(
         make([2, 1, 1], vec![1.0, -0.5]),
         Err(GridError::Density { index: 1, .. })
@@ -172,7 +188,10 @@ fn a_constant_grid_transmits_as_the_homogeneous_medium() {
     let medium = grid_medium(sigma_a, sigma_s, grid);
     let homogeneous = Medium::homogeneous("h", sigma_a * density, sigma_s * density, 0.0);
     let mut rng = Rng::new(7);
-    let (origin, direction) = (Vec3::new(-1.0, -0.2, 0.1), Vec3::new(1.0, 0.3, -0.1).normalize());
+    let (origin, direction) = (
+        Vec3::new(-1.0, -0.2, 0.1),
+        Vec3::new(1.0, 0.3, -0.1).normalize(),
+    );
     for d in [0.3, 1.0, 1.8] {
         let (mean, error) = mean_and_error(20_000, || {
             medium.transmittance_along(origin, direction, d, &mut || rng.f32())
@@ -262,12 +281,17 @@ fn spectral_tracking_is_unbiased_per_channel_in_a_chromatic_ramp() {
     let mut rng = Rng::new(5);
     let q = Vec3::new(0.5, 0.3, 0.2);
     let (mean, error) = mean_and_error(60_000, || {
-        match medium.sample_free_flight(Vec3::new(0.0, 0.5, 0.5), Vec3::X, 0.8, q, &mut || {
-            rng.f32()
-        }) {
+        match medium
+            .sample_free_flight(Vec3::new(0.0, 0.5, 0.5), Vec3::X, 0.8, q, &mut || rng.f32())
+        {
             FreeFlight::Pass { weight } => weight,
             FreeFlight::Scatter { .. } => Vec3::ZERO,
         }
     });
-    assert_close(mean, error, (-sigma_t * depth).exp(), "chromatic pass weight");
+    assert_close(
+        mean,
+        error,
+        (-sigma_t * depth).exp(),
+        "chromatic pass weight",
+    );
 }

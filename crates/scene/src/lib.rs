@@ -52,6 +52,7 @@ pub mod validate;
 
 pub use aabb::Aabb;
 pub use camera::{CameraModel, LensConnection};
+pub use density_grid::{DensityGrid, GridEdge, GridError, MAX_GRID_VOXELS, check_grid_size};
 pub use description::{
     Camera, Cylinder, Film, Light, LoadNotes, MAX_FILM_SIDE, Material, RenderDefaults, Rgb,
     SceneDescription, Sphere, Triangle, primitive_bounds,
@@ -66,12 +67,8 @@ pub use material::{
     MaterialParam, Mirror, RoughDielectric, SMOOTH_ROUGHNESS, TransportMode, fresnel_dielectric,
     luminance,
 };
-pub use density_grid::{
-    DensityGrid, GridEdge, GridError, MAX_GRID_VOXELS, check_grid_size,
-};
 pub use medium::{
-    FreeFlight, HenyeyGreenstein, Media, Medium, MediumShape, PhaseSample, ShapeMedia,
-    medium_after,
+    FreeFlight, HenyeyGreenstein, Media, Medium, MediumShape, PhaseSample, ShapeMedia, medium_after,
 };
 pub use ray::{Hit, Primitive, Ray};
 pub use scene::{Scene, SceneError};

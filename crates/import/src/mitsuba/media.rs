@@ -171,12 +171,7 @@ impl<'a> Importer<'a> {
             max,
             to_world,
         )
-        .map_err(|e| {
-            self.err(
-                volume,
-                crate::vol::vol_error(&path, e).to_string(),
-            )
-        })
+        .map_err(|e| self.err(volume, crate::vol::vol_error(&path, e).to_string()))
     }
 
     /// The media a shape or sensor names: its `<medium name="…">` children and `<ref name="…">`

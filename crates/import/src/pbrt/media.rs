@@ -99,19 +99,14 @@ impl Parser {
         }
         let dim = |parser: &Self, axis: &str| -> Result<u32, LoadError> {
             let n = parser.int(params, axis)?.unwrap_or(1);
-            u32::try_from(n).map_err(|_| {
-                parser.err(loc, format!("{label}: \"{axis}\" must be >= 0, got {n}"))
-            })
+            u32::try_from(n)
+                .map_err(|_| parser.err(loc, format!("{label}: \"{axis}\" must be >= 0, got {n}")))
         };
         let size = [dim(self, "nx")?, dim(self, "ny")?, dim(self, "nz")?];
         let bad = |e: scene::GridError| self.err(loc, format!("{label}: {e}"));
         // The dimensions are checked before the values are converted.
-        scene::check_grid_size(
-            u64::from(size[0]),
-            u64::from(size[1]),
-            u64::from(size[2]),
-        )
-        .map_err(bad)?;
+        scene::check_grid_size(u64::from(size[0]), u64::from(size[1]), u64::from(size[2]))
+            .map_err(bad)?;
         let Some(p) = params.get("density") else {
             return Err(self.err(loc, format!("{label} needs a \"float density\"")));
         };

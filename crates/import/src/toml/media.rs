@@ -75,17 +75,13 @@ impl Converter<'_> {
             }
             (None, Some(size), Some(density)) => (size, density, None, None),
             _ => {
-                return Err(self.invalid(
-                    key("file"),
-                    "give either file, or size and density",
-                ));
+                return Err(self.invalid(key("file"), "give either file, or size and density"));
             }
         };
         let (default_min, default_max) = file_box.unwrap_or((Vec3::ZERO, Vec3::ONE));
         let min = grid.min.map_or(default_min, Vec3::from);
         let max = grid.max.map_or(default_max, Vec3::from);
-        DensityGrid::new(size, data, edge, min, max, Affine3A::IDENTITY).map_err(|e| match source
-        {
+        DensityGrid::new(size, data, edge, min, max, Affine3A::IDENTITY).map_err(|e| match source {
             Some(path) => crate::vol::vol_error(&path, e),
             None => self.invalid(key("density"), e.to_string()),
         })

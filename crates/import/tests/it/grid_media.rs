@@ -55,7 +55,10 @@ fn toml_reads_inline_and_vol_grids() {
     );
     let d = load(&path).unwrap();
     let m = smoke(&d);
-    assert_eq!((m.sigma_a, m.sigma_s, m.g), (Vec3::new(0.1, 0.2, 0.3), Vec3::new(1.0, 2.0, 3.0), 0.25));
+    assert_eq!(
+        (m.sigma_a, m.sigma_s, m.g),
+        (Vec3::new(0.1, 0.2, 0.3), Vec3::new(1.0, 2.0, 3.0), 0.25)
+    );
     let grid = m.density.as_ref().unwrap();
     assert_eq!(grid.size(), [2, 1, 1]);
     assert_eq!(grid.data(), &[0.5, 1.5]);
@@ -63,7 +66,10 @@ fn toml_reads_inline_and_vol_grids() {
     assert_eq!(grid.bounds(), (Vec3::splat(-1.0), Vec3::ONE));
     // `fppm info` shows the grid.
     let summary = d.summary().to_string();
-    assert!(summary.contains("grid 2x1x1 (max density 1.5, edge zero)"), "{summary}");
+    assert!(
+        summary.contains("grid 2x1x1 (max density 1.5, edge zero)"),
+        "{summary}"
+    );
 
     // A .vol file: its box by default, clamped at the faces.
     let dir = path.parent().unwrap();
@@ -87,7 +93,10 @@ fn toml_reads_inline_and_vol_grids() {
 
 #[test]
 fn bad_grids_are_one_line_naming_the_file() {
-    let dir = fixture("grid_bad", &[("unused", "")]).parent().unwrap().to_path_buf();
+    let dir = fixture("grid_bad", &[("unused", "")])
+        .parent()
+        .unwrap()
+        .to_path_buf();
     let cases: [(&str, Vec<u8>, &str); 4] = [
         (
             "short.vol",
@@ -114,17 +123,30 @@ fn bad_grids_are_one_line_naming_the_file() {
         let vol = dir.join(name);
         std::fs::write(&vol, bytes).unwrap();
         let scene = dir.join(format!("{name}.toml"));
-        std::fs::write(&scene, toml_scene(&format!("[media.smoke.grid]\nfile = {name:?}"))).unwrap();
+        std::fs::write(
+            &scene,
+            toml_scene(&format!("[media.smoke.grid]\nfile = {name:?}")),
+        )
+        .unwrap();
         let err = load(&scene).unwrap_err();
         assert_names_file(&err, &vol);
         assert!(err.to_string().contains(needle), "{err}");
     }
     // Inline: the scene file is named.
     for (grid, needle) in [
-        ("size = [2, 2, 1]\ndensity = [1.0, 2.0]", "needs 4 density values, got 2"),
-        ("size = [1, 1, 1]\ndensity = [-1.0]", "density value 0 is -1"),
+        (
+            "size = [2, 2, 1]\ndensity = [1.0, 2.0]",
+            "needs 4 density values, got 2",
+        ),
+        (
+            "size = [1, 1, 1]\ndensity = [-1.0]",
+            "density value 0 is -1",
+        ),
         ("size = [0, 1, 1]\ndensity = []", "zero dimension"),
-        ("size = [1, 1, 1]\ndensity = [1.0]\nedge = \"wrap\"", "\"clamp\" or \"zero\""),
+        (
+            "size = [1, 1, 1]\ndensity = [1.0]\nedge = \"wrap\"",
+            "\"clamp\" or \"zero\"",
+        ),
         ("density = [1.0]", "give either file, or size and density"),
     ] {
         let scene = dir.join("inline.toml");
@@ -171,8 +193,14 @@ fn mitsuba_heterogeneous_gridvolume() {
     let d = load(&path).unwrap();
     let m = smoke(&d);
     // σs = scale·albedo, σa = scale·(1 − albedo) at density 1; the grid is the file's values.
-    assert!((m.sigma_s - Vec3::new(3.2, 2.0, 1.0)).abs().max_element() < 1e-5, "{m:?}");
-    assert!((m.sigma_a - Vec3::new(0.8, 2.0, 3.0)).abs().max_element() < 1e-5, "{m:?}");
+    assert!(
+        (m.sigma_s - Vec3::new(3.2, 2.0, 1.0)).abs().max_element() < 1e-5,
+        "{m:?}"
+    );
+    assert!(
+        (m.sigma_a - Vec3::new(0.8, 2.0, 3.0)).abs().max_element() < 1e-5,
+        "{m:?}"
+    );
     assert!((m.g - 0.3).abs() < 1e-6);
     let grid = m.density.as_ref().unwrap();
     assert_eq!((grid.size(), grid.edge()), ([2, 1, 1], GridEdge::Clamp));
@@ -187,7 +215,11 @@ fn mitsuba_heterogeneous_gridvolume() {
     std::fs::write(dir.join("smoke.vol"), b"VOL\x03").unwrap();
     let err = load(&path).unwrap_err();
     assert_names_file(&err, &path);
-    assert!(err.to_string().contains("smoke.vol: invalid volume grid file"), "{err}");
+    assert!(
+        err.to_string()
+            .contains("smoke.vol: invalid volume grid file"),
+        "{err}"
+    );
     // Unsupported wrap modes are refused rather than read differently.
     let wrap = MITSUBA.replace(
         r#"<string name="filename" value="smoke.vol"/>"#,
@@ -231,7 +263,10 @@ AttributeEnd
     // (the camera's mirror fix keeps x here: pbrt's LookAt frame is left-handed, fixed by
     // flipping the world's x, so the box lands at x = ±10).
     let centre = grid.to_world().transform_point3(Vec3::ZERO);
-    assert!((centre.x.abs() - 10.0).abs() < 1e-4 && centre.y.abs() < 1e-4, "{centre}");
+    assert!(
+        (centre.x.abs() - 10.0).abs() < 1e-4 && centre.y.abs() < 1e-4,
+        "{centre}"
+    );
     // Mean of the four samples at the centre (z: a single layer).
     assert!((grid.density(centre) - 1.5).abs() < 1e-4);
 
@@ -239,8 +274,14 @@ AttributeEnd
     std::fs::write(&path, bad).unwrap();
     let err = load(&path).unwrap_err();
     assert_names_file(&err, &path);
-    assert!(err.to_string().contains("needs 6 density values, got 4"), "{err}");
-    let huge = scene.replace(r#""integer nx" 2"#, r#""integer nx" 100000 "integer nz" 100000"#);
+    assert!(
+        err.to_string().contains("needs 6 density values, got 4"),
+        "{err}"
+    );
+    let huge = scene.replace(
+        r#""integer nx" 2"#,
+        r#""integer nx" 100000 "integer nz" 100000"#,
+    );
     std::fs::write(&path, huge).unwrap();
     let err = load(&path).unwrap_err();
     assert!(err.to_string().contains("exceeds the limit"), "{err}");

@@ -110,13 +110,10 @@ pub(super) fn trace(scene: &Scene, params: &RenderParams, ray: Ray, sampler: &mu
                 }
             } else {
                 // A grid: spectral delta tracking (`Medium::sample_free_flight`).
-                let flight = m.sample_free_flight(
-                    ray.origin,
-                    ray.direction,
-                    t_surface,
-                    q,
-                    &mut || sampler.next_f32(),
-                );
+                let flight =
+                    m.sample_free_flight(ray.origin, ray.direction, t_surface, q, &mut || {
+                        sampler.next_f32()
+                    });
                 let (t, weight) = match flight {
                     FreeFlight::Scatter { t, weight } => (Some(t), weight),
                     FreeFlight::Pass { weight } => (None, weight),
@@ -141,8 +138,7 @@ pub(super) fn trace(scene: &Scene, params: &RenderParams, ray: Ray, sampler: &mu
                 {
                     let p = phase.eval(outgoing, sample.incoming);
                     let shadow = shadow_ray(position, sample.incoming, sample.distance);
-                    let tr =
-                        transmittance_by(scene, shadow, medium, &mut || sampler.next_f32());
+                    let tr = transmittance_by(scene, shadow, medium, &mut || sampler.next_f32());
                     if p > 0.0 && tr != Rgb::ZERO {
                         let weight = if sample.is_delta {
                             1.0
@@ -306,7 +302,12 @@ struct RayHash(u64);
 impl RayHash {
     fn new(ray: &Ray) -> Self {
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        for v in ray.origin.to_array().into_iter().chain(ray.direction.to_array()) {
+        for v in ray
+            .origin
+            .to_array()
+            .into_iter()
+            .chain(ray.direction.to_array())
+        {
             state = (state ^ u64::from(v.to_bits())).wrapping_mul(0xbf58_476d_1ce4_e5b9);
             state ^= state >> 31;
         }

@@ -1,7 +1,8 @@
-//! Homogeneous participating media in the path tracer, against closed forms derived here:
-//! Beer–Lambert transmittance through an index-matched and a dielectric boundary, exact single
-//! scattering under a directional light, and the white furnace of an albedo-1 medium. Every
-//! other method refuses such a scene, and media that nothing refers to change no bit.
+//! Participating media in the path tracer, against closed forms derived here: Beer–Lambert
+//! transmittance through an index-matched and a dielectric boundary, exact single scattering
+//! under a directional light, and the white furnace of an albedo-1 medium, each for a
+//! homogeneous medium and for a density grid (delta and ratio tracking). Every other method
+//! refuses such a scene, and media that nothing refers to change no bit.
 
 use std::f64::consts::PI;
 
@@ -162,6 +163,19 @@ irradiance = [1.0, 1.0, 1.0]
 /// whatever the scattering every path ends on a wall and every pixel reads L in every channel.
 #[test]
 fn white_furnace_of_an_albedo_one_medium_reads_the_wall_radiance() {
+    white_furnace("");
+}
+
+/// The white furnace with a grid of uneven densities (0 to 2.5, chromatic σs, the camera
+/// inside the grid): spectral delta tracking and ratio tracking keep every channel at L.
+#[test]
+fn white_furnace_of_an_albedo_one_grid_reads_the_wall_radiance() {
+    white_furnace(
+        "[media.fog.grid]\nsize = [3, 2, 2]\ndensity = [0.0, 2.5, 0.4, 1.0, 0.1, 2.0, 1.5, 0.0, 0.3, 0.8, 2.2, 0.6]\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, 1.0]\n",
+    );
+}
+
+fn white_furnace(grid: &str) {
     let mut toml = String::from(
         r#"
 format = 1
@@ -183,6 +197,7 @@ albedo = [0.0, 0.0, 0.0]
 emission = [1.0, 1.0, 1.0]
 "#,
     );
+    toml += grid;
     // Corner and edges of each face, edge1 × edge2 pointing into the cube.
     let faces: [[[f64; 3]; 3]; 6] = [
         [[-1.0, -1.0, -1.0], [0.0, 0.0, 2.0], [2.0, 0.0, 0.0]],
@@ -207,6 +222,73 @@ emission = [1.0, 1.0, 1.0]
             );
         }
     }
+}
+
+/// Beer–Lambert through a grid of constant density 2 holding half the ink's coefficients: the
+/// same image as the homogeneous ink (delta tracking, then the emitter).
+#[test]
+fn transmittance_through_a_constant_grid_is_beer_lambert() {
+    let toml = through_sphere("type = \"interface\"").replace(
+        "[media.ink]\nsigma_a = [0.1, 0.5, 1.5]",
+        "[media.ink.grid]\nsize = [2, 2, 2]\ndensity = [2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0]\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, 1.0]\n[media.ink]\nsigma_a = [0.05, 0.25, 0.75]",
+    );
+    assert!(toml.contains("[media.ink.grid]"));
+    let image = path_render(&toml, 1024, 4, 1024);
+    let expected = SIGMA_A.map(|s| 2.0 * (-2.0 * s).exp());
+    assert_close(channel_means(&image), expected, 0.025, "constant grid");
+}
+
+/// Single scattering of the haze of [`single_scattering_matches_the_slab_integral`] as a grid
+/// of constant density 0.5 with doubled coefficients, clamped over a box larger than the
+/// sphere: the same slab integral (delta tracking for the vertex, ratio tracking for the
+/// shadow ray toward the sun).
+#[test]
+fn single_scattering_in_a_grid_matches_the_slab_integral() {
+    let toml = r#"
+format = 1
+[camera]
+position = [0.0, 0.0, 5.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 0.5
+[film]
+width = 4
+height = 4
+[media.haze]
+sigma_a = [0.1, 0.1, 0.1]
+sigma_s = [0.2, 0.4, 0.8]
+g = 0.3
+[media.haze.grid]
+size = [1, 2, 1]
+density = [0.5, 0.5]
+min = [-1.5, -1.5, -1.5]
+max = [1.5, 1.5, 1.5]
+[materials.boundary]
+type = "interface"
+[[shapes]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+material = "boundary"
+interior = "haze"
+[[lights]]
+type = "directional"
+direction = [0.0, 0.0, -1.0]
+irradiance = [1.0, 1.0, 1.0]
+"#;
+    let image = path_render(toml, 1024, 4, 1);
+    let g: f64 = 0.3;
+    let p = (1.0 - g * g) / (4.0 * PI * (1.0 + g).powi(3));
+    let sigma_s = [0.1, 0.2, 0.4];
+    let expected = sigma_s.map(|s: f64| {
+        let t = s + 0.05;
+        s * p * (1.0 - (-4.0 * t).exp()) / (2.0 * t)
+    });
+    assert_close(
+        channel_means(&image),
+        expected,
+        0.03,
+        "single scattering in a grid",
+    );
 }
 
 /// Every method but the path tracer refuses a scene with media with one typed error.
