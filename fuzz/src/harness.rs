@@ -22,6 +22,9 @@ pub const STUB_PLY: &str = include_str!("../stubs/stub.ply");
 pub const STUB_SPD: &str = include_str!("../stubs/stub.spd");
 /// The pbrt scene of the `ply` target: a camera, a point light and `mesh.ply` (the fuzzed file).
 pub const PLY_SCENE: &str = include_str!("../stubs/ply_scene.pbrt");
+/// The TOML scene of the `vol` target: a sphere of smoke whose grid is `smoke.vol` (the
+/// fuzzed file).
+pub const VOL_SCENE: &str = include_str!("../stubs/vol_scene.toml");
 /// The fixed scene of the `checkpoint` target (and of its seeds).
 pub const CHECKPOINT_SCENE: &str = include_str!("../stubs/checkpoint_scene.toml");
 

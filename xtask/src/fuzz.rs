@@ -40,7 +40,7 @@ Exit status 1 if a target crashed.
   --list           print the targets and exit";
 
 /// The targets: (name, dictionary in fuzz/dict/ or none).
-const TARGETS: [(&str, Option<&str>); 14] = [
+const TARGETS: [(&str, Option<&str>); 15] = [
     ("toml_scene", Some("toml.dict")),
     ("obj", Some("obj.dict")),
     ("gltf", Some("gltf.dict")),
@@ -48,6 +48,7 @@ const TARGETS: [(&str, Option<&str>); 14] = [
     ("mitsuba", Some("mitsuba.dict")),
     ("pbrt", Some("pbrt.dict")),
     ("ply", Some("ply.dict")),
+    ("vol", None),
     ("checkpoint", None),
     ("exr", None),
     ("scene_render", None),
@@ -427,6 +428,14 @@ mod seeds {
             "mitsuba" => add_files(&mut seeds, find(&shared.join("mitsuba3"), &["xml"])),
             "pbrt" => add_files(&mut seeds, find(&shared, &["pbrt"])),
             "ply" => add_files(&mut seeds, find(&shared, &["ply"])),
+            "vol" => {
+                add_files(&mut seeds, find(&root.join("scenes"), &["vol"]));
+                let ramp: Vec<f32> = (0..4 * 3 * 2).map(|i| (i % 4) as f32 * 0.5).collect();
+                seeds.insert(
+                    "ramp.vol".to_owned(),
+                    import::write_vol([4, 3, 2], glam::Vec3::ZERO, glam::Vec3::ONE, &ramp),
+                );
+            }
             "exr" => {
                 add_files(&mut seeds, find(&root.join("tests/golden"), &["exr"]));
                 seeds.insert("tiny.exr".to_owned(), tiny_exr(root)?);

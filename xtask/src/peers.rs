@@ -536,15 +536,16 @@ fn run_mitsuba(
 /// `perspective` sensor with `fov_axis = y` and a box-filtered `hdrfilm`; a diffuse colour
 /// texture (with albedo 1) is a `bitmap` reflectance (sRGB-decoded by Mitsuba for 8-bit files,
 /// bilinear, with the same wrap mode), a cut-out a `mask` BSDF with the alpha as opacity
-/// (`raw`); a homogeneous medium is a `homogeneous` medium ([`medium_xml`]) that shapes refer
+/// (`raw`); a homogeneous medium is a `homogeneous` medium ([`medium_xml`]), a grid medium a
+/// `heterogeneous` one with its `.vol` beside the XML ([`grid_medium_xml`]), that shapes refer
 /// to as `interior` and `exterior` and the sensor as its `medium`, the interface material a
 /// `null` BSDF; the integrator is `$integrator` with unlimited depth (by default `volpath`
 /// for a scene with media, else `path`); the environment is Mitsuba's
 /// `constant` or `envmap` ([`environment_emitter`]); a rough dielectric is `roughdielectric`
 /// (GGX), a glossy conductor a two-sided `roughconductor` of the η whose exact Fresnel fppm's
 /// Schlick approximates, a glossy coat over a diffuse base a two-sided `roughplastic`. Lights
-/// other than emissive surfaces, point lights and the environment are refused: the peer scenes
-/// do not use them.
+/// other than emissive surfaces, point and directional lights and the environment are refused:
+/// the peer scenes do not use them.
 pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -> Result<PathBuf> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut xml = String::new();
@@ -592,7 +593,12 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
     }
     writeln!(xml, "  </sensor>")?;
     for (index, medium) in description.media.list.iter().enumerate() {
-        writeln!(xml, "  {}", medium_xml(medium, index as u32))?;
+        let element = if medium.is_homogeneous() {
+            medium_xml(medium, index as u32)
+        } else {
+            grid_medium_xml(medium, index as u32, dir)?
+        };
+        writeln!(xml, "  {element}")?;
     }
 
     let rgb = |c: [f32; 3]| format!("{}, {}, {}", c[0], c[1], c[2]);
@@ -830,6 +836,15 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
                 v(position),
                 rgb(intensity.to_array())
             )?,
+            scene::Light::Directional {
+                direction,
+                irradiance,
+            } => writeln!(
+                xml,
+                "  <emitter type=\"directional\"><vector name=\"direction\" value=\"{}\"/><rgb name=\"irradiance\" value=\"{}\"/></emitter>",
+                v(direction),
+                rgb(irradiance.to_array())
+            )?,
             ref other => bail!("light {other:?} is not exported"),
         }
     }
@@ -885,6 +900,57 @@ pub(crate) fn medium_xml(medium: &scene::Medium, index: u32) -> String {
         albedo(2),
         medium.g
     )
+}
+
+/// A grid medium as Mitsuba 3's `heterogeneous`: its densities written to `medium-INDEX.vol` in
+/// `dir`, read by a `gridvolume` (trilinear, clamped: fppm's [`scene::GridEdge::Clamp`]) whose
+/// `to_world` maps the unit cube onto the grid's box in the world, `scale` the extinction at
+/// density 1, `albedo` σs / σt and the same `hg` phase function. Mitsuba's heterogeneous
+/// extinction is a scalar grid times `scale`, so a grid medium with chromatic σt (or pbrt's zero
+/// edges) is refused.
+fn grid_medium_xml(medium: &scene::Medium, index: u32, dir: &Path) -> Result<String> {
+    let Some(grid) = &medium.density else {
+        bail!("medium {:?} has no grid", medium.name);
+    };
+    let sigma_t = medium.sigma_t();
+    if sigma_t.max_element() != sigma_t.min_element() {
+        bail!(
+            "grid medium {:?}: Mitsuba's heterogeneous medium needs the same extinction in every channel, got {sigma_t}",
+            medium.name
+        );
+    }
+    if grid.edge() != scene::GridEdge::Clamp {
+        bail!(
+            "grid medium {:?}: only grids clamped at the faces (Mitsuba's gridvolume) are exported",
+            medium.name
+        );
+    }
+    let file = format!("medium-{index}.vol");
+    let (min, max) = grid.bounds();
+    std::fs::write(
+        dir.join(&file),
+        import::write_vol(grid.size(), min, max, grid.data()),
+    )?;
+    // Unit cube → the box → the world; Mitsuba's `matrix` is row-major.
+    let to_world = glam::Mat4::from(grid.to_world())
+        * glam::Mat4::from_translation(min)
+        * glam::Mat4::from_scale(max - min);
+    let m = to_world.transpose().to_cols_array();
+    let matrix = m.iter().map(f32::to_string).collect::<Vec<_>>().join(" ");
+    let scale = sigma_t.x;
+    let albedo = if scale > 0.0 {
+        medium.sigma_s / scale
+    } else {
+        glam::Vec3::ZERO
+    };
+    Ok(format!(
+        "<medium type=\"heterogeneous\" id=\"{}\"><volume name=\"sigma_t\" type=\"gridvolume\"><string name=\"filename\" value=\"{file}\"/><transform name=\"to_world\"><matrix value=\"{matrix}\"/></transform></volume><rgb name=\"albedo\" value=\"{}, {}, {}\"/><float name=\"scale\" value=\"{scale}\"/><phase type=\"hg\"><float name=\"g\" value=\"{}\"/></phase></medium>",
+        medium_id(index),
+        albedo.x,
+        albedo.y,
+        albedo.z,
+        medium.g
+    ))
 }
 
 /// The environment as a Mitsuba emitter: `constant` (scale folded into the radiance) or

@@ -41,6 +41,7 @@ fn peer_scenes_export_the_materials_fppm_renders() {
         "glossy-caustic",
         "room-indirect",
         "fog-box",
+        "smoke-sun",
     ] {
         let path = root.join("scenes/peers").join(format!("{name}.toml"));
         let original = import::load(&path).unwrap();

@@ -239,6 +239,15 @@ pub enum LoadError {
         /// What is wrong.
         message: String,
     },
+    /// A density grid file (Mitsuba's `.vol`) is malformed, too large or holds a negative or
+    /// non-finite density.
+    #[error("{}: invalid volume grid file: {message}", path.display())]
+    VolumeFile {
+        /// The grid file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// Nothing fppm can render emits light, but the file has emitters it had to skip
     /// (environment lights are not supported yet).
     #[error(
@@ -342,6 +351,7 @@ impl LoadError {
             | Self::Xml { path, .. }
             | Self::Pbrt { path, .. }
             | Self::MeshFile { path, .. }
+            | Self::VolumeFile { path, .. }
             | Self::Texture { path, .. }
             | Self::EnvironmentMap { path, .. }
             | Self::NoSupportedEmitter { path, .. } => path,

@@ -55,6 +55,7 @@ mod polygon;
 mod serialized;
 mod spectrum;
 mod toml;
+mod vol;
 
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -74,6 +75,7 @@ pub(crate) use frame::frame_camera;
 pub use guard::containing_a_panic;
 pub use obj::DEFAULT_ALBEDO;
 pub(crate) use scene::validate::fmt_vec;
+pub use vol::write_vol;
 
 /// Film width used when the scene file gives none.
 pub const DEFAULT_FILM_WIDTH: u32 = 512;

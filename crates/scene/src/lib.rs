@@ -33,6 +33,7 @@
 mod aabb;
 mod bvh;
 mod camera;
+mod density_grid;
 mod description;
 pub mod fingerprint;
 mod frame;
@@ -51,6 +52,7 @@ pub mod validate;
 
 pub use aabb::Aabb;
 pub use camera::{CameraModel, LensConnection};
+pub use density_grid::{DensityGrid, GridEdge, GridError, MAX_GRID_VOXELS, check_grid_size};
 pub use description::{
     Camera, Cylinder, Film, Light, LoadNotes, MAX_FILM_SIDE, Material, RenderDefaults, Rgb,
     SceneDescription, Sphere, Triangle, primitive_bounds,
@@ -66,11 +68,11 @@ pub use material::{
     luminance,
 };
 pub use medium::{
-    HenyeyGreenstein, Media, Medium, MediumShape, PhaseSample, ShapeMedia, medium_after,
+    FreeFlight, HenyeyGreenstein, Media, Medium, MediumShape, PhaseSample, ShapeMedia, medium_after,
 };
 pub use ray::{Hit, Primitive, Ray};
 pub use scene::{Scene, SceneError};
 pub use summary::{
-    Bounds, CameraSummary, LightCounts, MaterialSummary, MediumSummary, SceneSummary,
+    Bounds, CameraSummary, GridSummary, LightCounts, MaterialSummary, MediumSummary, SceneSummary,
     TextureSummary,
 };

@@ -76,6 +76,7 @@ fn transmittance_is_beer_lambert_per_channel() {
         sigma_a: Vec3::new(0.5, 0.0, 2.0),
         sigma_s: Vec3::new(0.5, 0.0, 1.0),
         g: 0.0,
+        density: None,
     };
     let t = m.transmittance(2.0);
     assert!((t.x - (-2.0f32).exp()).abs() < 1e-6);

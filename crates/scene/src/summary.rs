@@ -70,12 +70,27 @@ pub struct MediumSummary {
     /// Henyey–Greenstein asymmetry.
     #[serde(serialize_with = "rounded")]
     pub g: f32,
+    /// The density grid of a heterogeneous medium: voxels per axis, largest density, edge rule.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grid: Option<GridSummary>,
     /// Shapes (triangle ranges and spheres) with this medium on their interior side.
     pub interior_of: usize,
     /// Shapes with this medium on their exterior side.
     pub exterior_of: usize,
     /// Whether the camera sits in it.
     pub around_camera: bool,
+}
+
+/// The density grid of a [`MediumSummary`].
+#[derive(Clone, Debug, Serialize)]
+pub struct GridSummary {
+    /// Voxels along x, y and z.
+    pub size: [u32; 3],
+    /// The largest density.
+    #[serde(serialize_with = "rounded")]
+    pub max_density: f32,
+    /// What samples outside the grid read (`clamp` or `zero`).
+    pub edge: &'static str,
 }
 
 /// Number of delta lights of each kind.
@@ -328,6 +343,11 @@ impl SceneDescription {
                 sigma_a: m.sigma_a,
                 sigma_s: m.sigma_s,
                 g: m.g,
+                grid: m.density.as_ref().map(|grid| GridSummary {
+                    size: grid.size(),
+                    max_density: grid.max_density(),
+                    edge: grid.edge().name(),
+                }),
                 interior_of: count(i, |s| s.interior),
                 exterior_of: count(i, |s| s.exterior),
                 around_camera: media.camera == Some(i as u32),
@@ -415,9 +435,20 @@ impl fmt::Display for SceneSummary {
         if !self.media.is_empty() {
             writeln!(f, "media      {}", self.media.len())?;
             for m in &self.media {
+                let kind = match &m.grid {
+                    None => "homogeneous".to_owned(),
+                    Some(grid) => format!(
+                        "grid {}x{}x{} (max density {}, edge {}), at density 1:",
+                        grid.size[0],
+                        grid.size[1],
+                        grid.size[2],
+                        Show(grid.max_density),
+                        grid.edge
+                    ),
+                };
                 writeln!(
                     f,
-                    "  {:?} homogeneous sigma_a {} sigma_s {} g {} (interior of {}, exterior of {} shapes{})",
+                    "  {:?} {kind} sigma_a {} sigma_s {} g {} (interior of {}, exterior of {} shapes{})",
                     m.name,
                     Show3(m.sigma_a),
                     Show3(m.sigma_s),

@@ -386,6 +386,13 @@ pub fn media(d: &SceneDescription) -> Result<(), Invalid> {
                 format!("must be in (-1, 1), got {}", m.g),
             ));
         }
+        // A grid is valid by construction; its peak extinction must still be finite.
+        if !m.is_homogeneous() && !m.majorant().is_finite() {
+            return Err(Invalid::value(
+                key("density"),
+                "times its coefficients overflows (the peak extinction is not finite)",
+            ));
+        }
     }
     let count = media.list.len();
     let index = |key: String, m: Option<u32>| match m {

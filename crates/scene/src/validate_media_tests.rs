@@ -37,6 +37,7 @@ fn with_fog() -> SceneDescription {
             sigma_a: Vec3::splat(0.1),
             sigma_s: Vec3::splat(0.5),
             g: 0.3,
+            density: None,
         }],
         shapes: vec![ShapeMedia {
             shape: MediumShape::Triangles { start: 0, end: 12 },

@@ -613,3 +613,72 @@ material = "lamp"
     .ok();
     fppm(&dir, &["render", "fog.toml", "--passes", "1"]).ok();
 }
+
+/// A medium's density grid that is broken (a `.vol` whose header and size disagree, a negative
+/// density, absurd dimensions): one line naming the grid file and the problem, exit 1 like
+/// every other bad scene file, and no output. A good grid renders with the path tracer.
+#[test]
+fn bad_density_grids() {
+    let dir = temp_dir("bad_grid");
+    let scene = r#"format = 1
+[camera]
+position = [0.0, 0.0, 4.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 30.0
+[film]
+width = 8
+height = 8
+[media.smoke]
+sigma_a = [0.1, 0.1, 0.1]
+sigma_s = [2.0, 2.0, 2.0]
+[media.smoke.grid]
+file = "smoke.vol"
+min = [-1.0, -1.0, -1.0]
+max = [1.0, 1.0, 1.0]
+[materials.boundary]
+type = "interface"
+[[lights]]
+type = "directional"
+direction = [0.0, -1.0, -1.0]
+irradiance = [3.0, 3.0, 3.0]
+[[shapes]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+material = "boundary"
+interior = "smoke"
+"#;
+    std::fs::write(dir.join("smoke.toml"), scene).unwrap();
+    // Mitsuba's .vol: "VOL", version 3, encoding 1, x, y, z resolutions, channels, a box, data.
+    let vol = |size: [i32; 3], data: &[f32]| {
+        let mut out = b"VOL\x03".to_vec();
+        for v in [1, size[0], size[1], size[2], 1] {
+            out.extend_from_slice(&i32::to_le_bytes(v));
+        }
+        for v in [0.0f32, 0.0, 0.0, 1.0, 1.0, 1.0].iter().chain(data) {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        out
+    };
+    let cases: [(Vec<u8>, &str); 3] = [
+        (vol([2, 2, 2], &[1.0; 5]), "the file has 68"),
+        (vol([1, 1, 2], &[1.0, -0.5]), "density value 1 is -0.5"),
+        (vol([1 << 20, 1 << 20, 1], &[]), "exceeds the limit"),
+    ];
+    for (bytes, needle) in cases {
+        std::fs::write(dir.join("smoke.vol"), bytes).unwrap();
+        check_in(
+            &dir,
+            &["render", "smoke.toml", "--method", "path", "--passes", "1"],
+            1,
+            &["smoke.vol", "invalid volume grid file", needle],
+            &["smoke.toml", "smoke.vol"],
+        );
+    }
+    std::fs::write(dir.join("smoke.vol"), vol([1, 1, 2], &[1.0, 0.5])).unwrap();
+    fppm(
+        &dir,
+        &["render", "smoke.toml", "--method", "path", "--passes", "1"],
+    )
+    .ok();
+}

@@ -1,6 +1,10 @@
 //! Participating media: `<medium type="homogeneous">` (Mitsuba 3's `sigma_t`, `albedo`,
-//! `scale`, or `sigma_a` and `sigma_s`; an `hg` or `isotropic` phase function), referred to
-//! by shapes as `interior` and `exterior` and by the sensor as its `medium` (`docs/media.md`).
+//! `scale`, or `sigma_a` and `sigma_s`) and `<medium type="heterogeneous">` (a `gridvolume`
+//! `sigma_t` read from a `.vol` file, a constant `albedo`, `scale`), an `hg` or `isotropic`
+//! phase function, referred to by shapes as `interior` and `exterior` and by the sensor as its
+//! `medium` (`docs/media.md`).
+
+use std::sync::Arc;
 
 use super::*;
 
@@ -19,29 +23,37 @@ impl<'a> Importer<'a> {
             return Err(self.err(node, "expected a <medium>"));
         }
         let ty = node.attr("type").unwrap_or("");
-        if ty != "homogeneous" {
-            return Err(self.err(
-                node,
-                format!("medium type \"{ty}\" is not supported (only homogeneous)"),
-            ));
-        }
         let scale = self.float(node, "scale")?.unwrap_or(1.0) as f32;
-        let (sigma_a, sigma_s) = match (prop(node, "sigma_a"), prop(node, "sigma_s")) {
-            (None, None) => {
-                let sigma_t = self
-                    .colour(node, "sigma_t", SpectrumUse::Ior)?
-                    .unwrap_or(Rgb::ONE);
-                let albedo = self
-                    .colour(node, "albedo", SpectrumUse::Reflectance)?
-                    .unwrap_or(Rgb::splat(DEFAULT_ALBEDO));
-                (sigma_t * (Rgb::ONE - albedo), sigma_t * albedo)
+        let (sigma_a, sigma_s, density) = match ty {
+            "homogeneous" => {
+                let (sigma_a, sigma_s) = match (prop(node, "sigma_a"), prop(node, "sigma_s")) {
+                    (None, None) => {
+                        let sigma_t = self
+                            .colour(node, "sigma_t", SpectrumUse::Ior)?
+                            .unwrap_or(Rgb::ONE);
+                        let albedo = self
+                            .colour(node, "albedo", SpectrumUse::Reflectance)?
+                            .unwrap_or(Rgb::splat(DEFAULT_ALBEDO));
+                        (sigma_t * (Rgb::ONE - albedo), sigma_t * albedo)
+                    }
+                    _ => (
+                        self.colour(node, "sigma_a", SpectrumUse::Ior)?
+                            .unwrap_or(Rgb::ZERO),
+                        self.colour(node, "sigma_s", SpectrumUse::Ior)?
+                            .unwrap_or(Rgb::ZERO),
+                    ),
+                };
+                (sigma_a, sigma_s, None)
             }
-            _ => (
-                self.colour(node, "sigma_a", SpectrumUse::Ior)?
-                    .unwrap_or(Rgb::ZERO),
-                self.colour(node, "sigma_s", SpectrumUse::Ior)?
-                    .unwrap_or(Rgb::ZERO),
-            ),
+            "heterogeneous" => self.heterogeneous(node)?,
+            _ => {
+                return Err(self.err(
+                    node,
+                    format!(
+                        "medium type \"{ty}\" is not supported (only homogeneous and heterogeneous)"
+                    ),
+                ));
+            }
         };
         let mut g = 0.0;
         for child in &node.children {
@@ -76,9 +88,90 @@ impl<'a> Importer<'a> {
             sigma_a: sigma_a * scale,
             sigma_s: sigma_s * scale,
             g,
+            density,
         });
         self.medium_cache.insert(key, index);
         Ok(index)
+    }
+
+    /// A `heterogeneous` medium's (σa, σs) at density 1, before `scale`, and its grid: Mitsuba 3's
+    /// σt(x) = scale·sigma_t(x) and σs(x) = albedo·σt(x), with `sigma_t` a `gridvolume` (or a
+    /// constant: then the medium is homogeneous) and `albedo` a constant (default 0.75).
+    fn heterogeneous(
+        &mut self,
+        node: &'a Node,
+    ) -> Result<(Rgb, Rgb, Option<Arc<scene::DensityGrid>>), LoadError> {
+        let albedo_node = prop(node, "albedo").map(|n| self.deref(n)).transpose()?;
+        if albedo_node.is_some_and(|n| n.tag == "volume") {
+            return Err(self.err(
+                node,
+                "an albedo given as a volume is not supported (give a float or rgb)",
+            ));
+        }
+        let albedo = self
+            .colour(node, "albedo", SpectrumUse::Reflectance)?
+            .unwrap_or(Rgb::splat(DEFAULT_ALBEDO));
+        let sigma_t_node = prop(node, "sigma_t").map(|n| self.deref(n)).transpose()?;
+        let (sigma_t, density) = match sigma_t_node {
+            Some(volume) if volume.tag == "volume" => {
+                (Rgb::ONE, Some(Arc::new(self.grid_volume(volume)?)))
+            }
+            _ => (
+                self.colour(node, "sigma_t", SpectrumUse::Ior)?
+                    .unwrap_or(Rgb::ONE),
+                None,
+            ),
+        };
+        Ok((sigma_t * (Rgb::ONE - albedo), sigma_t * albedo, density))
+    }
+
+    /// A `<volume type="gridvolume">` (or `grid`): its `.vol` file over the unit cube of its
+    /// `to_world` (over the file's box with `use_grid_bbox`), trilinear and clamped at the
+    /// faces, Mitsuba's defaults (other filters and wrap modes are refused).
+    fn grid_volume(&mut self, volume: &'a Node) -> Result<scene::DensityGrid, LoadError> {
+        let ty = volume.attr("type").unwrap_or("");
+        if ty != "gridvolume" && ty != "grid" {
+            return Err(self.err(
+                volume,
+                format!("volume type \"{ty}\" is not supported (only gridvolume)"),
+            ));
+        }
+        if let Some(filter) = self.string(volume, "filter_type")?
+            && filter != "trilinear"
+        {
+            return Err(self.err(
+                volume,
+                format!("filter_type \"{filter}\" is not supported (only trilinear)"),
+            ));
+        }
+        if let Some(wrap) = self.string(volume, "wrap_mode")?
+            && wrap != "clamp"
+        {
+            return Err(self.err(
+                volume,
+                format!("wrap_mode \"{wrap}\" is not supported (only clamp)"),
+            ));
+        }
+        let file = self
+            .string(volume, "filename")?
+            .ok_or_else(|| self.err(volume, "needs a filename"))?;
+        let path = self.doc.resolve(volume, file);
+        let vol = crate::vol::load_vol(&path).map_err(|e| self.err(volume, e.to_string()))?;
+        let (min, max) = if self.boolean(volume, "use_grid_bbox")?.unwrap_or(false) {
+            (vol.min, vol.max)
+        } else {
+            (glam::Vec3::ZERO, glam::Vec3::ONE)
+        };
+        let to_world = glam::Affine3A::from_mat4(self.transform(volume, "to_world")?.as_mat4());
+        scene::DensityGrid::new(
+            vol.size,
+            vol.data,
+            scene::GridEdge::Clamp,
+            min,
+            max,
+            to_world,
+        )
+        .map_err(|e| self.err(volume, crate::vol::vol_error(&path, e).to_string()))
     }
 
     /// The media a shape or sensor names: its `<medium name="…">` children and `<ref name="…">`

@@ -191,6 +191,19 @@ impl Parser {
             }
         }
         builder.media.list = std::mem::take(&mut self.media);
+        // Grids were placed by the transform at `MakeNamedMedium`; the camera's reflection
+        // applies to them as to shapes.
+        if fix != DMat4::IDENTITY {
+            let fix = glam::Affine3A::from_mat4(fix.as_mat4());
+            for (i, m) in builder.media.list.iter_mut().enumerate() {
+                if let Some(grid) = &m.density {
+                    let placed = grid.placed(fix * grid.to_world()).map_err(|e| {
+                        self.err(self.medium_locs[i], format!("medium \"{}\": {e}", m.name))
+                    })?;
+                    m.density = Some(std::sync::Arc::new(placed));
+                }
+            }
+        }
         if let Some((name, loc)) = self.camera_medium.take() {
             builder.media.camera = self.medium_named(&name, loc)?;
         }

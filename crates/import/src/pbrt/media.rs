@@ -1,6 +1,9 @@
-//! Participating media: `MakeNamedMedium` of type `homogeneous` (pbrt-v4's `sigma_a`,
-//! `sigma_s`, `scale` and `g`, `src/pbrt/media.cpp`), and the media a `MediumInterface` puts on
-//! either side of the shapes that follow it and around the camera (`docs/media.md`).
+//! Participating media: `MakeNamedMedium` of type `homogeneous` and `uniformgrid` (pbrt-v4's
+//! `sigma_a`, `sigma_s`, `scale` and `g`, and a grid's `density`, `nx`, `ny`, `nz`, `p0`,
+//! `p1`, `src/pbrt/media.cpp`), and the media a `MediumInterface` puts on either side of the
+//! shapes that follow it and around the camera (`docs/media.md`).
+
+use std::sync::Arc;
 
 use super::*;
 
@@ -21,11 +24,11 @@ impl Parser {
             .str_param(params, "type")?
             .ok_or_else(|| self.err(loc, format!("{label} needs a \"string type\"")))?;
         match ty.as_str() {
-            "homogeneous" => {}
-            "uniformgrid" | "rgbgrid" | "cloud" | "nanovdb" => {
+            "homogeneous" | "uniformgrid" => {}
+            "rgbgrid" | "cloud" | "nanovdb" => {
                 return Err(self.err(
                     loc,
-                    format!("{label}: heterogeneous media (\"{ty}\") are not supported, only homogeneous"),
+                    format!("{label}: medium type \"{ty}\" is not supported, only homogeneous and uniformgrid"),
                 ));
             }
             other => {
@@ -56,16 +59,71 @@ impl Parser {
             .unwrap_or(Rgb::ONE);
         let scale = self.float(params, "scale")?.unwrap_or(1.0) as f32;
         let g = self.float(params, "g")?.unwrap_or(0.0) as f32;
+        let density = if ty == "uniformgrid" {
+            Some(Arc::new(self.uniform_grid(&label, params, loc)?))
+        } else {
+            None
+        };
         // Negative, non-finite or out-of-range values are refused by the scene's validation.
         self.medium_index
             .insert(name.clone(), self.media.len() as u32);
+        self.medium_locs.push(loc);
         self.media.push(scene::Medium {
             name,
             sigma_a: sigma_a * scale,
             sigma_s: sigma_s * scale,
             g,
+            density,
         });
         Ok(())
+    }
+
+    /// A `uniformgrid` medium's density grid (pbrt-v4's `GridMedium::Create`): `float density`
+    /// (nx·ny·nz values, x fastest), `integer nx, ny, nz` (default 1), `point3 p0, p1` (the
+    /// box in the medium's space, default the unit cube), placed by the current transform
+    /// (medium to world), read as pbrt's `SampledGrid` (zero outside the samples). Emission
+    /// (`Le`, `Lescale`, `temperature`) is refused.
+    fn uniform_grid(
+        &mut self,
+        label: &str,
+        params: &Params,
+        loc: Loc,
+    ) -> Result<scene::DensityGrid, LoadError> {
+        for emissive in ["temperature", "Lescale"] {
+            if params.get(emissive).is_some() {
+                return Err(self.err(
+                    loc,
+                    format!("{label}: emissive media (\"{emissive}\") are not supported"),
+                ));
+            }
+        }
+        let dim = |parser: &Self, axis: &str| -> Result<u32, LoadError> {
+            let n = parser.int(params, axis)?.unwrap_or(1);
+            u32::try_from(n)
+                .map_err(|_| parser.err(loc, format!("{label}: \"{axis}\" must be >= 0, got {n}")))
+        };
+        let size = [dim(self, "nx")?, dim(self, "ny")?, dim(self, "nz")?];
+        let bad = |e: scene::GridError| self.err(loc, format!("{label}: {e}"));
+        // The dimensions are checked before the values are converted.
+        scene::check_grid_size(u64::from(size[0]), u64::from(size[1]), u64::from(size[2]))
+            .map_err(bad)?;
+        let Some(p) = params.get("density") else {
+            return Err(self.err(loc, format!("{label} needs a \"float density\"")));
+        };
+        self.expect_type(p, &["float"])?;
+        let density: Vec<f32> = self.nums(p)?.into_iter().map(|x| x as f32).collect();
+        let point = |parser: &Self, key: &str, default: Vec3| -> Result<Vec3, LoadError> {
+            match parser.vec3s(params, key, &["point3", "point"])?.as_deref() {
+                None => Ok(default),
+                Some([p]) => Ok(*p),
+                Some(_) => Err(parser.err(loc, format!("{label}: \"{key}\" needs one point"))),
+            }
+        };
+        let p0 = point(self, "p0", Vec3::ZERO)?;
+        let p1 = point(self, "p1", Vec3::ONE)?;
+        let to_world = glam::Affine3A::from_mat4(self.state.ctm.as_mat4());
+        scene::DensityGrid::new(size, density, scene::GridEdge::Zero, p0, p1, to_world)
+            .map_err(|e| self.err(loc, format!("{label}: {e}")))
     }
 
     /// The index of the medium `name` ("" is vacuum), or an error at `loc` if none was made.

@@ -69,6 +69,7 @@ pub(crate) fn load_pbrt(path: &Path, options: &LoadOptions) -> Result<SceneDescr
         include_stack: Vec::new(),
         active: Active::All,
         media: Vec::new(),
+        medium_locs: Vec::new(),
         medium_index: HashMap::new(),
         camera_medium: None,
     };
@@ -218,6 +219,8 @@ struct Parser {
     active: Active,
     /// `MakeNamedMedium`, in the order of definition.
     media: Vec<scene::Medium>,
+    /// Where each medium of `media` was made.
+    medium_locs: Vec<Loc>,
     /// Index into `media` by name.
     medium_index: HashMap<String, u32>,
     /// The outside medium's name at the `Camera` directive (pbrt-v4's camera medium).

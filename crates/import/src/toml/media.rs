@@ -2,11 +2,13 @@
 //! `[media.NAME]` tables, and the names that shapes and the camera give as their media.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
-use scene::Medium;
+use glam::{Affine3A, Vec3};
+use scene::{DensityGrid, GridEdge, Medium};
 
 use super::convert::Converter;
-use super::schema::MediumToml;
+use super::schema::{GridToml, MediumToml};
 use crate::error::LoadError;
 
 /// The media by name, in name order, and each name's index.
@@ -17,7 +19,7 @@ pub(super) struct MediaNames {
 
 impl Converter<'_> {
     /// Every `[media.NAME]` table as a medium: coefficients finite and non-negative, `g` in
-    /// (−1, 1), 0 by default.
+    /// (−1, 1), 0 by default, and an optional density grid (`[media.NAME.grid]`).
     pub(super) fn media(
         &self,
         tables: BTreeMap<String, MediumToml>,
@@ -34,15 +36,55 @@ impl Converter<'_> {
             if !(g > -1.0 && g < 1.0) {
                 return Err(self.invalid(key("g"), format!("must be in (-1, 1), got {g}")));
             }
+            let density = match m.grid {
+                Some(grid) => Some(Arc::new(self.grid(&name, grid)?)),
+                None => None,
+            };
             media.names.insert(name.clone(), media.list.len() as u32);
             media.list.push(Medium {
                 name,
                 sigma_a,
                 sigma_s,
                 g,
+                density,
             });
         }
         Ok(media)
+    }
+
+    /// The `[media.NAME.grid]` table: a `.vol` `file` (its box unless `min`/`max` are given)
+    /// or inline `size` and `density` (box `min`/`max`, by default the unit cube), and the
+    /// `edge` rule (`clamp`, the default, as Mitsuba; or `zero`, as pbrt).
+    fn grid(&self, name: &str, grid: GridToml) -> Result<DensityGrid, LoadError> {
+        let key = |k: &str| format!("[media.{name}.grid] {k}");
+        let edge = match grid.edge.as_deref() {
+            None | Some("clamp") => GridEdge::Clamp,
+            Some("zero") => GridEdge::Zero,
+            Some(other) => {
+                return Err(self.invalid(
+                    key("edge"),
+                    format!("must be \"clamp\" or \"zero\", got {other:?}"),
+                ));
+            }
+        };
+        let (size, data, file_box, source) = match (grid.file, grid.size, grid.density) {
+            (Some(file), None, None) => {
+                let path = self.dir.join(file);
+                let vol = crate::vol::load_vol(&path)?;
+                (vol.size, vol.data, Some((vol.min, vol.max)), Some(path))
+            }
+            (None, Some(size), Some(density)) => (size, density, None, None),
+            _ => {
+                return Err(self.invalid(key("file"), "give either file, or size and density"));
+            }
+        };
+        let (default_min, default_max) = file_box.unwrap_or((Vec3::ZERO, Vec3::ONE));
+        let min = grid.min.map_or(default_min, Vec3::from);
+        let max = grid.max.map_or(default_max, Vec3::from);
+        DensityGrid::new(size, data, edge, min, max, Affine3A::IDENTITY).map_err(|e| match source {
+            Some(path) => crate::vol::vol_error(&path, e),
+            None => self.invalid(key("density"), e.to_string()),
+        })
     }
 
     /// The index of the medium `name` that `key` gives; `None` for no name (vacuum).

@@ -22,13 +22,27 @@ pub(super) struct SceneFile {
     pub(super) render: Option<RenderToml>,
 }
 
-/// A homogeneous medium (extension).
+/// A medium (extension): homogeneous, or with a density grid.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct MediumToml {
     pub(super) sigma_a: [f32; 3],
     pub(super) sigma_s: [f32; 3],
     pub(super) g: Option<f32>,
+    pub(super) grid: Option<GridToml>,
+}
+
+/// A medium's density grid (extension): a Mitsuba `.vol` file or inline values, over an
+/// axis-aligned box of the world.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct GridToml {
+    pub(super) file: Option<String>,
+    pub(super) size: Option<[u32; 3]>,
+    pub(super) density: Option<Vec<f32>>,
+    pub(super) min: Option<[f32; 3]>,
+    pub(super) max: Option<[f32; 3]>,
+    pub(super) edge: Option<String>,
 }
 
 #[derive(Deserialize)]

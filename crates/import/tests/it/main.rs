@@ -6,6 +6,7 @@ mod bad_input;
 mod cylinder;
 mod fuzz_regressions;
 mod gltf;
+mod grid_media;
 mod import_textures;
 mod media;
 mod mitsuba;

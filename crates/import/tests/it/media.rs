@@ -83,12 +83,14 @@ interior = "water"
                     sigma_a: Vec3::ZERO,
                     sigma_s: Vec3::new(0.01, 0.02, 0.03),
                     g: 0.0,
+                    density: None,
                 },
                 Medium {
                     name: "water".into(),
                     sigma_a: Vec3::new(0.3, 0.1, 0.05),
                     sigma_s: Vec3::splat(0.2),
                     g: 0.9,
+                    density: None,
                 },
             ],
             shapes: vec![
@@ -313,8 +315,16 @@ fn mitsuba_media_that_fppm_cannot_render_are_refused() {
             "cannot bound a medium",
         ),
         (
-            r#"<shape type="cube"><medium type="heterogeneous" name="interior"/></shape>"#,
-            "medium type \"heterogeneous\" is not supported",
+            r#"<shape type="cube"><medium type="heterogeneous" name="interior"><volume name="albedo" type="gridvolume"/></medium></shape>"#,
+            "an albedo given as a volume is not supported",
+        ),
+        (
+            r#"<shape type="cube"><medium type="heterogeneous" name="interior"><volume name="sigma_t" type="constvolume"/></medium></shape>"#,
+            "volume type \"constvolume\" is not supported",
+        ),
+        (
+            r#"<shape type="cube"><medium type="foggy" name="interior"/></shape>"#,
+            "medium type \"foggy\" is not supported",
         ),
         (
             r#"<shape type="cube"><medium type="homogeneous" name="interior"><phase type="rayleigh"/></medium></shape>"#,

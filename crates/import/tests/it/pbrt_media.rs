@@ -80,6 +80,7 @@ fn homogeneous_media_and_interfaces_read_into_the_description() {
             sigma_a: Vec3::new(1.0, 0.5, 0.25),
             sigma_s: Vec3::new(2.0, 4.0, 8.0),
             g: 0.5,
+            density: None,
         }
     );
     assert_eq!(haze.sigma_a, Vec3::ZERO);
@@ -137,8 +138,8 @@ fn refusals_name_the_file() {
     let cases: [(&str, &str, &[&str]); 6] = [
         (
             "pbrt_media_grid",
-            r#"MakeNamedMedium "smoke" "string type" "uniformgrid" "float density" [ 1 ]"#,
-            &["line 12", "smoke", "uniformgrid", "only homogeneous"],
+            r#"MakeNamedMedium "smoke" "string type" "uniformgrid" "float density" [ 1 ] "integer nx" [ 2 ]"#,
+            &["line 12", "smoke", "needs 2 density values, got 1"],
         ),
         (
             "pbrt_media_nanovdb",

@@ -8,7 +8,10 @@
 //! - Free-flight sampling is chromatic (pbrt-v4's and Mitsuba's spectral MIS over RGB): a
 //!   channel is picked with probability proportional to the path throughput, a distance drawn
 //!   from that channel's exp(−σt·t), and the density is the average of the channels' densities
-//!   under those probabilities, so every channel's estimate stays unbiased.
+//!   under those probabilities, so every channel's estimate stays unbiased. In a grid medium
+//!   it is spectral delta tracking ([`scene::Medium::sample_free_flight`]) with the same
+//!   channel proportions, and shadow rays estimate the transmittance by ratio tracking
+//!   ([`scene::Medium::transmittance_along`]).
 //! - At a medium vertex the Henyey–Greenstein phase function scatters; its sampling is exact
 //!   (weight one). Next-event estimation from surfaces and medium vertices multiplies by the
 //!   transmittance of the shadow ray, computed exactly through every medium it crosses and
@@ -18,7 +21,7 @@
 //!   the combination unbiased.
 
 use glam::Vec3;
-use scene::{Hit, Ray, Rgb, Scene, TransportMode, medium_after};
+use scene::{FreeFlight, Hit, Ray, Rgb, Scene, TransportMode, medium_after};
 
 use super::{next_event_through, power_heuristic, roulette};
 use crate::params::RenderParams;
@@ -63,33 +66,65 @@ pub(super) fn trace(scene: &Scene, params: &RenderParams, ray: Ray, sampler: &mu
         let hit = scene.intersect(&ray);
         let t_surface = hit.map_or(f32::INFINITY, |h| h.t);
         if let Some(m) = medium.and_then(|m| media.get(m as usize)) {
-            let sigma_t = m.sigma_t();
             let total = beta.x + beta.y + beta.z;
             if total.is_nan() || total <= 0.0 {
                 break;
             }
             let q = beta / total;
-            let (u_channel, u_distance) = (sampler.next_f32(), sampler.next_f32());
-            let channel = if u_channel < q.x {
-                0
-            } else if u_channel < q.x + q.y {
-                1
+            // The distance of a medium vertex before the surface, if the flight ends in one;
+            // `beta` is weighted either way.
+            let scatter_at = if m.is_homogeneous() {
+                let sigma_t = m.sigma_t();
+                let (u_channel, u_distance) = (sampler.next_f32(), sampler.next_f32());
+                let channel = if u_channel < q.x {
+                    0
+                } else if u_channel < q.x + q.y {
+                    1
+                } else {
+                    2
+                };
+                let t = if sigma_t[channel] > 0.0 {
+                    -(1.0 - u_distance).ln() / sigma_t[channel]
+                } else {
+                    f32::INFINITY
+                };
+                if t < t_surface {
+                    // A medium vertex.
+                    let tr = m.transmittance(t);
+                    let pdf = (q * sigma_t * tr).element_sum();
+                    if pdf.is_nan() || pdf <= 0.0 {
+                        break;
+                    }
+                    beta *= m.sigma_s * tr / pdf;
+                    Some(t)
+                } else {
+                    // The surface (or infinity) is reached: weight by the transmittance over
+                    // the probability of getting there.
+                    let tr = m.transmittance(t_surface);
+                    let survive = (q * tr).element_sum();
+                    if survive.is_nan() || survive <= 0.0 {
+                        break;
+                    }
+                    beta *= tr / survive;
+                    None
+                }
             } else {
-                2
-            };
-            let t = if sigma_t[channel] > 0.0 {
-                -(1.0 - u_distance).ln() / sigma_t[channel]
-            } else {
-                f32::INFINITY
-            };
-            if t < t_surface {
-                // A medium vertex.
-                let tr = m.transmittance(t);
-                let pdf = (q * sigma_t * tr).element_sum();
-                if pdf.is_nan() || pdf <= 0.0 {
+                // A grid: spectral delta tracking (`Medium::sample_free_flight`).
+                let flight =
+                    m.sample_free_flight(ray.origin, ray.direction, t_surface, q, &mut || {
+                        sampler.next_f32()
+                    });
+                let (t, weight) = match flight {
+                    FreeFlight::Scatter { t, weight } => (Some(t), weight),
+                    FreeFlight::Pass { weight } => (None, weight),
+                };
+                beta *= weight;
+                if beta == Rgb::ZERO || !beta.is_finite() {
                     break;
                 }
-                beta *= m.sigma_s * tr / pdf;
+                t
+            };
+            if let Some(t) = scatter_at {
                 let position = ray.at(t);
                 if depth >= params.budget.max_depth {
                     break;
@@ -103,7 +138,7 @@ pub(super) fn trace(scene: &Scene, params: &RenderParams, ray: Ray, sampler: &mu
                 {
                     let p = phase.eval(outgoing, sample.incoming);
                     let shadow = shadow_ray(position, sample.incoming, sample.distance);
-                    let tr = transmittance(scene, shadow, medium);
+                    let tr = transmittance_by(scene, shadow, medium, &mut || sampler.next_f32());
                     if p > 0.0 && tr != Rgb::ZERO {
                         let weight = if sample.is_delta {
                             1.0
@@ -129,14 +164,6 @@ pub(super) fn trace(scene: &Scene, params: &RenderParams, ray: Ray, sampler: &mu
                 crossings = 0;
                 continue;
             }
-            // The surface (or infinity) is reached: weight by the transmittance over the
-            // probability of getting there.
-            let tr = m.transmittance(t_surface);
-            let survive = (q * tr).element_sum();
-            if survive.is_nan() || survive <= 0.0 {
-                break;
-            }
-            beta *= tr / survive;
         }
         let Some(hit) = hit else {
             if lights.has_environment() {
@@ -181,7 +208,9 @@ pub(super) fn trace(scene: &Scene, params: &RenderParams, ray: Ray, sampler: &mu
         let u_light_2d = sampler.next_2d();
         if !bsdf.is_specular() {
             radiance += beta
-                * surface_next_event(scene, &hit, &bsdf, outgoing, medium, u_light, u_light_2d);
+                * surface_next_event(
+                    scene, &hit, &bsdf, outgoing, medium, u_light, u_light_2d, sampler,
+                );
         }
         let u_lobe = sampler.next_f32();
         let u = sampler.next_2d();
@@ -219,14 +248,33 @@ fn shadow_ray(origin: Vec3, direction: Vec3, distance: f32) -> Ray {
 
 /// The transmittance along `ray` (to its `t_max`) starting in `medium`: the product of each
 /// medium's over its stretch, through interfaces; zero if any other surface is in the way.
-pub(crate) fn transmittance(scene: &Scene, mut ray: Ray, mut medium: Option<u32>) -> Rgb {
+pub(crate) fn transmittance(scene: &Scene, ray: Ray, medium: Option<u32>) -> Rgb {
+    // Exact through homogeneous media, which draw no number. Through a grid, ratio tracking
+    // with numbers hashed from the ray: deterministic, and unbiased for each ray.
+    let mut rng = RayHash::new(&ray);
+    transmittance_by(scene, ray, medium, &mut || rng.next_f32())
+}
+
+/// [`transmittance`] with the numbers of ratio tracking in grid media drawn from `u` (the path
+/// tracer's sampler); homogeneous media draw none.
+fn transmittance_by(
+    scene: &Scene,
+    mut ray: Ray,
+    mut medium: Option<u32>,
+    u: &mut impl FnMut() -> f32,
+) -> Rgb {
     let media = &scene.media().list;
     let target = ray.t_max.is_finite().then(|| ray.at(ray.t_max));
     let mut tr = Rgb::ONE;
     for _ in 0..=MAX_CROSSINGS {
         let hit = scene.intersect(&ray);
         if let Some(m) = medium.and_then(|m| media.get(m as usize)) {
-            tr *= m.transmittance(hit.map_or(ray.t_max, |h| h.t));
+            let t = hit.map_or(ray.t_max, |h| h.t);
+            if m.is_homogeneous() {
+                tr *= m.transmittance(t);
+            } else {
+                tr *= m.transmittance_along(ray.origin, ray.direction, t, u);
+            }
         }
         let Some(hit) = hit else {
             return tr;
@@ -243,10 +291,40 @@ pub(crate) fn transmittance(scene: &Scene, mut ray: Ray, mut medium: Option<u32>
     Rgb::ZERO
 }
 
+/// Uniform numbers from a hash of a ray (SplitMix64 over its origin's and direction's bits),
+/// for [`transmittance`]'s callers that have no sampler.
+struct RayHash(u64);
+
+impl RayHash {
+    fn new(ray: &Ray) -> Self {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        for v in ray
+            .origin
+            .to_array()
+            .into_iter()
+            .chain(ray.direction.to_array())
+        {
+            state = (state ^ u64::from(v.to_bits())).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            state ^= state >> 31;
+        }
+        Self(state)
+    }
+
+    fn next_f32(&mut self) -> f32 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^= z >> 31;
+        (z >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
+    }
+}
+
 /// Light sampling at a non-specular surface vertex `hit` seen along −`outgoing`, in a scene
 /// with media: [`super::next_event`] with the shadow ray's transmittance for its visibility.
 /// `medium` is the medium the path arrived in; the shadow ray leaves in the medium of the side
 /// it leaves to.
+#[allow(clippy::too_many_arguments)]
 fn surface_next_event(
     scene: &Scene,
     hit: &Hit,
@@ -255,6 +333,7 @@ fn surface_next_event(
     medium: Option<u32>,
     u_light: f32,
     u: glam::Vec2,
+    sampler: &mut Sampler,
 ) -> Rgb {
     next_event_through(scene, hit, bsdf, outgoing, u_light, u, |sample| {
         let shadow = if sample.distance.is_finite() {
@@ -263,6 +342,6 @@ fn surface_next_event(
             hit.spawn_ray(sample.incoming)
         };
         let start = medium_after(scene.shape_media(hit), hit, sample.incoming, medium);
-        transmittance(scene, shadow, start)
+        transmittance_by(scene, shadow, start, &mut || sampler.next_f32())
     })
 }

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use scene::{Bsdf, Hit, Rgb, TransportMode, medium_after};
 
 use super::frequency::SlotFrequency;
-use super::volume::Segment;
+use super::volume::{Segment, stretch_transmittance};
 use super::{NO_VISIBLE_POINT, PhotonMapper, SLOT_CHUNK, Setup};
 use crate::path::{MAX_CROSSINGS, bsdf_emission_weight, next_event};
 use crate::rng::{CAMERA_STREAM, Sampler};
@@ -42,8 +42,10 @@ struct CameraSample {
     visible: Option<VisiblePoint>,
     /// Values dropped for being NaN or infinite: the direct sum, the visible point's weight.
     non_finite: u64,
-    /// Its stretches through media, for the volume gather (empty without media).
+    /// Its stretches through media, for the volume gather (empty without media), and their
+    /// ratio-tracking walks through grids (`Segment::table` indexes this list).
     segments: Vec<Segment>,
+    tables: Vec<(f32, Rgb)>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -79,12 +81,16 @@ impl PhotonMapper {
             if setup.scene.has_media() && !self.volume.segments_traced {
                 // A restored PPM render: its visible points' stretches through media, as the
                 // first pass traced them.
-                let segments: Vec<Vec<Segment>> = (0..n_slots)
+                let samples: Vec<CameraSample> = (0..n_slots)
                     .into_par_iter()
                     .with_min_len(SLOT_CHUNK)
-                    .map(|slot| setup.trace_camera_path(slot as u32, 0, true).segments)
+                    .map(|slot| setup.trace_camera_path(slot as u32, 0, true))
                     .collect();
-                self.volume.segments = segments.concat();
+                self.volume.segments.clear();
+                self.volume.tables.clear();
+                for sample in &samples {
+                    self.volume.add_segments(&sample.segments, &sample.tables);
+                }
                 self.volume.segments_traced = true;
             }
             // Only the directly seen emission changes: accumulate it in place, in parallel.
@@ -122,10 +128,11 @@ impl PhotonMapper {
         let inv_passes = 1.0 / self.weight_passes as f32;
         let mut non_finite = 0;
         self.volume.segments.clear();
+        self.volume.tables.clear();
         self.volume.segments_traced = true;
         for (slot, sample) in traced.into_iter().enumerate() {
             non_finite += sample.non_finite;
-            self.volume.segments.extend_from_slice(&sample.segments);
+            self.volume.add_segments(&sample.segments, &sample.tables);
             for c in 0..3 {
                 self.direct[slot][c] += f64::from(sample.direct[c]);
             }
@@ -182,10 +189,11 @@ impl Setup {
     fn trace_camera_path(&self, slot: u32, pass: u32, segments: bool) -> CameraSample {
         let weight_scale = 1.0 / self.params.film.samples_per_pixel as f32;
         let mut stretches = Vec::new();
+        let mut tables = Vec::new();
         let chain = self.camera_chain_in_media(
             slot,
             pass,
-            (segments && self.scene.has_media()).then_some(&mut stretches),
+            (segments && self.scene.has_media()).then_some((&mut stretches, &mut tables)),
         );
         let mut direct = chain.direct;
         let mut non_finite = 0;
@@ -244,6 +252,7 @@ impl Setup {
             visible,
             non_finite,
             segments: stretches,
+            tables,
         }
     }
 
@@ -270,7 +279,7 @@ impl Setup {
         &self,
         slot: u32,
         pass: u32,
-        mut segments: Option<&mut Vec<Segment>>,
+        mut segments: Option<(&mut Vec<Segment>, &mut Vec<(f32, Rgb)>)>,
     ) -> CameraChain {
         let spp = self.params.film.samples_per_pixel;
         let pixel = slot / spp;
@@ -299,12 +308,23 @@ impl Setup {
             let hit = self.scene.intersect(&ray);
             if let Some(m) = medium.and_then(|m| self.scene.media().list.get(m as usize)) {
                 let t = hit.map_or(f32::INFINITY, |h| h.t);
-                if let Some(segments) = segments.as_deref_mut()
+                let direction = ray.direction.normalize();
+                let mut walk = Vec::new();
+                let tables = match segments.as_mut() {
+                    Some((_, tables)) => &mut **tables,
+                    None => &mut walk,
+                };
+                let start = tables.len() as u32;
+                let tr = stretch_transmittance(m, ray.origin, direction, t, tables, &mut || {
+                    sampler.next_f32()
+                });
+                let end = tables.len() as u32;
+                if let Some((segments, _)) = segments.as_mut()
                     && bounces < max_depth
                 {
                     segments.push(Segment {
                         origin: ray.origin,
-                        direction: ray.direction.normalize(),
+                        direction,
                         t_max: t,
                         medium: medium.unwrap_or_default(),
                         budget: max_depth - 1 - bounces,
@@ -313,9 +333,10 @@ impl Setup {
                         entry_normal: left,
                         exit_normal: hit.map_or(Vec3::ZERO, |h| h.geometric_normal),
                         primary: bounces == 0 && pinhole,
+                        table: (start, end),
                     });
                 }
-                throughput *= m.transmittance(t);
+                throughput *= tr;
             }
             let Some(hit) = hit else {
                 // An escaped camera path sees the environment (zero without one).

@@ -3,7 +3,7 @@
 //! scenes with media.
 
 use glam::Vec3;
-use scene::{Hit, Ray, Rgb, medium_after};
+use scene::{FreeFlight, Hit, Ray, Rgb, medium_after};
 
 use super::Setup;
 use crate::light_path::luminance;
@@ -49,9 +49,9 @@ impl Setup {
     }
 
     /// A free flight along `ray` in medium `id` toward `hit` (none: the ray leaves the scene),
-    /// for a photon of power `power`: chromatic, as the path tracer's (`path/media.rs`): a
-    /// channel drawn in proportion to the power, a distance from its exp(−σt·t), and the
-    /// densities averaged over the channels, so that every channel stays unbiased.
+    /// for a photon of power `power`: `Medium::sample_free_flight`, with the channels in
+    /// proportion to the power (spectral MIS: chromatic free-flight sampling in a homogeneous
+    /// medium, spectral tracking in a grid), so that every channel stays unbiased.
     pub(super) fn fly(
         &self,
         id: u32,
@@ -64,46 +64,31 @@ impl Setup {
             return Flight::Through(power);
         };
         let t_surface = hit.map_or(f32::INFINITY, |h| h.t);
-        let sigma_t = m.sigma_t();
         let total = power.element_sum();
         if total.is_nan() || total <= 0.0 {
             return Flight::End;
         }
-        let q = power / total;
-        let (u_channel, u_distance) = (sampler.next_f32(), sampler.next_f32());
-        let channel = if u_channel < q.x {
-            0
-        } else if u_channel < q.x + q.y {
-            1
-        } else {
-            2
+        let flight = m.sample_free_flight(
+            ray.origin,
+            ray.direction,
+            t_surface,
+            power / total,
+            &mut || sampler.next_f32(),
+        );
+        let (weight, position) = match flight {
+            FreeFlight::Scatter { t, weight } => (weight, Some(ray.at(t))),
+            FreeFlight::Pass { weight } => (weight, None),
         };
-        let t = if sigma_t[channel] > 0.0 {
-            -(1.0 - u_distance).ln() / sigma_t[channel]
-        } else {
-            f32::INFINITY
-        };
-        let (tr, density) = if t < t_surface {
-            let tr = m.transmittance(t);
-            (m.sigma_s * tr, (q * sigma_t * tr).element_sum())
-        } else {
-            let tr = m.transmittance(t_surface);
-            (tr, (q * tr).element_sum())
-        };
-        if density.is_nan() || density <= 0.0 {
+        if weight == Rgb::ZERO {
             return Flight::End;
         }
-        let p = power * tr / density;
+        let p = power * weight;
         if !p.is_finite() {
             return Flight::NonFinite;
         }
-        if t < t_surface {
-            Flight::Scatter {
-                position: ray.at(t),
-                power: p,
-            }
-        } else {
-            Flight::Through(p)
+        match position {
+            Some(position) => Flight::Scatter { position, power: p },
+            None => Flight::Through(p),
         }
     }
 

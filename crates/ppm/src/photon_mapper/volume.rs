@@ -25,7 +25,7 @@
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
-use scene::{Rgb, Scene};
+use scene::{Medium, Rgb, Scene};
 
 /// Photons per leaf of [`VolumeTree`].
 const LEAF: usize = 8;
@@ -69,6 +69,63 @@ pub(crate) struct Segment {
     /// Whether it lies on the slot's primary ray through a pinhole (no bounce before it), so
     /// that [`ScreenIndex`] finds its photons by the pixel it crosses.
     pub(crate) primary: bool,
+    /// In a grid medium, its ratio-tracking walk: the range of [`Volume::tables`] (of the
+    /// camera sample's own list while it is traced) that [`stretch_transmittance`] filled; empty
+    /// in a homogeneous one, whose transmittance is exact.
+    pub(crate) table: (u32, u32),
+}
+
+/// The transmittance of `medium` along the camera stretch (`origin`, unit `direction`,
+/// `t_max`): exact in a homogeneous medium, drawing nothing; in a grid, one ratio-tracking walk
+/// (numbers from `u`) whose tentative collisions are appended to `table` as (t, the walk's
+/// product up to and including t). The product at the last collision before any t is an
+/// unbiased estimate of the transmittance from the origin to t (the collisions before t are
+/// those of a walk to t), so the one walk serves the stretch's end and every photon gathered
+/// along it ([`table_transmittance`]).
+pub(crate) fn stretch_transmittance(
+    medium: &Medium,
+    origin: Vec3,
+    direction: Vec3,
+    t_max: f32,
+    table: &mut Vec<(f32, Rgb)>,
+    u: &mut impl FnMut() -> f32,
+) -> Rgb {
+    let Some(grid) = medium.density.as_deref() else {
+        return medium.transmittance(t_max);
+    };
+    let majorant = medium.majorant();
+    let Some((t0, t1)) = grid.clip(origin, direction, t_max) else {
+        return Rgb::ONE;
+    };
+    if !(majorant > 0.0) {
+        return Rgb::ONE;
+    }
+    let sigma_t = medium.sigma_t();
+    let mut tr = Rgb::ONE;
+    let mut t = t0;
+    // The same guard as `Medium::transmittance_along`: a walk this long has a negligible
+    // transmittance.
+    for _ in 0..(1 << 20) {
+        t -= (1.0 - u()).ln() / majorant;
+        if t >= t1 {
+            return tr;
+        }
+        let st = sigma_t * grid.density(origin + direction * t);
+        tr *= (Rgb::ONE - st / majorant).max(Rgb::ZERO);
+        table.push((t, tr));
+        if tr == Rgb::ZERO {
+            return tr;
+        }
+    }
+    Rgb::ZERO
+}
+
+/// The transmittance from a stretch's origin to `t` along it, from its ratio-tracking walk.
+fn table_transmittance(table: &[(f32, Rgb)], t: f32) -> Rgb {
+    match table.partition_point(|&(tj, _)| tj <= t) {
+        0 => Rgb::ONE,
+        k => table[k - 1].1,
+    }
 }
 
 /// The area of the disc of radius `r` across the stretch at distance `t` along it that lies
@@ -423,6 +480,8 @@ pub(crate) struct Volume {
     /// The stretches of the camera paths of the last camera pass that placed visible points,
     /// in slot order.
     pub(crate) segments: Vec<Segment>,
+    /// The ratio-tracking walks of the stretches through grid media ([`Segment::table`]).
+    pub(crate) tables: Vec<(f32, Rgb)>,
     /// Whether `segments` were traced by this renderer (a restored one has none yet).
     pub(crate) segments_traced: bool,
     tree: VolumeTree,
@@ -430,11 +489,23 @@ pub(crate) struct Volume {
 }
 
 impl Volume {
+    /// Appends one camera sample's stretches and their ratio-tracking walks (whose ranges index
+    /// `tables`).
+    pub(crate) fn add_segments(&mut self, segments: &[Segment], tables: &[(f32, Rgb)]) {
+        let offset = self.tables.len() as u32;
+        self.tables.extend_from_slice(tables);
+        self.segments.extend(segments.iter().map(|s| Segment {
+            table: (s.table.0 + offset, s.table.1 + offset),
+            ..*s
+        }));
+    }
+
     /// Heap bytes of the per-pass buffers (stretches and tree) and of the per-slot sums.
     pub(crate) fn heap_bytes(&self) -> (usize, usize) {
         use std::mem::size_of;
         (
             self.segments.capacity() * size_of::<Segment>()
+                + self.tables.capacity() * size_of::<(f32, Rgb)>()
                 + self.tree.heap_bytes()
                 + self.screen.heap_bytes(),
             (self.sum.capacity() + self.last.capacity()) * size_of::<[f64; 3]>(),
@@ -469,7 +540,7 @@ impl Volume {
         self.last.resize(n_slots, [0.0; 3]);
         self.gathers += 1;
         let media = &scene.media().list;
-        let (tree, screen) = (&self.tree, &self.screen);
+        let (tree, screen, tables) = (&self.tree, &self.screen, &self.tables);
         let normalization = 1.0 / (emitted as f32 * samples_per_pixel as f32);
         let estimates: Vec<Rgb> = self
             .segments
@@ -482,9 +553,18 @@ impl Volume {
                 let phase = medium.phase();
                 let outgoing = -segment.direction;
                 let mut sum = Rgb::ZERO;
+                let table = tables
+                    .get(segment.table.0 as usize..segment.table.1 as usize)
+                    .unwrap_or_default();
+                let homogeneous = medium.is_homogeneous();
                 let visit = |photon: &VolumePhoton, t: f32| {
                     if photon.medium == segment.medium && photon.bounces <= segment.budget {
-                        sum += medium.transmittance(t)
+                        let tr = if homogeneous {
+                            medium.transmittance(t)
+                        } else {
+                            table_transmittance(table, t)
+                        };
+                        sum += tr
                             * photon.power
                             * (phase.eval(outgoing, photon.incoming)
                                 / inside_area(segment, t, radius));
@@ -576,6 +656,7 @@ mod tests {
                 entry_normal: Vec3::ZERO,
                 exit_normal: Vec3::ZERO,
                 primary: false,
+                table: (0, 0),
             };
             let mut found = Vec::new();
             tree.gather(&segment, radius, |p, _| found.push(p.position.to_array()));
@@ -646,6 +727,7 @@ mod tests {
                 entry_normal: Vec3::ZERO,
                 exit_normal: Vec3::ZERO,
                 primary: true,
+                table: (0, 0),
             };
             let mut found = Vec::new();
             screen.gather(&tree.photons, &segment, pixel, radius, |p, _| {

@@ -1,7 +1,8 @@
-//! Homogeneous participating media in the path tracer, against closed forms derived here:
-//! Beer–Lambert transmittance through an index-matched and a dielectric boundary, exact single
-//! scattering under a directional light, and the white furnace of an albedo-1 medium. Every
-//! other method refuses such a scene, and media that nothing refers to change no bit.
+//! Participating media in the path tracer, against closed forms derived here: Beer–Lambert
+//! transmittance through an index-matched and a dielectric boundary, exact single scattering
+//! under a directional light, and the white furnace of an albedo-1 medium, each for a
+//! homogeneous medium and for a density grid (delta and ratio tracking). Every other method
+//! refuses such a scene, and media that nothing refers to change no bit.
 
 use std::f64::consts::PI;
 
@@ -162,7 +163,18 @@ irradiance = [1.0, 1.0, 1.0]
 /// whatever the scattering every path ends on a wall and every pixel reads L in every channel.
 #[test]
 fn white_furnace_of_an_albedo_one_medium_reads_the_wall_radiance() {
-    let toml = furnace_fog_box();
+    white_furnace("");
+}
+
+/// The white furnace with a grid of uneven densities (0 to 2.5, chromatic σs, the camera
+/// inside the grid): spectral delta tracking and ratio tracking keep every channel at L.
+#[test]
+fn white_furnace_of_an_albedo_one_grid_reads_the_wall_radiance() {
+    white_furnace(FURNACE_GRID);
+}
+
+fn white_furnace(grid: &str) {
+    let toml = furnace_fog_box() + grid;
     let image = path_render(&toml, 64, 4, 1024);
     assert_close(channel_means(&image), [1.0; 3], 0.015, "furnace mean");
     for (i, px) in image.iter().enumerate() {
@@ -173,6 +185,73 @@ fn white_furnace_of_an_albedo_one_medium_reads_the_wall_radiance() {
             );
         }
     }
+}
+
+/// Beer–Lambert through a grid of constant density 2 holding half the ink's coefficients: the
+/// same image as the homogeneous ink (delta tracking, then the emitter).
+#[test]
+fn transmittance_through_a_constant_grid_is_beer_lambert() {
+    let toml = through_sphere("type = \"interface\"").replace(
+        "[media.ink]\nsigma_a = [0.1, 0.5, 1.5]",
+        "[media.ink.grid]\nsize = [2, 2, 2]\ndensity = [2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0]\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, 1.0]\n[media.ink]\nsigma_a = [0.05, 0.25, 0.75]",
+    );
+    assert!(toml.contains("[media.ink.grid]"));
+    let image = path_render(&toml, 1024, 4, 1024);
+    let expected = SIGMA_A.map(|s| 2.0 * (-2.0 * s).exp());
+    assert_close(channel_means(&image), expected, 0.025, "constant grid");
+}
+
+/// Single scattering of the haze of [`single_scattering_matches_the_slab_integral`] as a grid
+/// of constant density 0.5 with doubled coefficients, clamped over a box larger than the
+/// sphere: the same slab integral (delta tracking for the vertex, ratio tracking for the
+/// shadow ray toward the sun).
+#[test]
+fn single_scattering_in_a_grid_matches_the_slab_integral() {
+    let toml = r#"
+format = 1
+[camera]
+position = [0.0, 0.0, 5.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 0.5
+[film]
+width = 4
+height = 4
+[media.haze]
+sigma_a = [0.1, 0.1, 0.1]
+sigma_s = [0.2, 0.4, 0.8]
+g = 0.3
+[media.haze.grid]
+size = [1, 2, 1]
+density = [0.5, 0.5]
+min = [-1.5, -1.5, -1.5]
+max = [1.5, 1.5, 1.5]
+[materials.boundary]
+type = "interface"
+[[shapes]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+material = "boundary"
+interior = "haze"
+[[lights]]
+type = "directional"
+direction = [0.0, 0.0, -1.0]
+irradiance = [1.0, 1.0, 1.0]
+"#;
+    let image = path_render(toml, 1024, 4, 1);
+    let g: f64 = 0.3;
+    let p = (1.0 - g * g) / (4.0 * PI * (1.0 + g).powi(3));
+    let sigma_s = [0.1, 0.2, 0.4];
+    let expected = sigma_s.map(|s: f64| {
+        let t = s + 0.05;
+        s * p * (1.0 - (-4.0 * t).exp()) / (2.0 * t)
+    });
+    assert_close(
+        channel_means(&image),
+        expected,
+        0.03,
+        "single scattering in a grid",
+    );
 }
 
 /// The methods that do not render media (light tracing, the bidirectional ones) refuse a scene
@@ -319,21 +398,29 @@ irradiance = [1.0, 1.0, 1.0]
 /// rendered by the photon mappers: the walls seen through the fog plus the light the fog
 /// scatters toward the camera (volume photons after any number of scattering events, chromatic
 /// free flights) make L = 1 in every channel.
+/// With the uneven grid of [`white_furnace_of_an_albedo_one_grid_reads_the_wall_radiance`] the
+/// photons' free flights are spectral tracking and the camera stretches' transmittance one
+/// ratio-tracking walk each, which also weighs every photon gathered along them.
 #[test]
 fn photon_mappers_read_the_furnace_of_an_albedo_one_medium() {
-    let toml = furnace_fog_box();
-    for method in [Method::Sppm, Method::FreqSppm] {
-        let mut params = params(method, 50_000);
-        params.kernel.initial_radius = Some(0.1);
-        let image = render(&scene(&toml), params, 12);
-        assert_close(
-            channel_means(&image),
-            [1.0; 3],
-            0.03,
-            &format!("{method}: furnace"),
-        );
+    for (grid, what) in [("", "furnace"), (FURNACE_GRID, "grid furnace")] {
+        let toml = furnace_fog_box() + grid;
+        for method in [Method::Sppm, Method::FreqSppm] {
+            let mut params = params(method, 50_000);
+            params.kernel.initial_radius = Some(0.1);
+            let image = render(&scene(&toml), params, 12);
+            assert_close(
+                channel_means(&image),
+                [1.0; 3],
+                0.03,
+                &format!("{method}: {what}"),
+            );
+        }
     }
 }
+
+/// An uneven density grid (0 to 2.5) over the furnace box.
+const FURNACE_GRID: &str = "[media.fog.grid]\nsize = [3, 2, 2]\ndensity = [0.0, 2.5, 0.4, 1.0, 0.1, 2.0, 1.5, 0.0, 0.3, 0.8, 2.2, 0.6]\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, 1.0]\n";
 
 /// A closed box whose black walls all emit L = 1 inward, filled with a medium of albedo one
 /// and seen from inside.
