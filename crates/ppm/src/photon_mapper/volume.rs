@@ -97,7 +97,7 @@ pub(crate) fn stretch_transmittance(
     let Some((t0, t1)) = grid.clip(origin, direction, t_max) else {
         return Rgb::ONE;
     };
-    if !(majorant > 0.0) {
+    if majorant.is_nan() || majorant <= 0.0 {
         return Rgb::ONE;
     }
     let sigma_t = medium.sigma_t();
