@@ -293,7 +293,8 @@ impl DensityGrid {
             let (near, far) = if a <= b { (a, b) } else { (b, a) };
             t0 = t0.max(near);
             t1 = t1.min(far);
-            if !(t0 <= t1) {
+            // (A NaN bound fails too.)
+            if t0.is_nan() || t1.is_nan() || t0 > t1 {
                 return None;
             }
         }

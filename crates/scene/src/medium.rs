@@ -183,7 +183,7 @@ impl Medium {
             // The channel weights now: q scaled by what the walk has multiplied so far.
             let qw = q * weight;
             let total = qw.element_sum();
-            if !(total > 0.0) {
+            if total.is_nan() || total <= 0.0 {
                 return FreeFlight::Pass { weight: Rgb::ZERO };
             }
             let qn = qw / total;
