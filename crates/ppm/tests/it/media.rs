@@ -233,9 +233,12 @@ fn transmittance_through_a_constant_grid_is_beer_lambert() {
         "[media.ink.grid]\nsize = [2, 2, 2]\ndensity = [2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0]\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, 1.0]\n[media.ink]\nsigma_a = [0.05, 0.25, 0.75]",
     );
     assert!(toml.contains("[media.ink.grid]"));
-    let image = path_render(&toml, 1024, 4, 1024);
+    // Delta tracking under one majorant (that of the densest channel) makes the others'
+    // estimates binary: in the blue channel a path passes with probability T = e⁻³, so the
+    // relative standard error is √((1 − T)/T / n), 0.85 % over n = 262 144 paths.
+    let image = path_render(&toml, 1024, 16, 1024);
     let expected = SIGMA_A.map(|s| 2.0 * (-2.0 * s).exp());
-    assert_close(channel_means(&image), expected, 0.025, "constant grid");
+    assert_close(channel_means(&image), expected, 0.03, "constant grid");
 }
 
 /// Single scattering of the haze of [`single_scattering_matches_the_slab_integral`] as a grid
