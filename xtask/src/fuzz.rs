@@ -428,14 +428,7 @@ mod seeds {
             "mitsuba" => add_files(&mut seeds, find(&shared.join("mitsuba3"), &["xml"])),
             "pbrt" => add_files(&mut seeds, find(&shared, &["pbrt"])),
             "ply" => add_files(&mut seeds, find(&shared, &["ply"])),
-            "vol" => {
-                add_files(&mut seeds, find(&root.join("scenes"), &["vol"]));
-                let ramp: Vec<f32> = (0..4 * 3 * 2).map(|i| (i % 4) as f32 * 0.5).collect();
-                seeds.insert(
-                    "ramp.vol".to_owned(),
-                    import::write_vol([4, 3, 2], glam::Vec3::ZERO, glam::Vec3::ONE, &ramp),
-                );
-            }
+            "vol" => seeds.extend(vol_grids(root)),
             "exr" => {
                 add_files(&mut seeds, find(&root.join("tests/golden"), &["exr"]));
                 seeds.insert("tiny.exr".to_owned(), tiny_exr(root)?);
@@ -598,6 +591,23 @@ mod seeds {
     /// Small images of every kind the texture loader reads: 8- and 16-bit PNG (grey, RGB,
     /// RGBA with a mask), JPEG, OpenEXR (half and float) and Radiance HDR. The JPEG, EXR and HDR
     /// encoders are the `image` features `import` enables (Cargo unifies them).
+    /// The `vol` target's seeds: the `.vol` grids of `scenes/` and a small ramp written by
+    /// `import::write_vol`.
+    pub(super) fn vol_grids(root: &Path) -> Vec<(String, Vec<u8>)> {
+        let mut seeds = BTreeMap::new();
+        for f in find(&root.join("scenes"), &["vol"]) {
+            if let Ok(bytes) = std::fs::read(&f) {
+                seeds.insert(seed_name(&f), bytes);
+            }
+        }
+        let ramp: Vec<f32> = (0..4 * 3 * 2).map(|i| (i % 4) as f32 * 0.5).collect();
+        seeds.insert(
+            "ramp.vol".to_owned(),
+            import::write_vol([4, 3, 2], glam::Vec3::ZERO, glam::Vec3::ONE, &ramp),
+        );
+        seeds.into_iter().collect()
+    }
+
     pub(super) fn images() -> Result<Vec<(String, Vec<u8>)>> {
         use image::{DynamicImage, ImageBuffer, ImageFormat, Luma, Rgb, Rgb32FImage, Rgba};
         let encode = |img: DynamicImage, format: ImageFormat| -> Result<Vec<u8>> {
@@ -797,6 +807,29 @@ mod tests {
             let bytes = harness::checkpoint_bytes(&scene, body);
             let restored = ppm::Renderer::restore(std::sync::Arc::clone(&scene), &bytes);
             assert!(restored.is_ok(), "{name}: {:?}", restored.err());
+        }
+    }
+
+    /// Every `.vol` seed loads as the grid of the `vol` target's scene and builds.
+    #[test]
+    fn vol_seeds_load_as_grids() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let seeds = seeds::vol_grids(&root);
+        assert!(
+            seeds.len() >= 2,
+            "{:?}",
+            seeds.iter().map(|s| &s.0).collect::<Vec<_>>()
+        );
+        for (name, bytes) in seeds {
+            let path = harness::fuzzed("scene.toml");
+            let grid = harness::fuzzed("smoke.vol");
+            let files = import::MemoryFiles::new()
+                .with(&path, harness::VOL_SCENE)
+                .with(&grid, bytes);
+            let d = load_from(&path, files, &LoadOptions::default())
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(d.media.list[0].density.is_some(), "{name}");
+            scene::Scene::new(d).unwrap_or_else(|e| panic!("{name}: {e}"));
         }
     }
 

@@ -115,6 +115,27 @@ pub struct DensityGrid {
     to_world: Affine3A,
     to_local: Affine3A,
     max_density: f32,
+    /// Majorant cells per axis (at most [`MAJORANT_CELLS`]).
+    cells: [u32; 3],
+    /// The largest density that trilinear lookups can return inside each majorant cell, x
+    /// fastest.
+    majorants: Vec<f32>,
+}
+
+/// Majorant cells per axis at most: a coarse grid of local maxima, so that free flights and
+/// transmittances take short steps only where the medium is dense (pbrt-v4's 16³
+/// `majorantGrid`).
+pub const MAJORANT_CELLS: u32 = 16;
+
+/// One stretch `[t0, t1]` of a ray inside one majorant cell, and that cell's largest density.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MajorantSegment {
+    /// Where the ray enters the cell (or the box, or 0).
+    pub t0: f32,
+    /// Where it leaves it (or the box, or `t_max`).
+    pub t1: f32,
+    /// The largest density there.
+    pub max_density: f32,
 }
 
 impl DensityGrid {
@@ -162,6 +183,7 @@ impl DensityGrid {
         if !to_local.is_finite() {
             return Err(GridError::Transform);
         }
+        let (cells, majorants) = majorant_cells(size, &data);
         Ok(Self {
             size,
             data,
@@ -171,6 +193,8 @@ impl DensityGrid {
             to_world,
             to_local,
             max_density,
+            cells,
+            majorants,
         })
     }
 
@@ -293,11 +317,137 @@ impl DensityGrid {
             let (near, far) = if a <= b { (a, b) } else { (b, a) };
             t0 = t0.max(near);
             t1 = t1.min(far);
-            if !(t0 <= t1) {
+            // (A NaN bound fails too.)
+            if t0.is_nan() || t1.is_nan() || t0 > t1 {
                 return None;
             }
         }
         Some((t0, t1))
+    }
+}
+
+/// The majorant grid of a density grid of `size` voxels: per axis min(n, [`MAJORANT_CELLS`])
+/// cells, each the maximum of every sample whose trilinear footprint can reach it, widened by one
+/// sample on each side (so that a point that rounding puts just outside its cell is still
+/// bounded). Samples outside the grid are zero or clamped copies, neither larger than this.
+fn majorant_cells(size: [u32; 3], data: &[f32]) -> ([u32; 3], Vec<f32>) {
+    let cells = size.map(|n| n.min(MAJORANT_CELLS));
+    // The samples each cell of each axis depends on: cell c covers u ∈ [c/m, (c+1)/m], i.e.
+    // grid coordinates s = u·n − ½ in [c·n/m − ½, (c+1)·n/m − ½], read from samples
+    // floor(s_lo) to floor(s_hi) + 1.
+    let ranges = |axis: usize| -> Vec<(usize, usize)> {
+        let (n, m) = (f64::from(size[axis]), f64::from(cells[axis]));
+        (0..cells[axis])
+            .map(|c| {
+                let lo = (f64::from(c) * n / m - 0.5).floor() - 1.0;
+                let hi = (f64::from(c + 1) * n / m - 0.5).floor() + 2.0;
+                (
+                    lo.clamp(0.0, n - 1.0) as usize,
+                    hi.clamp(0.0, n - 1.0) as usize,
+                )
+            })
+            .collect()
+    };
+    let (rx, ry, rz) = (ranges(0), ranges(1), ranges(2));
+    let (nx, ny) = (size[0] as usize, size[1] as usize);
+    let mut majorants = Vec::with_capacity(rx.len() * ry.len() * rz.len());
+    for &(z0, z1) in &rz {
+        for &(y0, y1) in &ry {
+            for &(x0, x1) in &rx {
+                let mut peak = 0.0f32;
+                for z in z0..=z1 {
+                    for y in y0..=y1 {
+                        let row = (z * ny + y) * nx;
+                        for &v in &data[row + x0..=row + x1] {
+                            peak = peak.max(v);
+                        }
+                    }
+                }
+                majorants.push(peak);
+            }
+        }
+    }
+    (cells, majorants)
+}
+
+impl DensityGrid {
+    /// The stretches of the ray `origin + t·direction`, `0 ≤ t ≤ t_max`, inside the box, one
+    /// per majorant cell it crosses in order, each with the cell's largest density (a 3D DDA
+    /// over the majorant grid, as pbrt-v4's `DDAMajorantIterator`). Empty if the ray misses
+    /// the box.
+    #[must_use]
+    pub fn majorant_segments(
+        &self,
+        origin: Vec3,
+        direction: Vec3,
+        t_max: f32,
+    ) -> Vec<MajorantSegment> {
+        let mut out = Vec::new();
+        let Some((t_in, t_out)) = self.clip(origin, direction, t_max) else {
+            return out;
+        };
+        let m = Vec3::new(
+            self.cells[0] as f32,
+            self.cells[1] as f32,
+            self.cells[2] as f32,
+        );
+        // The ray in majorant-cell coordinates (the box is [0, m]).
+        let extent = self.max - self.min;
+        let o = (self.to_local.transform_point3(origin) - self.min) / extent * m;
+        let d = self.to_local.transform_vector3(direction) / extent * m;
+        let entry = o + d * t_in;
+        let mut cell = [0i64; 3];
+        let mut next = [f32::INFINITY; 3];
+        let mut delta = [f32::INFINITY; 3];
+        let mut step = [0i64; 3];
+        for a in 0..3 {
+            let last = i64::from(self.cells[a]) - 1;
+            cell[a] = (entry[a].floor() as i64).clamp(0, last);
+            if d[a] > 0.0 {
+                next[a] = t_in + ((cell[a] + 1) as f32 - entry[a]) / d[a];
+                delta[a] = 1.0 / d[a];
+                step[a] = 1;
+            } else if d[a] < 0.0 {
+                next[a] = t_in + (cell[a] as f32 - entry[a]) / d[a];
+                delta[a] = -1.0 / d[a];
+                step[a] = -1;
+            }
+        }
+        let (cx, cy) = (i64::from(self.cells[0]), i64::from(self.cells[1]));
+        let mut t = t_in;
+        // Every crossing moves one cell along one axis: at most the sum of the cells.
+        let most = self.cells.iter().map(|&c| c as usize).sum::<usize>() + 3;
+        for _ in 0..most {
+            let axis = if next[0] <= next[1] && next[0] <= next[2] {
+                0
+            } else if next[1] <= next[2] {
+                1
+            } else {
+                2
+            };
+            let t1 = next[axis].min(t_out).max(t);
+            let index = ((cell[2] * cy + cell[1]) * cx + cell[0]) as usize;
+            out.push(MajorantSegment {
+                t0: t,
+                t1,
+                max_density: self.majorants[index],
+            });
+            if t1 >= t_out {
+                break;
+            }
+            t = t1;
+            cell[axis] += step[axis];
+            if cell[axis] < 0 || cell[axis] >= i64::from(self.cells[axis]) {
+                break;
+            }
+            next[axis] += delta[axis];
+        }
+        // The DDA's last crossing and the box's exit differ by rounding: the last cell runs to
+        // the exit (its majorant is widened by a sample, which covers the difference).
+        if let Some(last) = out.last_mut() {
+            last.t1 = t_out;
+        }
+        out
     }
 }
 

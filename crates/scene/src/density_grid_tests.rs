@@ -295,3 +295,68 @@ fn spectral_tracking_is_unbiased_per_channel_in_a_chromatic_ramp() {
         "chromatic pass weight",
     );
 }
+
+#[test]
+fn majorant_segments_cover_the_ray_and_bound_its_densities() {
+    let mut rng = Rng::new(17);
+    // Larger than the majorant grid on two axes, smaller on one; random densities; rotated,
+    // scaled and moved; both edge rules.
+    let size = [37, 5, 20];
+    let data: Vec<f32> = (0..37 * 5 * 20)
+        .map(|_| {
+            let v = rng.f32();
+            v * v * v * 4.0
+        })
+        .collect();
+    let to_world = Affine3A::from_scale_rotation_translation(
+        Vec3::new(1.5, 0.5, 2.0),
+        glam::Quat::from_rotation_y(0.7) * glam::Quat::from_rotation_x(-0.3),
+        Vec3::new(0.2, -1.0, 0.4),
+    );
+    for edge in [GridEdge::Clamp, GridEdge::Zero] {
+        let grid = DensityGrid::new(
+            size,
+            data.clone(),
+            edge,
+            Vec3::splat(-1.0),
+            Vec3::ONE,
+            to_world,
+        )
+        .unwrap();
+        let mut crossing = 0;
+        for _ in 0..300 {
+            let origin = rng.vec3(-3.0, 3.0);
+            // Half the rays aim at a point of the box, half go anywhere.
+            let direction = if rng.f32() < 0.5 {
+                (to_world.transform_point3(rng.vec3(-1.0, 1.0)) - origin).normalize()
+            } else {
+                rng.unit()
+            };
+            let t_max = if rng.f32() < 0.3 { 2.0 } else { f32::INFINITY };
+            let segments = grid.majorant_segments(origin, direction, t_max);
+            let Some((t0, t1)) = grid.clip(origin, direction, t_max) else {
+                assert!(segments.is_empty());
+                continue;
+            };
+            crossing += 1;
+            assert_eq!(segments.first().map(|s| s.t0), Some(t0));
+            assert_eq!(segments.last().map(|s| s.t1), Some(t1));
+            for pair in segments.windows(2) {
+                assert_eq!(pair[0].t1, pair[1].t0);
+            }
+            for s in &segments {
+                assert!(s.t0 <= s.t1);
+                for k in 0..=16 {
+                    let t = s.t0 + (s.t1 - s.t0) * k as f32 / 16.0;
+                    let d = grid.density(origin + direction * t);
+                    assert!(
+                        d <= s.max_density * (1.0 + 1e-5) + 1e-6,
+                        "{edge:?}: density {d} above its cell's {}",
+                        s.max_density
+                    );
+                }
+            }
+        }
+        assert!(crossing > 100, "{crossing} rays crossed the box");
+    }
+}

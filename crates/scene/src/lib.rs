@@ -52,7 +52,10 @@ pub mod validate;
 
 pub use aabb::Aabb;
 pub use camera::{CameraModel, LensConnection};
-pub use density_grid::{DensityGrid, GridEdge, GridError, MAX_GRID_VOXELS, check_grid_size};
+pub use density_grid::{
+    DensityGrid, GridEdge, GridError, MAJORANT_CELLS, MAX_GRID_VOXELS, MajorantSegment,
+    check_grid_size,
+};
 pub use description::{
     Camera, Cylinder, Film, Light, LoadNotes, MAX_FILM_SIDE, Material, RenderDefaults, Rgb,
     SceneDescription, Sphere, Triangle, primitive_bounds,

@@ -59,8 +59,7 @@ pub enum FreeFlight {
 }
 
 /// The most tentative collisions one delta- or ratio-tracking walk takes; beyond it the walk
-/// ends with weight zero (a guard against a majorant so large that the steps stop advancing;
-/// a walk that long has a negligible transmittance anyway).
+/// ends with weight zero (a guard against a majorant so large that the steps stop advancing).
 const MAX_TRACKING_STEPS: u32 = 1 << 20;
 
 impl Medium {
@@ -96,7 +95,8 @@ impl Medium {
 
     /// One majorant of the extinction of every channel everywhere: the largest channel of σt
     /// times the grid's largest density (a hair above, so that rounding in the interpolation
-    /// never makes a null coefficient negative).
+    /// never makes a null coefficient negative). The tracking itself uses the tighter
+    /// majorants of [`DensityGrid::majorant_segments`].
     #[must_use]
     pub fn majorant(&self) -> f32 {
         let peak = self.sigma_t().max_element();
@@ -115,12 +115,14 @@ impl Medium {
     ///   probability q_c, a distance from exp(−σt,c·t), weighted by the average of the
     ///   channels' densities under q (the same estimator as the path tracer's own code).
     /// - Grid: spectral tracking (Kutz et al. 2017, "Spectral and decomposition tracking for
-    ///   rendering heterogeneous volumes", history-aware): tentative collisions from the
-    ///   scalar majorant σ̄ ([`Medium::majorant`]) over the stretch inside the grid's box; at
-    ///   each, a real collision with probability Σq·σt(x)/σ̄ (weight σs(x)/Σq·σt(x), Mitsuba's
-    ///   and pbrt's choice: absorption is a weight, not a termination) or a null one
-    ///   (weight σn(x)/Σq·σn(x), σn = σ̄ − σt), q following the weights. Unbiased in every
-    ///   channel; for a grey medium it is plain delta tracking with weights σs/σt and one.
+    ///   rendering heterogeneous volumes", history-aware): tentative collisions from a scalar
+    ///   majorant σ̄ per cell of the grid's majorant grid ([`DensityGrid::majorant_segments`]:
+    ///   the largest channel of σt times the cell's largest density) over the stretch inside
+    ///   the grid's box; at each, a real collision with probability Σq·σt(x)/σ̄ (weight
+    ///   σs(x)/Σq·σt(x), Mitsuba's and pbrt's choice: absorption is a weight, not a
+    ///   termination) or a null one (weight σn(x)/Σq·σn(x), σn = σ̄ − σt), q following the
+    ///   weights. Unbiased in every channel; for a grey medium it is plain delta tracking with
+    ///   weights σs/σt and one.
     pub fn sample_free_flight(
         &self,
         origin: Vec3,
@@ -163,48 +165,57 @@ impl Medium {
             };
             return FreeFlight::Pass { weight };
         };
-        let majorant = self.majorant();
-        let Some((t0, t1)) = grid.clip(origin, direction, t_max) else {
-            return FreeFlight::Pass { weight: Rgb::ONE };
-        };
-        if majorant <= 0.0 {
-            return FreeFlight::Pass { weight: Rgb::ONE };
-        }
+        // The per-cell majorant of every channel: the largest channel of σt times the cell's
+        // largest density, a hair above it.
+        let peak = sigma_t.max_element() * (1.0 + 1e-5);
         let mut weight = Rgb::ONE;
-        let mut t = t0;
-        for _ in 0..MAX_TRACKING_STEPS {
-            t -= (1.0 - u()).ln() / majorant;
-            if t >= t1 {
-                return FreeFlight::Pass { weight };
+        let mut steps = 0;
+        for segment in grid.majorant_segments(origin, direction, t_max) {
+            let majorant = peak * segment.max_density;
+            if majorant <= 0.0 {
+                continue;
             }
-            let d = grid.density(origin + direction * t);
-            let st = sigma_t * d;
-            let sn = (Rgb::splat(majorant) - st).max(Rgb::ZERO);
-            // The channel weights now: q scaled by what the walk has multiplied so far.
-            let qw = q * weight;
-            let total = qw.element_sum();
-            if !(total > 0.0) {
-                return FreeFlight::Pass { weight: Rgb::ZERO };
+            // Exponential steps are memoryless: the walk restarts at each cell's entry.
+            let mut t = segment.t0;
+            loop {
+                steps += 1;
+                if steps > MAX_TRACKING_STEPS {
+                    return FreeFlight::Pass { weight: Rgb::ZERO };
+                }
+                t -= (1.0 - u()).ln() / majorant;
+                if t >= segment.t1 {
+                    break;
+                }
+                let d = grid.density(origin + direction * t);
+                let st = sigma_t * d;
+                let sn = (Rgb::splat(majorant) - st).max(Rgb::ZERO);
+                // The channel weights now: q scaled by what the walk has multiplied so far.
+                let qw = q * weight;
+                let total = qw.element_sum();
+                if total.is_nan() || total <= 0.0 {
+                    return FreeFlight::Pass { weight: Rgb::ZERO };
+                }
+                let qn = qw / total;
+                let real = (qn * st).element_sum();
+                let null = (qn * sn).element_sum();
+                let p_real = real / (real + null);
+                if u() < p_real {
+                    return FreeFlight::Scatter {
+                        t,
+                        weight: weight * (self.sigma_s * d) / real,
+                    };
+                }
+                weight *= sn / null;
             }
-            let qn = qw / total;
-            let real = (qn * st).element_sum();
-            let null = (qn * sn).element_sum();
-            let p_real = real / (real + null);
-            if u() < p_real {
-                return FreeFlight::Scatter {
-                    t,
-                    weight: weight * (self.sigma_s * d) / real,
-                };
-            }
-            weight *= sn / null;
         }
-        FreeFlight::Pass { weight: Rgb::ZERO }
+        FreeFlight::Pass { weight }
     }
 
     /// The transmittance along `origin + t·direction` from 0 to `t_max` (finite): exact for a
     /// homogeneous medium (no number drawn), an unbiased estimate for a grid by ratio tracking
-    /// with the scalar majorant σ̄ (the product of σn(x)/σ̄ over tentative collisions drawn
-    /// from σ̄ inside the grid's box), so that its mean is exp(−∫σt) in every channel.
+    /// with a scalar majorant σ̄ per majorant cell (the product of σn(x)/σ̄ over tentative
+    /// collisions drawn from σ̄ inside the grid's box), so that its mean is exp(−∫σt) in every
+    /// channel.
     pub fn transmittance_along(
         &self,
         origin: Vec3,
@@ -212,31 +223,53 @@ impl Medium {
         t_max: f32,
         u: &mut impl FnMut() -> f32,
     ) -> Rgb {
+        self.transmittance_walk(origin, direction, t_max, u, |_, _| {})
+    }
+
+    /// [`Medium::transmittance_along`], calling `visit(t, product)` at each tentative collision
+    /// of a grid's ratio-tracking walk with the walk's product up to and including it: the
+    /// product at the last collision before any t ≤ `t_max` is itself an unbiased estimate of
+    /// the transmittance from the origin to t (the collisions before t are a walk to t), so one
+    /// walk serves every point of the ray. A homogeneous medium calls nothing.
+    pub fn transmittance_walk(
+        &self,
+        origin: Vec3,
+        direction: Vec3,
+        t_max: f32,
+        u: &mut impl FnMut() -> f32,
+        mut visit: impl FnMut(f32, Rgb),
+    ) -> Rgb {
         let Some(grid) = &self.density else {
             return self.transmittance(t_max);
         };
-        let majorant = self.majorant();
-        let Some((t0, t1)) = grid.clip(origin, direction, t_max) else {
-            return Rgb::ONE;
-        };
-        if majorant <= 0.0 {
-            return Rgb::ONE;
-        }
         let sigma_t = self.sigma_t();
+        let peak = sigma_t.max_element() * (1.0 + 1e-5);
         let mut tr = Rgb::ONE;
-        let mut t = t0;
-        for _ in 0..MAX_TRACKING_STEPS {
-            t -= (1.0 - u()).ln() / majorant;
-            if t >= t1 {
-                return tr;
+        let mut steps = 0;
+        for segment in grid.majorant_segments(origin, direction, t_max) {
+            let majorant = peak * segment.max_density;
+            if majorant <= 0.0 {
+                continue;
             }
-            let st = sigma_t * grid.density(origin + direction * t);
-            tr *= (Rgb::ONE - st / majorant).max(Rgb::ZERO);
-            if tr == Rgb::ZERO {
-                return tr;
+            let mut t = segment.t0;
+            loop {
+                steps += 1;
+                if steps > MAX_TRACKING_STEPS {
+                    return Rgb::ZERO;
+                }
+                t -= (1.0 - u()).ln() / majorant;
+                if t >= segment.t1 {
+                    break;
+                }
+                let st = sigma_t * grid.density(origin + direction * t);
+                tr *= (Rgb::ONE - st / majorant).max(Rgb::ZERO);
+                visit(t, tr);
+                if tr == Rgb::ZERO {
+                    return tr;
+                }
             }
         }
-        Rgb::ZERO
+        tr
     }
 
     /// The extinction coefficient σt = σa + σs (at density 1 for a grid medium).

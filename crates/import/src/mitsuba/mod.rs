@@ -88,13 +88,11 @@ pub(crate) fn load_mitsuba(
                 }
             }
             "integrator" => importer.integrator(node, &mut render)?,
-            // Declarations used through <ref>, and elements with no bearing on the image.
-            "volume" => {
-                return Err(doc.error(node, "volume grids (heterogeneous media) are not supported"));
-            }
-            "bsdf" | "medium" | "texture" | "spectrum" | "phase" | "float" | "integer"
-            | "boolean" | "string" | "rgb" | "point" | "vector" | "alias" | "transform" | "ref" => {
-            }
+            // Declarations used through <ref> (a `volume` as a heterogeneous medium's
+            // `sigma_t`), and elements with no bearing on the image.
+            "bsdf" | "medium" | "volume" | "texture" | "spectrum" | "phase" | "float"
+            | "integer" | "boolean" | "string" | "rgb" | "point" | "vector" | "alias"
+            | "transform" | "ref" => {}
             other => {
                 importer.builder.warn(format!(
                     "<{other}> at the top level of the scene is ignored"

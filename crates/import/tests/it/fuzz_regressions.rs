@@ -382,3 +382,54 @@ fn texture_declaring_a_huge_data_window_is_refused_from_its_header() {
         "{err}"
     );
 }
+
+/// The `vol` fuzz target's fixed scene (`fuzz/stubs/vol_scene.toml`) loads from memory with a
+/// good grid and builds; the free flights and transmittances the target runs through it stay
+/// finite; a grid the header of which lies is one line naming the `.vol`.
+#[test]
+fn the_vol_targets_scene_loads_its_grid_from_memory() {
+    let stub = include_str!("../../../../fuzz/stubs/vol_scene.toml");
+    let ramp: Vec<f32> = (0..24).map(|i| (i % 4) as f32 * 0.5).collect();
+    let good = import::write_vol([4, 3, 2], glam::Vec3::ZERO, glam::Vec3::ONE, &ramp);
+    let files = MemoryFiles::new()
+        .with("/fuzz/scene.toml", stub)
+        .with("/fuzz/smoke.vol", good.clone());
+    let d = load_memory("/fuzz/scene.toml", files).unwrap();
+    let scene = scene::Scene::new(d).unwrap();
+    let medium = &scene.media().list[0];
+    let mut state = 0u32;
+    let mut u = move || {
+        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (state >> 8) as f32 / (1u32 << 24) as f32
+    };
+    for (origin, direction) in [
+        (glam::Vec3::new(-2.0, 0.1, 0.2), glam::Vec3::X),
+        (glam::Vec3::new(0.0, 2.0, 0.0), -glam::Vec3::Y),
+    ] {
+        let tr = medium.transmittance_along(origin, direction, 4.0, &mut u);
+        assert!(
+            tr.is_finite() && tr.min_element() >= 0.0 && tr.max_element() <= 1.0,
+            "{tr}"
+        );
+        match medium.sample_free_flight(
+            origin,
+            direction,
+            4.0,
+            glam::Vec3::splat(1.0 / 3.0),
+            &mut u,
+        ) {
+            scene::FreeFlight::Scatter { t, weight } => {
+                assert!(
+                    (0.0..=4.0).contains(&t) && weight.is_finite(),
+                    "{t} {weight}"
+                );
+            }
+            scene::FreeFlight::Pass { weight } => assert!(weight.is_finite(), "{weight}"),
+        }
+    }
+    let files = MemoryFiles::new()
+        .with("/fuzz/scene.toml", stub)
+        .with("/fuzz/smoke.vol", &good[..good.len() - 1]);
+    let err = load_memory("/fuzz/scene.toml", files).unwrap_err();
+    assert_names_file(&err, Path::new("/fuzz/smoke.vol"));
+}

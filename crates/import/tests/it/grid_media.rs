@@ -211,6 +211,25 @@ fn mitsuba_heterogeneous_gridvolume() {
     assert!((grid.density(Vec3::new(-0.5, 0.0, 0.0)) - 0.5).abs() < 1e-5);
     assert_eq!(grid.density(Vec3::new(1.5, 0.0, 0.0)), 0.0);
 
+    // The volume declared at the top level and referred to by id reads the same.
+    let volume = r#"<volume name="sigma_t" type="gridvolume">
+            <string name="filename" value="smoke.vol"/>
+            <transform name="to_world"><scale value="2"/><translate x="-1" y="-1" z="-1"/></transform>
+        </volume>"#;
+    assert!(MITSUBA.contains(volume));
+    let by_ref = MITSUBA
+        .replace(volume, r#"<ref name="sigma_t" id="grid"/>"#)
+        .replace(
+            "<medium type=",
+            &format!(
+                "{}\n    <medium type=",
+                volume.replace(r#"name="sigma_t""#, r#"id="grid""#)
+            ),
+        );
+    std::fs::write(&path, &by_ref).unwrap();
+    let d = load(&path).unwrap();
+    assert_eq!(smoke(&d).density.as_ref(), Some(grid), "{by_ref}");
+    std::fs::write(&path, MITSUBA).unwrap();
     // A corrupt file: one line naming the scene and the grid file.
     std::fs::write(dir.join("smoke.vol"), b"VOL\x03").unwrap();
     let err = load(&path).unwrap_err();

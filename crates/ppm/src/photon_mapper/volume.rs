@@ -77,11 +77,9 @@ pub(crate) struct Segment {
 
 /// The transmittance of `medium` along the camera stretch (`origin`, unit `direction`,
 /// `t_max`): exact in a homogeneous medium, drawing nothing; in a grid, one ratio-tracking walk
-/// (numbers from `u`) whose tentative collisions are appended to `table` as (t, the walk's
-/// product up to and including t). The product at the last collision before any t is an
-/// unbiased estimate of the transmittance from the origin to t (the collisions before t are
-/// those of a walk to t), so the one walk serves the stretch's end and every photon gathered
-/// along it ([`table_transmittance`]).
+/// (`Medium::transmittance_walk`, numbers from `u`) whose tentative collisions are appended to
+/// `table` as (t, the walk's product up to and including t), so that the one walk serves the
+/// stretch's end and every photon gathered along it ([`table_transmittance`]).
 pub(crate) fn stretch_transmittance(
     medium: &Medium,
     origin: Vec3,
@@ -90,34 +88,7 @@ pub(crate) fn stretch_transmittance(
     table: &mut Vec<(f32, Rgb)>,
     u: &mut impl FnMut() -> f32,
 ) -> Rgb {
-    let Some(grid) = medium.density.as_deref() else {
-        return medium.transmittance(t_max);
-    };
-    let majorant = medium.majorant();
-    let Some((t0, t1)) = grid.clip(origin, direction, t_max) else {
-        return Rgb::ONE;
-    };
-    if majorant.is_nan() || majorant <= 0.0 {
-        return Rgb::ONE;
-    }
-    let sigma_t = medium.sigma_t();
-    let mut tr = Rgb::ONE;
-    let mut t = t0;
-    // The same guard as `Medium::transmittance_along`: a walk this long has a negligible
-    // transmittance.
-    for _ in 0..(1 << 20) {
-        t -= (1.0 - u()).ln() / majorant;
-        if t >= t1 {
-            return tr;
-        }
-        let st = sigma_t * grid.density(origin + direction * t);
-        tr *= (Rgb::ONE - st / majorant).max(Rgb::ZERO);
-        table.push((t, tr));
-        if tr == Rgb::ZERO {
-            return tr;
-        }
-    }
-    Rgb::ZERO
+    medium.transmittance_walk(origin, direction, t_max, u, |t, tr| table.push((t, tr)))
 }
 
 /// The transmittance from a stretch's origin to `t` along it, from its ratio-tracking walk.
