@@ -13,6 +13,9 @@ use super::{NO_VISIBLE_POINT, PhotonMapper, SLOT_CHUNK, Setup};
 use crate::path::{MAX_CROSSINGS, bsdf_emission_weight, next_event};
 use crate::rng::{CAMERA_STREAM, Sampler};
 
+/// Where a camera path records its stretches through media and their ratio-tracking walks.
+type Stretches<'a> = (&'a mut Vec<Segment>, &'a mut Vec<(f32, Rgb)>);
+
 /// A camera path up to its first non-specular hit ([`PhotonMapper::camera_chain`]).
 pub(crate) struct CameraChain {
     /// Emission seen along the path (not divided by the slots per pixel).
@@ -279,7 +282,7 @@ impl Setup {
         &self,
         slot: u32,
         pass: u32,
-        mut segments: Option<(&mut Vec<Segment>, &mut Vec<(f32, Rgb)>)>,
+        mut segments: Option<Stretches<'_>>,
     ) -> CameraChain {
         let spp = self.params.film.samples_per_pixel;
         let pixel = slot / spp;
