@@ -118,6 +118,7 @@ fn material(m: &Mat, i: usize) -> Material {
         kind,
         emission: m.emission.as_ref().map_or(Vec3::ZERO, V::get),
         textures: None,
+        spectra: None,
     }
 }
 

@@ -105,6 +105,7 @@ impl<'a> Importer<'a> {
             kind,
             emission,
             textures: bsdf.textures.clone(),
+            spectra: None,
         });
         let to_world = parent * self.transform(node, "to_world")?;
         let m = to_world.as_mat4();

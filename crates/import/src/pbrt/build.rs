@@ -142,6 +142,7 @@ impl Parser {
                 kind,
                 emission,
                 textures,
+                spectra: None,
             });
             let to_world = fix * shape.state.ctm;
             let (triangles, spheres, cylinders) = (

@@ -103,6 +103,7 @@ impl Converter<'_> {
             kind,
             emission,
             textures: (!textures.is_empty()).then(|| std::sync::Arc::new(textures)),
+            spectra: None,
         })
     }
 

@@ -328,6 +328,9 @@ pub enum Spectrum {
     RgbUnbounded(RgbUnbounded),
     /// An uplifted emission.
     RgbIlluminant(RgbIlluminant),
+    /// Another spectrum times a factor (a blackbody or a named illuminant at a given
+    /// luminance).
+    Scaled(f64, Box<Spectrum>),
 }
 
 impl Spectrum {
@@ -340,6 +343,7 @@ impl Spectrum {
             Self::RgbAlbedo(s) => s.eval(lambda),
             Self::RgbUnbounded(s) => s.eval(lambda),
             Self::RgbIlluminant(s) => s.eval(lambda),
+            Self::Scaled(k, s) => k * s.eval(lambda),
         }
     }
 
@@ -362,6 +366,19 @@ impl Spectrum {
             })
             .sum::<glam::DVec3>()
             / CIE_Y_INTEGRAL
+    }
+
+    /// Its linear sRGB colour as an emission: [`super::xyz_to_srgb`] of [`Spectrum::to_xyz`] (a
+    /// spectrum of 1 everywhere has luminance 1; D65 normalized to luminance 1 is white).
+    pub fn emission_srgb(&self) -> glam::DVec3 {
+        super::xyz_to_srgb(self.to_xyz())
+    }
+
+    /// Its linear sRGB colour as a reflectance under D65, normalized as the uplift is (D65 of
+    /// luminance 1, trapezoid rule on the 1 nm nodes of 360–830 nm), so that a reflectance of 1
+    /// everywhere is white and an uplifted colour comes back as itself.
+    pub fn reflectance_srgb(&self) -> glam::DVec3 {
+        super::uplift::reflectance_srgb(|l| self.eval(l))
     }
 }
 
