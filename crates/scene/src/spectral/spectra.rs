@@ -19,8 +19,8 @@ pub struct PiecewiseLinear {
 
 impl PiecewiseLinear {
     /// A measured spectrum from its wavelengths (nm) and values. Refused: lists of different
-    /// lengths, fewer than 2 samples, a non-finite wavelength or value, a negative value, a
-    /// repeated or decreasing wavelength.
+    /// lengths, fewer than 2 samples, a non-finite wavelength or value, a wavelength ≤ 0, a
+    /// negative value, a repeated or decreasing wavelength.
     pub fn new(lambdas: Vec<f64>, values: Vec<f64>) -> Result<Self, SpectrumError> {
         if lambdas.len() != values.len() {
             return Err(SpectrumError::LengthMismatch {
@@ -40,6 +40,9 @@ impl PiecewiseLinear {
                     wavelength,
                     value,
                 });
+            }
+            if wavelength <= 0.0 {
+                return Err(SpectrumError::NonPositiveWavelength { index, wavelength });
             }
             if value < 0.0 {
                 return Err(SpectrumError::Negative {
@@ -167,6 +170,12 @@ impl Blackbody {
     /// Its temperature, K.
     pub fn temperature(&self) -> f64 {
         self.t
+    }
+
+    /// Its spectral radiance at the peak, W / (m² sr m): the factor that turns the normalized
+    /// emission into Planck's law.
+    pub fn peak_radiance(&self) -> f64 {
+        1.0 / self.normalization
     }
 
     /// The normalized emission at `lambda` nm.
@@ -480,6 +489,10 @@ mod tests {
         assert!(matches!(
             err(vec![400.0, 500.0], vec![1.0, -0.1]),
             E::Negative { index: 1, .. }
+        ));
+        assert!(matches!(
+            err(vec![-400.0, 500.0], vec![1.0, 1.0]),
+            E::NonPositiveWavelength { index: 0, .. }
         ));
         assert!(matches!(
             err(vec![400.0, 500.0, 500.0], vec![1.0, 1.0, 1.0]),
