@@ -330,14 +330,18 @@ impl<'a> Importer<'a> {
                             let k0 = f64::from(k.unwrap_or(Rgb::ZERO).y);
                             let values = vec![k0; eta_s.lambdas().len()];
                             scene::spectral::PiecewiseLinear::new(eta_s.lambdas().to_vec(), values)
-                                .map_err(|e| self.err(node, format!("k: {e}")))?
+                                .map_err(|e| {
+                                    self.err(node, format!("{}: k: {e}", node.label()))
+                                        .into_bad_spectrum()
+                                })?
                         }
                     };
                     let p = prop(node, "eta").unwrap_or(node);
-                    spectra.conductor = Some(
-                        scene::spectral::Conductor::new(eta_s, k_s)
-                            .map_err(|e| self.err(p, format!("eta: {e}")))?,
-                    );
+                    spectra.conductor =
+                        Some(scene::spectral::Conductor::new(eta_s, k_s).map_err(|e| {
+                            self.err(p, format!("{}: eta: {e}", node.label()))
+                                .into_bad_spectrum()
+                        })?);
                 }
                 (eta, k.unwrap_or(Rgb::ZERO))
             }
@@ -345,7 +349,11 @@ impl<'a> Importer<'a> {
             (None, _, Some(m)) => {
                 let (eta, k) = spectrum::metal(m).ok_or_else(|| {
                     let p = prop(node, "material").unwrap_or(node);
-                    self.err(p, format!("unknown conductor material \"{m}\""))
+                    self.err(
+                        p,
+                        format!("{}: unknown conductor material \"{m}\"", node.label()),
+                    )
+                    .into_bad_spectrum()
                 })?;
                 spectra.conductor = scene::spectral::Conductor::named(m);
                 (eta, k)

@@ -240,14 +240,19 @@ impl<'a> Importer<'a> {
                 SpectrumValue::Constant(_) => Ok(None),
                 SpectrumValue::Pairs(w, v) => PiecewiseLinear::new(w, v)
                     .map(|s| Some(Spectrum::PiecewiseLinear(s)))
-                    .map_err(|e| self.err(p, format!("spectrum \"{name}\": {e}"))),
+                    .map_err(|e| {
+                        self.err(p, format!("{}: spectrum \"{name}\": {e}", node.label()))
+                            .into_bad_spectrum()
+                    }),
             },
             Some("blackbody") => {
                 let t = self
                     .float(p, "temperature")?
                     .ok_or_else(|| self.err(p, "a blackbody needs a temperature"))?;
-                let b = Blackbody::new(t)
-                    .map_err(|e| self.err(p, format!("spectrum \"{name}\": {e}")))?;
+                let b = Blackbody::new(t).map_err(|e| {
+                    self.err(p, format!("{}: spectrum \"{name}\": {e}", node.label()))
+                        .into_bad_spectrum()
+                })?;
                 Ok(Some(Spectrum::Scaled(
                     b.peak_radiance() * 1e-9,
                     Box::new(Spectrum::Blackbody(b)),

@@ -287,10 +287,10 @@ impl Parser {
         };
         if let (Some(e), Some(k)) = (eta_s, k_s) {
             let loc = p.get(&eta_name).map_or(loc, Self::loc_of_param);
-            spectra.conductor = Some(
-                scene::spectral::Conductor::new(e, k)
-                    .map_err(|e| self.err(loc, format!("parameter \"{eta_name}\": {e}")))?,
-            );
+            spectra.conductor = Some(scene::spectral::Conductor::new(e, k).map_err(|e| {
+                self.err(loc, format!("parameter \"{eta_name}\": {e}"))
+                    .into_bad_spectrum()
+            })?);
         }
         Ok((eta.unwrap_or(ce), k.unwrap_or(ck)))
     }
@@ -315,7 +315,10 @@ impl Parser {
         match self.spectral(p, name)? {
             Some((w, v)) => scene::spectral::PiecewiseLinear::new(w, v)
                 .map(Some)
-                .map_err(|e| self.err(loc, format!("parameter \"spectrum {name}\": {e}"))),
+                .map_err(|e| {
+                    self.err(loc, format!("parameter \"spectrum {name}\": {e}"))
+                        .into_bad_spectrum()
+                }),
             None => Ok(None),
         }
     }
@@ -342,7 +345,8 @@ impl Parser {
                     "parameter \"spectrum {name}\": unknown named spectrum \"{s}\" (glasses: {})",
                     Ior::NAMES.join(", ")
                 ),
-            ));
+            )
+            .into_bad_spectrum());
         }
         let measured = self.measured_or_named(p, name)?.ok_or_else(|| {
             self.err(
@@ -350,7 +354,9 @@ impl Parser {
                 format!("parameter \"spectrum {name}\" must be a glass or λ/value pairs"),
             )
         })?;
-        Ior::tabulated(measured)
-            .map_err(|e| self.err(loc, format!("parameter \"spectrum {name}\": {e}")))
+        Ior::tabulated(measured).map_err(|e| {
+            self.err(loc, format!("parameter \"spectrum {name}\": {e}"))
+                .into_bad_spectrum()
+        })
     }
 }

@@ -289,8 +289,10 @@ impl Parser {
                 ));
             }
         };
-        let b = Blackbody::new(t)
-            .map_err(|e| self.err(loc, format!("parameter \"blackbody {}\": {e}", p.name)))?;
+        let b = Blackbody::new(t).map_err(|e| {
+            self.err(loc, format!("parameter \"blackbody {}\": {e}", p.name))
+                .into_bad_spectrum()
+        })?;
         let y = Spectrum::Blackbody(b).to_xyz().y;
         Ok(Some(Spectrum::Scaled(
             1.0 / y,
@@ -342,16 +344,20 @@ impl Parser {
         usage: SpectrumUse,
     ) -> Result<Rgb, LoadError> {
         if let Some(rest) = s.strip_prefix("metal-") {
-            let (metal, part) = rest
-                .rsplit_once('-')
-                .ok_or_else(|| self.err(loc, format!("unknown named spectrum \"{s}\"")))?;
+            let (metal, part) = rest.rsplit_once('-').ok_or_else(|| {
+                self.err(loc, format!("unknown named spectrum \"{s}\""))
+                    .into_bad_spectrum()
+            })?;
             let (eta, k) = spectrum::metal(metal).ok_or_else(|| {
                 self.err(loc, format!("named spectrum \"{s}\" is not known to fppm"))
+                    .into_bad_spectrum()
             })?;
             return match part {
                 "eta" => Ok(eta),
                 "k" => Ok(k),
-                _ => Err(self.err(loc, format!("unknown named spectrum \"{s}\""))),
+                _ => Err(self
+                    .err(loc, format!("unknown named spectrum \"{s}\""))
+                    .into_bad_spectrum()),
             };
         }
         if let Some(ior) = scene::spectral::Ior::named(s) {

@@ -201,12 +201,17 @@ impl Converter<'_> {
         }
     }
 
+    /// A [`LoadError::BadSpectrum`] about `key`.
+    fn bad(&self, key: impl Into<String>, message: impl Into<String>) -> LoadError {
+        self.invalid(key, message).into_bad_spectrum()
+    }
+
     /// A spectrum's `scale`: finite and ≥ 0, 1 by default.
     fn scale(&self, key: &str, scale: Option<f64>) -> Result<f64, LoadError> {
         match scale {
             None => Ok(1.0),
             Some(s) if s.is_finite() && s >= 0.0 => Ok(s),
-            Some(s) => Err(self.invalid(
+            Some(s) => Err(self.bad(
                 format!("{key} scale"),
                 format!("must be finite and >= 0, got {s}"),
             )),
@@ -219,12 +224,12 @@ impl Converter<'_> {
     fn spectrum(&self, key: &str, s: SpectrumToml, usage: Usage) -> Result<Spectrum, LoadError> {
         let scale = self.scale(key, s.scale)?;
         let emission_only =
-            |what: &str| self.invalid(key, format!("a {what} is an emission, not a reflectance"));
+            |what: &str| self.bad(key, format!("a {what} is an emission, not a reflectance"));
         if let Some(t) = s.blackbody {
             if usage != Usage::Emission {
                 return Err(emission_only("blackbody"));
             }
-            let b = Blackbody::new(t).map_err(|e| self.invalid(key, e.to_string()))?;
+            let b = Blackbody::new(t).map_err(|e| self.bad(key, e.to_string()))?;
             let y = Spectrum::Blackbody(b).to_xyz().y;
             return Ok(Spectrum::Scaled(
                 scale / y,
@@ -236,7 +241,7 @@ impl Converter<'_> {
                 return Err(emission_only("named illuminant"));
             }
             let illuminant = NamedIlluminant::from_name(&name).ok_or_else(|| {
-                self.invalid(
+                self.bad(
                     key,
                     format!("unknown illuminant \"{name}\" (known: D65, A)"),
                 )
@@ -254,7 +259,7 @@ impl Converter<'_> {
                 .enumerate()
                 .find(|&(_, &v)| v * scale > 1.0)
         {
-            return Err(self.invalid(
+            return Err(self.bad(
                 key,
                 format!(
                     "a reflectance must be at most 1: sample {i} is {} at {} nm",
@@ -272,16 +277,16 @@ impl Converter<'_> {
             samples.iter().map(|s| s[0]).collect(),
             samples.iter().map(|s| s[1]).collect(),
         )
-        .map_err(|e| self.invalid(key, e.to_string()))
+        .map_err(|e| self.bad(key, e.to_string()))
     }
 
     /// A dielectric's index of refraction given as a named glass or a dispersion law.
     fn ior_law(&self, key: &str, ior: IorToml) -> Result<Ior, LoadError> {
-        let bad = |e: spectral::SpectrumError| self.invalid(key, e.to_string());
+        let bad = |e: spectral::SpectrumError| self.bad(key, e.to_string());
         match ior {
             IorToml::Number(n) => Ior::constant(f64::from(n)).map_err(bad),
             IorToml::Named(name) => Ior::named(&name).ok_or_else(|| {
-                self.invalid(
+                self.bad(
                     key,
                     format!(
                         "unknown glass \"{name}\" (known: {})",
@@ -293,7 +298,7 @@ impl Converter<'_> {
                 match (law.sellmeier, law.cauchy, law.samples) {
                     (Some(c), None, None) => {
                         let [b1, b2, b3, c1, c2, c3] = c[..] else {
-                            return Err(self.invalid(
+                            return Err(self.bad(
                             key,
                             format!("sellmeier needs 6 coefficients [B1, B2, B3, C1, C2, C3], got {}", c.len()),
                         ));
@@ -307,7 +312,7 @@ impl Converter<'_> {
                             [a, b] => (a, b, 0.0),
                             [a, b, c] => (a, b, c),
                             _ => {
-                                return Err(self.invalid(
+                                return Err(self.bad(
                                     key,
                                     format!(
                                         "cauchy needs 2 or 3 coefficients [A, B, C], got {}",
@@ -343,14 +348,12 @@ impl Converter<'_> {
         let key = |k: &str| format!("[materials.{name}] {k}");
         match (metal, eta) {
             (Some(_), Some(_)) => {
-                Err(self.invalid(key("metal"), "give either `metal` or `eta` and `k`"))
+                Err(self.bad(key("metal"), "give either `metal` or `eta` and `k`"))
             }
-            (None, None) => {
-                Err(self.invalid(key("eta"), "a conductor needs `metal` or `eta` and `k`"))
-            }
+            (None, None) => Err(self.bad(key("eta"), "a conductor needs `metal` or `eta` and `k`")),
             (Some(metal), None) => {
                 if k.is_some() {
-                    return Err(self.invalid(key("k"), "give either `metal` or `eta` and `k`"));
+                    return Err(self.bad(key("k"), "give either `metal` or `eta` and `k`"));
                 }
                 if let Some(c) = spectral::Conductor::named(&metal) {
                     let (eta, k) = c.rgb();
@@ -358,7 +361,7 @@ impl Converter<'_> {
                     return Ok((rgb(eta), rgb(k), Some(c)));
                 }
                 let (eta, k) = crate::spectrum::metal(&metal).ok_or_else(|| {
-                    self.invalid(
+                    self.bad(
                         key("metal"),
                         format!(
                             "unknown metal \"{metal}\" (spectral: {}; Mitsuba's RGB conductors by name)",
@@ -380,11 +383,11 @@ impl Converter<'_> {
                         let k = k.unwrap_or_else(|| zero_spectrum(&eta));
                         Some(
                             spectral::Conductor::new(eta, k)
-                                .map_err(|e| self.invalid(key("eta"), e.to_string()))?,
+                                .map_err(|e| self.bad(key("eta"), e.to_string()))?,
                         )
                     }
                     (None, Some(_)) => {
-                        return Err(self.invalid(key("k"), "a spectral k needs a spectral eta"));
+                        return Err(self.bad(key("k"), "a spectral k needs a spectral eta"));
                     }
                 };
                 Ok((eta_rgb, k_rgb, spectra))
@@ -412,7 +415,7 @@ impl Converter<'_> {
             ColorToml::Spectrum(s) if s.rgb.is_some() && s.scale.is_none() => {
                 Ok((self.colour(key, s.rgb.unwrap_or_default())?, None))
             }
-            _ => Err(self.invalid(
+            _ => Err(self.bad(
                 key,
                 "must be [r, g, b], { rgb = [r, g, b] } or { samples = [[nm, value], …] }",
             )),
