@@ -189,7 +189,7 @@ impl Converter<'_> {
                     let scale = self.scale(key, spectrum.scale)? as f32;
                     return Ok((check(rgb.map(|c| c * scale))?, None, None));
                 }
-                let spectrum = self.spectrum(key, spectrum, usage)?;
+                let spectrum = self.spectrum(key, *spectrum, usage)?;
                 let colour = match usage {
                     Usage::Reflectance => {
                         spectrum.reflectance_srgb().clamp(DVec3::ZERO, DVec3::ONE)

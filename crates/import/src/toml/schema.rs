@@ -135,7 +135,7 @@ pub(super) enum ColorToml {
         scale: Option<[f32; 3]>,
     },
     /// Extension: a spectrum (`docs/scene-format-extensions.md`, "Spectra").
-    Spectrum(SpectrumToml),
+    Spectrum(Box<SpectrumToml>),
 }
 
 /// A colour's table form: a texture or a spectrum, told apart by their keys.
@@ -220,13 +220,13 @@ impl<'de> Deserialize<'de> for ColorToml {
                          `illuminant`, `samples`, `rgb`",
                     ));
                 }
-                Ok(ColorToml::Spectrum(SpectrumToml {
+                Ok(ColorToml::Spectrum(Box::new(SpectrumToml {
                     blackbody: t.blackbody,
                     illuminant: t.illuminant,
                     samples: t.samples,
                     rgb: t.rgb,
                     scale,
-                }))
+                })))
             }
         }
         d.deserialize_any(Visitor)

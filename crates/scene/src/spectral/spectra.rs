@@ -424,6 +424,28 @@ mod tests {
         assert!((xyz.y / CIE_Y_INTEGRAL - 1.0).abs() < 1e-3, "{xyz}");
     }
 
+    /// The RGB colour of a spectrum: D65 of luminance 1 is sRGB white as an emission, a
+    /// reflectance of 1 is white under D65, an uplifted reflectance comes back as its colour,
+    /// and a scaled spectrum scales its colour.
+    #[test]
+    fn colours_of_emissions_and_reflectances() {
+        let d65 = Spectrum::PiecewiseLinear(NamedIlluminant::D65.spectrum().clone());
+        let white = d65.emission_srgb();
+        assert!((white - DVec3::ONE).abs().max_element() < 2e-3, "{white}");
+        let one = Spectrum::Constant(1.0).reflectance_srgb();
+        assert!((one - DVec3::ONE).abs().max_element() < 2e-3, "{one}");
+        for rgb in [[0.8, 0.3, 0.1], [0.1, 0.5, 0.9], [0.5, 0.5, 0.5]] {
+            let s = Spectrum::RgbAlbedo(RgbAlbedo::new(rgb).unwrap());
+            let back = s.reflectance_srgb();
+            assert!(
+                (back - DVec3::from_array(rgb)).abs().max_element() < 0.01,
+                "{rgb:?}: {back}"
+            );
+        }
+        let scaled = Spectrum::Scaled(3.0, Box::new(d65.clone())).emission_srgb();
+        assert!((scaled - 3.0 * white).abs().max_element() < 1e-9);
+    }
+
     /// Illuminant A is a 2856 K black body: its chromaticity is the CIE's (0.44757, 0.40745),
     /// and Planck's law at 2856 K gives the same.
     #[test]
