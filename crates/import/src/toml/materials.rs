@@ -380,6 +380,10 @@ impl Converter<'_> {
                 let spectra = match (eta_spectrum, k_spectrum) {
                     (None, None) => None,
                     (Some(eta), k) => {
+                        if k.is_none() && k_rgb != Vec3::ZERO {
+                            return Err(self
+                                .bad(key("k"), "must be a spectrum (or absent) when eta is one"));
+                        }
                         let k = k.unwrap_or_else(|| zero_spectrum(&eta));
                         Some(
                             spectral::Conductor::new(eta, k)
