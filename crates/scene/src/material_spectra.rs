@@ -124,3 +124,70 @@ impl Fingerprint for Ior {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use super::*;
+    use crate::{Material, MaterialKind, Rgb};
+
+    fn fingerprint(m: &Material) -> u64 {
+        let mut h = Fingerprinter::new();
+        h.add(m);
+        h.finish()
+    }
+
+    /// A material without spectra feeds what a material fed before spectra existed (emission,
+    /// model, textures), so RGB scenes keep their fingerprints; spectra change it.
+    #[test]
+    fn spectra_count_only_when_present() {
+        let m = Material {
+            name: "gold".to_owned(),
+            kind: MaterialKind::Conductor(crate::Conductor {
+                eta: Rgb::new(0.14, 0.37, 1.44),
+                k: Rgb::new(3.98, 2.38, 1.60),
+                specular_reflectance: Rgb::ONE,
+                roughness: 0.0,
+            }),
+            emission: Rgb::ZERO,
+            textures: None,
+            spectra: None,
+        };
+        let mut h = Fingerprinter::new();
+        h.vec3(m.emission);
+        h.add(&m.kind);
+        h.option(None::<&crate::texture::MaterialTextures>, |h, t| h.add(t));
+        assert_eq!(fingerprint(&m), h.finish());
+
+        let with = |spectra: MaterialSpectra| Material {
+            spectra: Some(Arc::new(spectra)),
+            ..m.clone()
+        };
+        let gold = with(MaterialSpectra {
+            conductor: spectral::Conductor::named("Au"),
+            ..MaterialSpectra::default()
+        });
+        let copper = with(MaterialSpectra {
+            conductor: spectral::Conductor::named("Cu"),
+            ..MaterialSpectra::default()
+        });
+        let bk7 = with(MaterialSpectra {
+            ior: Ior::named("glass-BK7"),
+            ..MaterialSpectra::default()
+        });
+        let hot = |t: f64| {
+            with(MaterialSpectra {
+                emission: spectral::Blackbody::new(t).ok().map(Spectrum::Blackbody),
+                ..MaterialSpectra::default()
+            })
+        };
+        let prints = [&m, &gold, &copper, &bk7, &hot(3000.0), &hot(3001.0)].map(fingerprint);
+        for i in 0..prints.len() {
+            for j in 0..i {
+                assert_ne!(prints[i], prints[j], "{i} {j}");
+            }
+        }
+        assert_eq!(fingerprint(&gold), fingerprint(&gold.clone()));
+    }
+}
