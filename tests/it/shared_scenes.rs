@@ -1,6 +1,5 @@
 //! Every shared scene that has emitters, and the suite's spectral scene, loads, builds and renders a
-//! pass with every method:
-//! finite, non-negative, and not black.
+//! pass with every method: finite, non-negative, and not black.
 
 use std::path::{Path, PathBuf};
 
