@@ -1,4 +1,5 @@
-//! The rough conductor: GGX (Trowbridge–Reitz) microfacets with Smith shadowing, over an optional
+//! The glossy model: GGX (Trowbridge–Reitz) microfacets with Smith shadowing and Schlick's Fresnel of a
+//! given normal-incidence colour (the exact Fresnel of a metal is `conductor.rs`), over an optional
 //! Lambertian base.
 //!
 //! The model is coupled so that it never reflects more than it receives (the MTL `Kd` + `Ks` it
