@@ -694,6 +694,26 @@ fn bad_spectra_are_usage_errors() {
         &["metal.xml", "id=\"gold\"", "Mithril"],
         &keep,
     );
+    std::fs::write(
+        dir.join("metal.xml"),
+        xml.replace(
+            "<string name=\"material\" value=\"Mithril\"/>",
+            "<spectrum name=\"eta\" value=\"500:0.2, 400:0.3\"/>",
+        ),
+    )
+    .unwrap();
+    check_in(
+        &dir,
+        &["render", "metal.xml"],
+        2,
+        &[
+            "metal.xml",
+            "line 2",
+            "name=\"eta\"",
+            "wavelengths must increase",
+        ],
+        &keep,
+    );
     let pbrt = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n\
         Material \"dielectric\" \"spectrum eta\" \"glass-XYZ\"\nShape \"sphere\"\n\
         AttributeBegin\nAreaLightSource \"diffuse\" \"blackbody L\" [ -5 ]\n\

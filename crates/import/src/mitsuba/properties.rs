@@ -173,8 +173,12 @@ impl<'a> Importer<'a> {
     pub(super) fn spectrum(&self, p: &Node, usage: SpectrumUse) -> Result<Rgb, LoadError> {
         match self.spectrum_samples(p)? {
             SpectrumValue::Constant(x) => Ok(spectrum::constant_spectrum_to_rgb(x, usage)),
-            SpectrumValue::Pairs(w, v) => spectrum::spectrum_to_rgb(&w, &v, usage)
-                .ok_or_else(|| self.err(p, "wavelengths must increase and values be finite")),
+            SpectrumValue::Pairs(w, v) => {
+                spectrum::spectrum_to_rgb(&w, &v, usage).ok_or_else(|| {
+                    self.err(p, "wavelengths must increase and values be finite")
+                        .into_bad_spectrum()
+                })
+            }
         }
     }
 
