@@ -56,6 +56,7 @@ enum Kind {
     Mirror(V),
     Dielectric(F),
     Glossy(V, F, V),
+    Conductor(V, V, V, F),
 }
 
 #[derive(Arbitrary, Debug)]
@@ -112,12 +113,19 @@ fn material(m: &Mat, i: usize) -> Material {
             roughness: roughness.0,
             diffuse: d.get(),
         }),
+        Kind::Conductor(eta, k, tint, roughness) => MaterialKind::Conductor(scene::Conductor {
+            eta: eta.get(),
+            k: k.get(),
+            specular_reflectance: tint.get(),
+            roughness: roughness.0,
+        }),
     };
     Material {
         name: format!("m{i}"),
         kind,
         emission: m.emission.as_ref().map_or(Vec3::ZERO, V::get),
         textures: None,
+        spectra: None,
     }
 }
 

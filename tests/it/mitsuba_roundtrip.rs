@@ -119,6 +119,13 @@ fn write_mitsuba(scene: &SceneDescription, dir: &Path) -> PathBuf {
                 c3(diffuse / (1.0 - F0))
             ),
             MaterialKind::Interface(_) => format!("<bsdf type=\"null\" id=\"m{i}\"/>"),
+            MaterialKind::Conductor(c) => format!(
+                "<bsdf type=\"roughconductor\" id=\"m{i}\"><float name=\"alpha\" value=\"{}\"/><rgb name=\"eta\" value=\"{}\"/><rgb name=\"k\" value=\"{}\"/><rgb name=\"specular_reflectance\" value=\"{}\"/></bsdf>",
+                c.roughness,
+                c3(c.eta),
+                c3(c.k),
+                c3(c.specular_reflectance)
+            ),
         };
         writeln!(x, "  {body}").unwrap();
     }
@@ -296,6 +303,12 @@ fn close_kind(a: MaterialKind, b: MaterialKind, what: &str) {
             close(r1, r2, what);
             close_f(a1, a2, what);
             close(d1, d2, what);
+        }
+        (MaterialKind::Conductor(x), MaterialKind::Conductor(y)) => {
+            close(x.eta, y.eta, what);
+            close(x.k, y.k, what);
+            close(x.specular_reflectance, y.specular_reflectance, what);
+            close_f(x.roughness, y.roughness, what);
         }
         _ => panic!("{what}: {a:?} vs {b:?}"),
     }

@@ -1,5 +1,5 @@
-//! Every shared scene that has emitters loads, builds and renders a pass with every method:
-//! finite, non-negative, and not black.
+//! Every shared scene that has emitters, and the suite's spectral scene, loads, builds and renders a
+//! pass with every method: finite, non-negative, and not black.
 
 use std::path::{Path, PathBuf};
 
@@ -36,7 +36,20 @@ const LIT_SCENES: &[&str] = &[
 #[test]
 fn every_lit_shared_scene_renders_with_every_method() {
     for relative in LIT_SCENES {
-        let mut description = import::load(&shared(relative)).unwrap();
+        renders_with_every_method(&shared(relative), relative);
+    }
+}
+
+/// The suite's spectral scene: smooth and rough conductors, a dispersive glass, a blackbody lamp.
+#[test]
+fn the_spectral_scene_renders_with_every_method() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/spectral-metals.toml");
+    renders_with_every_method(&path, "spectral-metals.toml");
+}
+
+fn renders_with_every_method(path: &Path, relative: &str) {
+    {
+        let mut description = import::load(path).unwrap();
         description.film = Film {
             width: 12,
             height: 12,

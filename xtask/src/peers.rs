@@ -673,6 +673,23 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
                 rgb((reflectance / 0.04).min(Vec3::ONE).to_array()),
                 rgb((diffuse / 0.96).min(Vec3::ONE).to_array())
             ),
+            // The conductor with its RGB η and k, as Mitsuba's RGB variants render it.
+            scene::MaterialKind::Conductor(c) => {
+                let kind = if c.is_smooth() {
+                    "<bsdf type=\"conductor\">".to_owned()
+                } else {
+                    format!(
+                        "<bsdf type=\"roughconductor\"><string name=\"distribution\" value=\"ggx\"/><float name=\"alpha\" value=\"{}\"/>",
+                        c.roughness
+                    )
+                };
+                format!(
+                    "<bsdf type=\"twosided\">{kind}<rgb name=\"eta\" value=\"{}\"/><rgb name=\"k\" value=\"{}\"/><rgb name=\"specular_reflectance\" value=\"{}\"/></bsdf></bsdf>",
+                    rgb(c.eta.to_array()),
+                    rgb(c.k.to_array()),
+                    rgb(c.specular_reflectance.to_array())
+                )
+            }
             // Bounds media without scattering: Mitsuba's `null` BSDF (media are attached to
             // the shape, below).
             scene::MaterialKind::Interface(_) => "<bsdf type=\"null\"/>".to_owned(),

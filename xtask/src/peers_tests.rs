@@ -26,6 +26,20 @@ fn same_kind(a: MaterialKind, b: MaterialKind) -> bool {
                 && close(x.roughness, y.roughness)
                 && close3(x.diffuse, y.diffuse)
         }
+        // A glossy conductor exports as Mitsuba's `roughconductor` with the (η, k) whose Fresnel
+        // Schlick's curve follows, which comes back as fppm's conductor of that reflectance at
+        // normal incidence.
+        (MaterialKind::Glossy(x), MaterialKind::Conductor(y)) => {
+            x.diffuse == glam::Vec3::ZERO
+                && close3(x.reflectance, b.albedo())
+                && close(x.roughness, y.roughness)
+        }
+        (MaterialKind::Conductor(x), MaterialKind::Conductor(y)) => {
+            close3(x.eta, y.eta)
+                && close3(x.k, y.k)
+                && close3(x.specular_reflectance, y.specular_reflectance)
+                && close(x.roughness, y.roughness)
+        }
         _ => false,
     }
 }

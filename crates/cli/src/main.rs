@@ -85,7 +85,11 @@ fn main() -> ExitCode {
         Ok(Outcome::Done) => ExitCode::SUCCESS,
         Ok(Outcome::Interrupted) => ExitCode::from(130),
         Err(err) => {
-            let code = if err.downcast_ref::<UsageError>().is_some() {
+            // A bad spectrum in a scene is a usage error, as the issue of spectra asks.
+            let bad_spectrum = err
+                .downcast_ref::<import::LoadError>()
+                .is_some_and(import::LoadError::is_bad_spectrum);
+            let code = if err.downcast_ref::<UsageError>().is_some() || bad_spectrum {
                 2
             } else {
                 1

@@ -142,6 +142,16 @@ pub enum LoadError {
         /// What is wrong with it, e.g. `must be in (0, 180) degrees, got 180`.
         message: String,
     },
+    /// A spectrum, a dispersion law or a named spectrum that cannot be used: a negative or
+    /// decreasing wavelength, a negative value, an index of refraction below 1 in range, an
+    /// unknown name. The CLI treats it as a usage error (exit 2).
+    #[error("{}: {message}", path.display())]
+    BadSpectrum {
+        /// The file.
+        path: PathBuf,
+        /// Where (line, material, value) and what is wrong.
+        message: String,
+    },
     /// `format` is not 1.
     #[error("{}: unsupported scene format version {found} (this loader reads format = 1)", path.display())]
     UnsupportedVersion {
@@ -326,6 +336,22 @@ fn location(line: Option<u32>, column: Option<u32>) -> String {
 }
 
 impl LoadError {
+    /// The same error as a [`LoadError::BadSpectrum`]: its message (after the file name) kept.
+    #[must_use]
+    pub fn into_bad_spectrum(self) -> Self {
+        let path = self.path().to_path_buf();
+        let text = self.to_string();
+        let prefix = format!("{}: ", path.display());
+        let message = text.strip_prefix(&prefix).unwrap_or(&text).to_owned();
+        Self::BadSpectrum { path, message }
+    }
+
+    /// Whether the error is a [`LoadError::BadSpectrum`].
+    #[must_use]
+    pub fn is_bad_spectrum(&self) -> bool {
+        matches!(self, Self::BadSpectrum { .. })
+    }
+
     /// The file the error is about.
     #[must_use]
     pub fn path(&self) -> &std::path::Path {
@@ -340,6 +366,7 @@ impl LoadError {
             | Self::UnknownType { path, .. }
             | Self::UnknownMaterial { path, .. }
             | Self::InvalidValue { path, .. }
+            | Self::BadSpectrum { path, .. }
             | Self::UnsupportedVersion { path, .. }
             | Self::Obj { path, .. }
             | Self::Mtl { path, .. }

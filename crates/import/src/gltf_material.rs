@@ -25,6 +25,7 @@ pub(super) fn default_material() -> Material {
         }),
         emission: Vec3::ZERO,
         textures: None,
+        spectra: None,
     }
 }
 
@@ -216,6 +217,7 @@ pub(super) fn material(
         kind,
         emission,
         textures: (!maps.is_empty()).then(|| Arc::new(maps)),
+        spectra: None,
     };
     Ok((material, uv_set))
 }

@@ -136,6 +136,7 @@ pub(crate) fn default_material_value() -> Material {
         }),
         emission: Vec3::ZERO,
         textures: None,
+        spectra: None,
     }
 }
 
@@ -470,6 +471,7 @@ fn mtl_material(m: &tobj::Material, warnings: &mut Vec<String>) -> Material {
         kind,
         emission,
         textures: None,
+        spectra: None,
     }
 }
 

@@ -124,49 +124,6 @@ pub(crate) fn constant_spectrum_to_rgb(v: f64, usage: SpectrumUse) -> Rgb {
     }
 }
 
-/// Reflectance of a conductor at normal incidence, per channel:
-/// ((η − 1)² + k²) / ((η + 1)² + k²).
-pub(crate) fn conductor_reflectance(eta: Rgb, k: Rgb) -> Rgb {
-    let num = (eta - 1.0) * (eta - 1.0) + k * k;
-    let den = (eta + 1.0) * (eta + 1.0) + k * k;
-    (num / den.max(Rgb::splat(1e-12))).clamp(Rgb::ZERO, Rgb::ONE)
-}
-
-/// Reflectance at normal incidence of a conductor whose η and k are spectra, computed per
-/// wavelength (on η's wavelengths, k interpolated linearly and held at its ends) and then
-/// converted to RGB as a reflectance: closer to a spectral renderer than converting η and k
-/// to RGB first. `None` if either spectrum is malformed.
-pub(crate) fn conductor_reflectance_spectral(
-    eta: (&[f64], &[f64]),
-    k: (&[f64], &[f64]),
-) -> Option<Rgb> {
-    let (we, ve) = eta;
-    let (wk, vk) = k;
-    if we.is_empty() || wk.is_empty() || we.len() != ve.len() || wk.len() != vk.len() {
-        return None;
-    }
-    let k_at = |w: f64| -> f64 {
-        let j = wk.partition_point(|&x| x <= w);
-        if j == 0 {
-            vk[0]
-        } else if j >= wk.len() {
-            vk[wk.len() - 1]
-        } else {
-            let t = (w - wk[j - 1]) / (wk[j] - wk[j - 1]);
-            (1.0 - t) * vk[j - 1] + t * vk[j]
-        }
-    };
-    let r: Vec<f64> = we
-        .iter()
-        .zip(ve)
-        .map(|(&w, &n)| {
-            let k = k_at(w);
-            ((n - 1.0) * (n - 1.0) + k * k) / ((n + 1.0) * (n + 1.0) + k * k)
-        })
-        .collect();
-    spectrum_to_rgb(we, &r, SpectrumUse::Reflectance)
-}
-
 /// Reflectance of a smooth dielectric interface at normal incidence: ((η − 1) / (η + 1))².
 pub(crate) fn dielectric_reflectance(eta: f32) -> f32 {
     let r = (eta - 1.0) / (eta + 1.0);
@@ -220,13 +177,16 @@ mod tests {
 
     #[test]
     fn conductor_reflectance_is_fresnel_at_normal_incidence() {
-        // η = 1.5, k = 0: the dielectric value 0.04.
-        let r = conductor_reflectance(Rgb::splat(1.5), Rgb::ZERO);
-        assert!((r.x - 0.04).abs() < 1e-6);
         assert!((dielectric_reflectance(1.5) - 0.04).abs() < 1e-6);
         // Gold is reddish-yellow: red above blue.
         let (eta, k) = metal("Au").unwrap();
-        let gold = conductor_reflectance(eta, k);
+        let gold = scene::MaterialKind::Conductor(scene::Conductor {
+            eta,
+            k,
+            specular_reflectance: Rgb::ONE,
+            roughness: 0.0,
+        })
+        .albedo();
         assert!(gold.x > 0.9 && gold.z < 0.7, "{gold}");
     }
 }

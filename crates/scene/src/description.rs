@@ -13,6 +13,7 @@ use glam::{Vec2, Vec3};
 
 use crate::fingerprint::{Fingerprint, Fingerprinter};
 use crate::material::{MaterialKind, MaterialParam};
+use crate::material_spectra::MaterialSpectra;
 use crate::texture::MaterialTextures;
 
 /// Linear Rec.709 RGB triple.
@@ -124,6 +125,9 @@ pub struct Material {
     /// Image textures that modulate the material (colour, emission, normal, cut-out); `None`
     /// for an untextured material, which then costs no texture work anywhere.
     pub textures: Option<Arc<MaterialTextures>>,
+    /// The spectra the RGB `kind` and `emission` were derived from, for spectral transport;
+    /// `None` for a material given in colours only.
+    pub spectra: Option<Arc<MaterialSpectra>>,
 }
 
 /// One world-space triangle. The front face is where v0, v1, v2 appear counter-clockwise.
@@ -355,12 +359,17 @@ impl Fingerprint for Film {
 }
 
 impl Fingerprint for Material {
-    /// The model by name and parameters, the emission and the textures (the name in the file
-    /// does not count).
+    /// The model by name and parameters, the emission, the textures and the spectra (the name
+    /// in the file does not count). Spectra count only when there are some, so a material in
+    /// colours keeps the fingerprint it had before spectra existed.
     fn fingerprint(&self, h: &mut Fingerprinter) {
         h.vec3(self.emission);
         h.add(&self.kind);
         h.option(self.textures.as_deref(), |h, t| h.add(t));
+        if let Some(spectra) = self.spectra.as_deref() {
+            h.str("spectra");
+            h.add(spectra);
+        }
     }
 }
 

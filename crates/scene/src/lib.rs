@@ -39,6 +39,7 @@ pub mod fingerprint;
 mod frame;
 mod light;
 mod material;
+mod material_spectra;
 mod medium;
 mod ray;
 mod sampling;
@@ -66,10 +67,11 @@ pub use light::{
     LightSample, LightSampler,
 };
 pub use material::{
-    Bsdf, BsdfPdfs, BsdfSample, Dielectric, Diffuse, Glossy, Interface, Lobe, MaterialKind,
-    MaterialParam, Mirror, RoughDielectric, SMOOTH_ROUGHNESS, TransportMode, fresnel_dielectric,
-    luminance,
+    Bsdf, BsdfPdfs, BsdfSample, Conductor, Dielectric, Diffuse, Glossy, Interface, Lobe,
+    MaterialKind, MaterialParam, Mirror, RoughDielectric, SMOOTH_ROUGHNESS, TransportMode,
+    fresnel_dielectric, luminance,
 };
+pub use material_spectra::{MaterialSpectra, REPRESENTATIVE_WAVELENGTH};
 pub use medium::{
     FreeFlight, HenyeyGreenstein, Media, Medium, MediumShape, PhaseSample, ShapeMedia, medium_after,
 };

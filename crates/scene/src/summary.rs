@@ -109,12 +109,12 @@ pub struct LightCounts {
 pub struct MaterialSummary {
     /// Name.
     pub name: String,
-    /// `diffuse`, `mirror`, `dielectric` or `glossy`.
+    /// The model's name ([`crate::MaterialKind::name`]).
     pub kind: &'static str,
     /// Diffuse albedo, or the Lambertian base of a glossy material from an OBJ file.
     #[serde(skip_serializing_if = "Option::is_none", serialize_with = "opt3")]
     pub albedo: Option<Vec3>,
-    /// Mirror or glossy reflectance.
+    /// Mirror or glossy reflectance; a conductor's at normal incidence.
     #[serde(skip_serializing_if = "Option::is_none", serialize_with = "opt3")]
     pub reflectance: Option<Vec3>,
     /// Dielectric index of refraction.
@@ -247,6 +247,10 @@ impl SceneDescription {
                         MaterialParam::Positive("roughness", x) => roughness = Some(x),
                         _ => {}
                     }
+                }
+                // A conductor shows its reflectance at normal incidence, Fresnel and tint.
+                if let crate::MaterialKind::Conductor(_) = m.kind {
+                    reflectance = Some(m.kind.albedo());
                 }
                 MaterialSummary {
                     name: m.name.clone(),

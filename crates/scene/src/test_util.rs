@@ -55,6 +55,7 @@ pub(crate) fn diffuse(albedo: f32, emission: Vec3) -> Material {
         }),
         emission,
         textures: None,
+        spectra: None,
     }
 }
 

@@ -682,3 +682,143 @@ interior = "smoke"
     )
     .ok();
 }
+
+/// Bad spectral input (issue #34): a negative or decreasing wavelength list, a Sellmeier law
+/// below 1 in range, unknown named spectra. One line naming the file, the material and the
+/// value, exit 2, in the TOML, Mitsuba and pbrt formats.
+#[test]
+fn bad_spectra_are_usage_errors() {
+    let dir = temp_dir("bad_spectra");
+    let scene = crate::small_default_scene();
+    let albedo = "albedo = [0.75, 0.73, 0.70]";
+    assert!(scene.contains(albedo));
+    let mirror = "type        = \"mirror\"\nreflectance = [0.95, 0.93, 0.88]";
+    assert!(scene.contains(mirror));
+    let cases: [(&str, String, &[&str]); 7] = [
+        (
+            "decreasing.toml",
+            scene.replace(
+                albedo,
+                "albedo = { samples = [[500.0, 0.5], [400.0, 0.4]] }",
+            ),
+            &[
+                "[materials.floor] albedo",
+                "wavelengths must increase",
+                "400 nm",
+            ],
+        ),
+        (
+            "negative.toml",
+            scene.replace(
+                albedo,
+                "albedo = { samples = [[-400.0, 0.5], [700.0, 0.4]] }",
+            ),
+            &["[materials.floor] albedo", "-400 nm"],
+        ),
+        (
+            "sellmeier.toml",
+            scene.replace(
+                mirror,
+                "type = \"dielectric\"\nior = { sellmeier = [-0.3, 0.0, 0.0, 0.01, 0.01, 0.01] }",
+            ),
+            &["[materials.mirror] ior", "index of refraction"],
+        ),
+        (
+            "glass.toml",
+            scene.replace(mirror, "type = \"dielectric\"\nior = \"glass-unobtainium\""),
+            &["[materials.mirror] ior", "glass-unobtainium"],
+        ),
+        (
+            "metal.toml",
+            scene.replace(mirror, "type = \"conductor\"\nmetal = \"Mithril\""),
+            &["[materials.mirror] metal", "Mithril"],
+        ),
+        (
+            "illuminant.toml",
+            scene.replace(
+                albedo,
+                &format!("{albedo}\nemission = {{ illuminant = \"D50\" }}"),
+            ),
+            &["[materials.floor] emission", "D50"],
+        ),
+        (
+            "eta.toml",
+            scene.replace(
+                mirror,
+                "type = \"conductor\"\neta = { samples = [[400.0, 0.2], [400.0, 0.3]] }",
+            ),
+            &["[materials.mirror] eta", "400 nm appears twice"],
+        ),
+    ];
+    let mut keep: Vec<&str> = Vec::new();
+    for (name, text, needles) in &cases {
+        std::fs::write(dir.join(name), text).unwrap();
+        keep.push(name);
+        keep.sort_unstable();
+        let needles: Vec<&str> = [&[*name][..], needles].concat();
+        check_in(&dir, &["render", name], 2, &needles, &keep);
+    }
+    let xml = r#"<scene version="3.0.0">
+    <shape type="sphere"><bsdf type="conductor" id="gold"><string name="material" value="Mithril"/></bsdf></shape>
+    <shape type="rectangle"><emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>
+</scene>"#;
+    std::fs::write(dir.join("metal.xml"), xml).unwrap();
+    keep.push("metal.xml");
+    keep.sort_unstable();
+    check_in(
+        &dir,
+        &["render", "metal.xml"],
+        2,
+        &["metal.xml", "id=\"gold\"", "Mithril"],
+        &keep,
+    );
+    std::fs::write(
+        dir.join("metal.xml"),
+        xml.replace(
+            "<string name=\"material\" value=\"Mithril\"/>",
+            "<spectrum name=\"eta\" value=\"500:0.2, 400:0.3\"/>",
+        ),
+    )
+    .unwrap();
+    check_in(
+        &dir,
+        &["render", "metal.xml"],
+        2,
+        &[
+            "metal.xml",
+            "line 2",
+            "name=\"eta\"",
+            "wavelengths must increase",
+        ],
+        &keep,
+    );
+    let pbrt = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+        Material \"dielectric\" \"spectrum eta\" \"glass-XYZ\"\nShape \"sphere\"\n\
+        AttributeBegin\nAreaLightSource \"diffuse\" \"blackbody L\" [ -5 ]\n\
+        Shape \"sphere\" \"float radius\" 0.1\nAttributeEnd\n";
+    std::fs::write(dir.join("glass.pbrt"), pbrt).unwrap();
+    keep.push("glass.pbrt");
+    keep.sort_unstable();
+    check_in(
+        &dir,
+        &["render", "glass.pbrt"],
+        2,
+        &["glass.pbrt", "line 4", "glass-XYZ"],
+        &keep,
+    );
+    std::fs::write(
+        dir.join("glass.pbrt"),
+        pbrt.replace(
+            "\"spectrum eta\" \"glass-XYZ\"",
+            "\"spectrum eta\" \"glass-BK7\"",
+        ),
+    )
+    .unwrap();
+    check_in(
+        &dir,
+        &["render", "glass.pbrt"],
+        2,
+        &["glass.pbrt", "line 7", "blackbody L", "-5"],
+        &keep,
+    );
+}

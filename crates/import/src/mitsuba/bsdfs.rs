@@ -47,12 +47,15 @@ impl<'a> Importer<'a> {
             .map(str::to_owned)
             .unwrap_or_else(|| format!("{}@{}", node.attr("type").unwrap_or("bsdf"), node.line));
         let mut textures = MaterialTextures::default();
-        let kind = self.bsdf_kind(node, &name, &mut textures)?;
+        let mut spectra = scene::MaterialSpectra::default();
+        let kind = self.bsdf_kind(node, &name, &mut textures, &mut spectra)?;
         let textures = (!textures.is_empty()).then(|| std::sync::Arc::new(textures));
+        let spectra = (!spectra.is_empty()).then(|| std::sync::Arc::new(spectra));
         let c = ConvertedBsdf {
             name,
             kind,
             textures,
+            spectra,
         };
         self.bsdf_cache.insert(key, c.clone());
         Ok(c)
@@ -130,6 +133,7 @@ impl<'a> Importer<'a> {
         node: &'a Node,
         name: &str,
         textures: &mut MaterialTextures,
+        spectra: &mut scene::MaterialSpectra,
     ) -> Result<Option<MaterialKind>, LoadError> {
         let label = node.label();
         let ty = node.attr("type").unwrap_or("");
@@ -146,12 +150,14 @@ impl<'a> Importer<'a> {
                 let inner = self.inner_bsdf(node)?;
                 let inner = self.bsdf(inner)?;
                 *textures = inner.textures.as_deref().cloned().unwrap_or_default();
+                *spectra = inner.spectra.as_deref().cloned().unwrap_or_default();
                 return Ok(inner.kind);
             }
             "mask" => {
                 let inner = self.inner_bsdf(node)?;
                 let inner = self.bsdf(inner)?;
                 *textures = inner.textures.as_deref().cloned().unwrap_or_default();
+                *spectra = inner.spectra.as_deref().cloned().unwrap_or_default();
                 textures.alpha = Some(self.mask_opacity(node)?);
                 return Ok(inner.kind);
             }
@@ -165,23 +171,40 @@ impl<'a> Importer<'a> {
                 let inner = self.inner_bsdf(node)?;
                 let inner = self.bsdf(inner)?;
                 *textures = inner.textures.as_deref().cloned().unwrap_or_default();
+                *spectra = inner.spectra.as_deref().cloned().unwrap_or_default();
                 return Ok(inner.kind);
             }
             "conductor" | "roughconductor" => {
-                let reflectance = self.conductor_reflectance(node, &label)?;
                 let alpha = if ty == "roughconductor" {
                     self.alpha(node, &label)?
                 } else {
                     0.0
                 };
-                if alpha <= MIRROR_ALPHA {
-                    MaterialKind::Mirror(scene::Mirror { reflectance })
-                } else {
-                    MaterialKind::Glossy(scene::Glossy {
+                if !(alpha.is_finite() && alpha >= 0.0) {
+                    let p = prop(node, "alpha").unwrap_or(node);
+                    return Err(self.err(p, format!("alpha must be ≥ 0, got {alpha}")));
+                }
+                let roughness = if alpha <= MIRROR_ALPHA { 0.0 } else { alpha };
+                match self.conductor(node, spectra)? {
+                    // Mitsuba's `none`: a perfect mirror at every angle, tinted.
+                    ConductorIor::None(reflectance) if roughness == 0.0 => {
+                        MaterialKind::Mirror(scene::Mirror { reflectance })
+                    }
+                    ConductorIor::None(reflectance) => MaterialKind::Glossy(scene::Glossy {
                         reflectance,
-                        roughness: alpha,
+                        roughness,
                         diffuse: Rgb::ZERO,
-                    })
+                    }),
+                    ConductorIor::Complex {
+                        eta,
+                        k,
+                        specular_reflectance,
+                    } => MaterialKind::Conductor(scene::Conductor {
+                        eta,
+                        k,
+                        specular_reflectance,
+                        roughness,
+                    }),
                 }
             }
             "dielectric" | "thindielectric" | "roughdielectric" => {
@@ -280,35 +303,78 @@ impl<'a> Importer<'a> {
         }))
     }
 
-    /// Reflectance at normal incidence of a (rough) conductor from its `material` or `eta`/`k`,
-    /// times `specular_reflectance`.
-    pub(super) fn conductor_reflectance(
+    /// The complex index of refraction of a (rough) conductor from its `material` (Mitsuba's RGB
+    /// η and k of the name, and pbrt-v4's spectra where fppm has them) or `eta`/`k` (colours, or
+    /// spectra converted as Mitsuba's RGB variants convert them, kept in `spectra`), with its
+    /// `specular_reflectance`.
+    fn conductor(
         &mut self,
         node: &'a Node,
-        label: &str,
-    ) -> Result<Rgb, LoadError> {
+        spectra: &mut scene::MaterialSpectra,
+    ) -> Result<ConductorIor, LoadError> {
         let specular = self
             .colour(node, "specular_reflectance", SpectrumUse::Reflectance)?
             .unwrap_or(Rgb::ONE);
         let eta = self.colour(node, "eta", SpectrumUse::Ior)?;
         let k = self.colour(node, "k", SpectrumUse::Ior)?;
         let material = self.string(node, "material")?;
-        let r0 = match (eta, k, material) {
-            (Some(eta), k, _) => spectrum::conductor_reflectance(eta, k.unwrap_or(Rgb::ZERO)),
-            (None, _, None | Some("none")) => Rgb::ONE,
+        let (eta, k) = match (eta, k, material) {
+            (Some(eta), k, _) => {
+                let eta_spectrum = self.measured_spectrum(node, "eta")?;
+                let k_spectrum = self.measured_spectrum(node, "k")?;
+                if let Some(scene::spectral::Spectrum::PiecewiseLinear(eta_s)) = eta_spectrum {
+                    let k_s = match k_spectrum {
+                        Some(scene::spectral::Spectrum::PiecewiseLinear(k_s)) => k_s,
+                        // A constant or RGB k: held flat over η's wavelengths.
+                        _ => {
+                            let k0 = f64::from(k.unwrap_or(Rgb::ZERO).y);
+                            let values = vec![k0; eta_s.lambdas().len()];
+                            scene::spectral::PiecewiseLinear::new(eta_s.lambdas().to_vec(), values)
+                                .map_err(|e| {
+                                    self.err(node, format!("{}: k: {e}", node.label()))
+                                        .into_bad_spectrum()
+                                })?
+                        }
+                    };
+                    let p = prop(node, "eta").unwrap_or(node);
+                    spectra.conductor =
+                        Some(scene::spectral::Conductor::new(eta_s, k_s).map_err(|e| {
+                            self.err(p, format!("{}: eta: {e}", node.label()))
+                                .into_bad_spectrum()
+                        })?);
+                }
+                (eta, k.unwrap_or(Rgb::ZERO))
+            }
+            (None, _, None | Some("none")) => return Ok(ConductorIor::None(specular)),
             (None, _, Some(m)) => {
                 let (eta, k) = spectrum::metal(m).ok_or_else(|| {
                     let p = prop(node, "material").unwrap_or(node);
-                    self.err(p, format!("unknown conductor material \"{m}\""))
+                    self.err(
+                        p,
+                        format!("{}: unknown conductor material \"{m}\"", node.label()),
+                    )
+                    .into_bad_spectrum()
                 })?;
-                let r0 = spectrum::conductor_reflectance(eta, k);
-                self.builder.warn(format!(
-                    "{label}: conductor {m} uses its reflectance at normal incidence {} (no angular Fresnel)",
-                    super::super::fmt_vec(r0)
-                ));
-                r0
+                spectra.conductor = scene::spectral::Conductor::named(m);
+                (eta, k)
             }
         };
-        Ok(r0 * specular)
+        Ok(ConductorIor::Complex {
+            eta,
+            k,
+            specular_reflectance: specular,
+        })
     }
+}
+
+/// What a conductor's index of refraction is.
+enum ConductorIor {
+    /// Mitsuba's `none`: reflects everything, times this tint.
+    None(Rgb),
+    /// A complex index of refraction.
+    Complex {
+        eta: Rgb,
+        k: Rgb,
+        specular_reflectance: Rgb,
+    },
 }

@@ -129,6 +129,8 @@ struct ConvertedBsdf {
     kind: Option<MaterialKind>,
     /// Its image textures (diffuse colour, cut-out), if any.
     textures: Option<std::sync::Arc<scene::texture::MaterialTextures>>,
+    /// The spectra its colours and indices came from, if any.
+    spectra: Option<std::sync::Arc<scene::MaterialSpectra>>,
 }
 
 struct Importer<'a> {

@@ -148,6 +148,13 @@ impl<'a> Importer<'a> {
                 Rgb::splat(v as f32)
             }
             "spectrum" if p.attr("type").is_none() => self.spectrum(p, usage)?,
+            // A blackbody emits its exact colour (Mitsuba renders it only spectrally).
+            "spectrum" if p.attr("type") == Some("blackbody") && usage == SpectrumUse::Emission => {
+                match self.measured_spectrum(node, name)? {
+                    Some(s) => s.emission_srgb().max(glam::DVec3::ZERO).as_vec3(),
+                    None => return Err(self.err(p, "blackbody spectrum vanished")),
+                }
+            }
             "texture" | "spectrum" => self.texture_standin(p)?,
             other => {
                 return Err(self.err(
@@ -164,7 +171,21 @@ impl<'a> Importer<'a> {
 
     /// `<spectrum value="…">` (one value, or `wavelength:value` pairs) or `filename=".spd"`.
     pub(super) fn spectrum(&self, p: &Node, usage: SpectrumUse) -> Result<Rgb, LoadError> {
-        let (w, v) = if let Some(value) = p.attr("value") {
+        match self.spectrum_samples(p)? {
+            SpectrumValue::Constant(x) => Ok(spectrum::constant_spectrum_to_rgb(x, usage)),
+            SpectrumValue::Pairs(w, v) => {
+                spectrum::spectrum_to_rgb(&w, &v, usage).ok_or_else(|| {
+                    self.err(p, "wavelengths must increase and values be finite")
+                        .into_bad_spectrum()
+                })
+            }
+        }
+    }
+
+    /// The samples of a `<spectrum>` without a plugin type: one value, or `wavelength:value`
+    /// pairs, or an `.spd` file.
+    pub(super) fn spectrum_samples(&self, p: &Node) -> Result<SpectrumValue, LoadError> {
+        if let Some(value) = p.attr("value") {
             if !value.contains(':') {
                 let n = numbers(value).map_err(|m| self.err(p, m))?;
                 let [x] = n.as_slice() else {
@@ -173,7 +194,7 @@ impl<'a> Importer<'a> {
                         "a <spectrum> value is one number or wavelength:value pairs",
                     ));
                 };
-                return Ok(spectrum::constant_spectrum_to_rgb(*x, usage));
+                return Ok(SpectrumValue::Constant(*x));
             }
             let mut w = Vec::new();
             let mut v = Vec::new();
@@ -192,15 +213,57 @@ impl<'a> Importer<'a> {
                         .map_err(|_| self.err(p, format!("\"{b}\" is not a number")))?,
                 );
             }
-            (w, v)
+            Ok(SpectrumValue::Pairs(w, v))
         } else if let Some(file) = p.attr("filename") {
             let path = self.doc.resolve(p, file);
-            read_spd(&path).map_err(|m| self.err(p, m))?
+            let (w, v) = read_spd(&path).map_err(|m| self.err(p, m))?;
+            Ok(SpectrumValue::Pairs(w, v))
         } else {
-            return Err(self.err(p, "<spectrum> needs a value or a filename"));
+            Err(self.err(p, "<spectrum> needs a value or a filename"))
+        }
+    }
+
+    /// The spectrum of property `name` when it is one: measured `wavelength:value` pairs or an
+    /// `.spd` file (validated: positive, increasing wavelengths, values ≥ 0), or a `blackbody`
+    /// (Mitsuba's: Planck's radiance in W/(m² sr nm)). `None` for a colour or a constant.
+    pub(super) fn measured_spectrum(
+        &self,
+        node: &'a Node,
+        name: &str,
+    ) -> Result<Option<scene::spectral::Spectrum>, LoadError> {
+        use scene::spectral::{Blackbody, PiecewiseLinear, Spectrum};
+        let Some(p) = prop(node, name) else {
+            return Ok(None);
         };
-        spectrum::spectrum_to_rgb(&w, &v, usage)
-            .ok_or_else(|| self.err(p, "wavelengths must increase and values be finite"))
+        let p = self.deref(p)?;
+        if p.tag != "spectrum" {
+            return Ok(None);
+        }
+        match p.attr("type") {
+            None => match self.spectrum_samples(p)? {
+                SpectrumValue::Constant(_) => Ok(None),
+                SpectrumValue::Pairs(w, v) => PiecewiseLinear::new(w, v)
+                    .map(|s| Some(Spectrum::PiecewiseLinear(s)))
+                    .map_err(|e| {
+                        self.err(p, format!("{}: spectrum \"{name}\": {e}", node.label()))
+                            .into_bad_spectrum()
+                    }),
+            },
+            Some("blackbody") => {
+                let t = self
+                    .float(p, "temperature")?
+                    .ok_or_else(|| self.err(p, "a blackbody needs a temperature"))?;
+                let b = Blackbody::new(t).map_err(|e| {
+                    self.err(p, format!("{}: spectrum \"{name}\": {e}", node.label()))
+                        .into_bad_spectrum()
+                })?;
+                Ok(Some(Spectrum::Scaled(
+                    b.peak_radiance() * 1e-9,
+                    Box::new(Spectrum::Blackbody(b)),
+                )))
+            }
+            Some(_) => Ok(None),
+        }
     }
 
     /// The constant colour that stands in for a texture, with a warning.
@@ -244,4 +307,10 @@ impl<'a> Importer<'a> {
             }
         }
     }
+}
+
+/// A `<spectrum>`'s samples: one value, or wavelength and value lists.
+pub(super) enum SpectrumValue {
+    Constant(f64),
+    Pairs(Vec<f64>, Vec<f64>),
 }

@@ -75,6 +75,7 @@ impl<'a> Importer<'a> {
                     albedo: Rgb::splat(DEFAULT_REFLECTANCE),
                 })),
                 textures: None,
+                spectra: None,
             },
         };
         let (interior, exterior) = self.shape_media(node)?;
@@ -88,11 +89,13 @@ impl<'a> Importer<'a> {
         };
         let first_triangle = self.builder.triangles.len() as u32;
         let emitter = self.shape_emitter(node)?;
+        let mut spectra = bsdf.spectra.as_deref().cloned().unwrap_or_default();
         let (name, emission) = match emitter {
             Some(e) => {
                 let radiance = self
                     .colour(e, "radiance", SpectrumUse::Emission)?
                     .ok_or_else(|| self.err(e, "an area emitter needs a radiance"))?;
+                spectra.emission = self.measured_spectrum(e, "radiance")?;
                 let id = e
                     .attr("id")
                     .map_or_else(|| format!("shape{index}"), str::to_owned);
@@ -105,6 +108,7 @@ impl<'a> Importer<'a> {
             kind,
             emission,
             textures: bsdf.textures.clone(),
+            spectra: (!spectra.is_empty()).then(|| std::sync::Arc::new(spectra)),
         });
         let to_world = parent * self.transform(node, "to_world")?;
         let m = to_world.as_mat4();

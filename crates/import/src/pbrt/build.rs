@@ -52,6 +52,7 @@ impl Parser {
         type Converted = Option<(
             MaterialKind,
             Option<std::sync::Arc<scene::texture::MaterialTextures>>,
+            scene::MaterialSpectra,
         )>;
         let mut material_cache: HashMap<String, Converted> = HashMap::new();
         let shapes = std::mem::take(&mut self.shapes);
@@ -80,21 +81,24 @@ impl Parser {
                         Some(def) => {
                             let label = format!("Material \"{}\" ({key})", def.kind);
                             let mut color = None;
-                            self.material(def, &label, &mut color)?.map(|kind| {
-                                let textures = color.map(|c| {
-                                    std::sync::Arc::new(scene::texture::MaterialTextures {
-                                        color: Some(c),
-                                        ..Default::default()
-                                    })
-                                });
-                                (kind, textures)
-                            })
+                            let mut spectra = scene::MaterialSpectra::default();
+                            self.material(def, &label, &mut color, &mut spectra)?
+                                .map(|kind| {
+                                    let textures = color.map(|c| {
+                                        std::sync::Arc::new(scene::texture::MaterialTextures {
+                                            color: Some(c),
+                                            ..Default::default()
+                                        })
+                                    });
+                                    (kind, textures, spectra)
+                                })
                         }
                         None => Some((
                             MaterialKind::Diffuse(scene::Diffuse {
                                 albedo: Rgb::splat(0.5),
                             }),
                             None,
+                            scene::MaterialSpectra::default(),
                         )),
                     };
                     material_cache.insert(cache_key, k.clone());
@@ -104,9 +108,15 @@ impl Parser {
             let media = self.shape_media(&shape.state)?;
             // `interface` is invisible, unless the shape bounds media: then it is their
             // boundary.
-            let Some((kind, textures)) = converted
-                .or_else(|| media.map(|_| (MaterialKind::Interface(scene::Interface), None)))
-            else {
+            let Some((kind, textures, mut spectra)) = converted.or_else(|| {
+                media.map(|_| {
+                    (
+                        MaterialKind::Interface(scene::Interface),
+                        None,
+                        scene::MaterialSpectra::default(),
+                    )
+                })
+            }) else {
                 continue;
             };
             let emission = match &shape.state.area {
@@ -116,6 +126,11 @@ impl Parser {
                         .colour(&p, "L", SpectrumUse::Emission)?
                         .unwrap_or(Rgb::ONE);
                     let scale = self.float(&p, "scale")?.unwrap_or(1.0) as f32;
+                    if let Some(l) = p.get("L") {
+                        spectra.emission = self.blackbody(l)?.map(|b| {
+                            scene::spectral::Spectrum::Scaled(f64::from(scale), Box::new(b))
+                        });
+                    }
                     if self.boolean(&p, "twosided")? == Some(true) {
                         builder.warn(format!(
                             "AreaLightSource at {}:{}: two-sided emission is rendered one-sided (front faces)",
@@ -142,6 +157,7 @@ impl Parser {
                 kind,
                 emission,
                 textures,
+                spectra: (!spectra.is_empty()).then(|| std::sync::Arc::new(spectra)),
             });
             let to_world = fix * shape.state.ctm;
             let (triangles, spheres, cylinders) = (

@@ -145,6 +145,7 @@ impl Parser {
         def: &MaterialDef,
         label: &str,
         color: &mut Option<scene::texture::TextureRef>,
+        spectra: &mut scene::MaterialSpectra,
     ) -> Result<Option<MaterialKind>, LoadError> {
         let p = def.params.clone();
         let refl = SpectrumUse::Reflectance;
@@ -163,62 +164,42 @@ impl Parser {
                 } else {
                     ""
                 };
-                let r0 = match self.colour(&p, &format!("{prefix}reflectance"), refl)? {
-                    Some(r) => r,
-                    None if self.spectral(&p, &format!("{prefix}eta"))?.is_some()
-                        && self.spectral(&p, &format!("{prefix}k"))?.is_some() =>
-                    {
-                        // Both measured spectra: the reflectance is computed per wavelength.
-                        let (Some(eta), Some(k)) = (
-                            self.spectral(&p, &format!("{prefix}eta"))?,
-                            self.spectral(&p, &format!("{prefix}k"))?,
-                        ) else {
-                            return Err(self.err(def.loc, "conductor spectra vanished"));
-                        };
-                        spectrum::conductor_reflectance_spectral((&eta.0, &eta.1), (&k.0, &k.1))
-                            .ok_or_else(|| {
-                                self.err(def.loc, format!("{label}: malformed eta or k spectrum"))
-                            })?
+                let (eta, k) = match self.colour(&p, &format!("{prefix}reflectance"), refl)? {
+                    // pbrt-v4's reflectance form: η = 1 and k = 2√r/√(1 − r), whose Fresnel
+                    // reflectance at normal incidence is r.
+                    Some(r) => {
+                        let r = r.clamp(Rgb::ZERO, Rgb::splat(0.9999));
+                        (Rgb::ONE, 2.0 * r.powf(0.5) / (Rgb::ONE - r).powf(0.5))
                     }
-                    None => {
-                        let eta = self.colour(&p, &format!("{prefix}eta"), SpectrumUse::Ior)?;
-                        let k = self.colour(&p, &format!("{prefix}k"), SpectrumUse::Ior)?;
-                        let (eta, k) = match (eta, k) {
-                            (Some(e), Some(k)) => (e, k),
-                            (e, k) => {
-                                let (ce, ck) =
-                                    spectrum::metal("Cu").unwrap_or((Rgb::ONE, Rgb::ZERO));
-                                (e.unwrap_or(ce), k.unwrap_or(ck))
-                            }
-                        };
-                        spectrum::conductor_reflectance(eta, k)
-                    }
+                    None => self.conductor_ior(&p, prefix, def.loc, spectra)?,
                 };
-                let alpha = self.alpha(&p, &format!("{prefix}roughness"), remap)?;
-                self.warn(format!(
-                    "{label}: the conductor uses its reflectance at normal incidence {} (no angular Fresnel)",
-                    super::super::fmt_vec(r0)
-                ));
+                let roughness = self.alpha(&p, &format!("{prefix}roughness"), remap)?;
                 if def.kind == "coatedconductor" {
                     self.warn(format!(
                         "{label}: the dielectric coating of a coatedconductor is ignored"
                     ));
                 }
-                if alpha <= MIRROR_ALPHA {
-                    MaterialKind::Mirror(scene::Mirror { reflectance: r0 })
-                } else {
-                    MaterialKind::Glossy(scene::Glossy {
-                        reflectance: r0,
-                        roughness: alpha,
-                        diffuse: Rgb::ZERO,
-                    })
-                }
+                MaterialKind::Conductor(scene::Conductor {
+                    eta,
+                    k,
+                    specular_reflectance: Rgb::ONE,
+                    roughness: if roughness <= MIRROR_ALPHA {
+                        0.0
+                    } else {
+                        roughness
+                    },
+                })
             }
             "dielectric" | "thindielectric" => {
                 let eta = match p.get("eta") {
-                    Some(e) if e.ty == "spectrum" => self
-                        .colour(&p, "eta", SpectrumUse::Ior)?
-                        .map_or(1.5, |c| c.y),
+                    Some(e) if e.ty == "spectrum" => {
+                        let law = self.ior_law(&p, "eta")?;
+                        let eta = law.eval(scene::REPRESENTATIVE_WAVELENGTH) as f32;
+                        if law.is_dispersive() {
+                            spectra.ior = Some(law);
+                        }
+                        eta
+                    }
                     Some(_) => self.float(&p, "eta")?.unwrap_or(1.5) as f32,
                     None => 1.5,
                 };
@@ -277,5 +258,105 @@ impl Parser {
                 })
             }
         }))
+    }
+}
+
+impl Parser {
+    /// A conductor's RGB η and k from `eta` and `k` (pbrt-v4's default: copper), and its
+    /// spectral ones in `spectra` where both are spectra: named metals get the RGB values
+    /// Mitsuba 3 loads for them, measured spectra the RGB of Mitsuba's conversion.
+    fn conductor_ior(
+        &mut self,
+        p: &Params,
+        prefix: &str,
+        loc: Loc,
+        spectra: &mut scene::MaterialSpectra,
+    ) -> Result<(Rgb, Rgb), LoadError> {
+        let (eta_name, k_name) = (format!("{prefix}eta"), format!("{prefix}k"));
+        let eta = self.colour(p, &eta_name, SpectrumUse::Ior)?;
+        let k = self.colour(p, &k_name, SpectrumUse::Ior)?;
+        let eta_s = self.measured_or_named(p, &eta_name)?;
+        let k_s = self.measured_or_named(p, &k_name)?;
+        let (ce, ck) = spectrum::metal("Cu").unwrap_or((Rgb::ONE, Rgb::ZERO));
+        let (eta_s, k_s) = match (eta.is_none() && k.is_none(), eta_s, k_s) {
+            (true, ..) => (
+                scene::spectral::Conductor::named_spectrum("metal-Cu-eta"),
+                scene::spectral::Conductor::named_spectrum("metal-Cu-k"),
+            ),
+            (false, e, k) => (e, k),
+        };
+        if let (Some(e), Some(k)) = (eta_s, k_s) {
+            let loc = p.get(&eta_name).map_or(loc, Self::loc_of_param);
+            spectra.conductor = Some(scene::spectral::Conductor::new(e, k).map_err(|e| {
+                self.err(loc, format!("parameter \"{eta_name}\": {e}"))
+                    .into_bad_spectrum()
+            })?);
+        }
+        Ok((eta.unwrap_or(ce), k.unwrap_or(ck)))
+    }
+
+    /// A `spectrum` parameter as a validated measured spectrum: λ/value pairs, an `.spd` file or
+    /// a named metal's η or k; `None` for other forms.
+    fn measured_or_named(
+        &self,
+        p: &Params,
+        name: &str,
+    ) -> Result<Option<scene::spectral::PiecewiseLinear>, LoadError> {
+        let Some(param) = p.get(name) else {
+            return Ok(None);
+        };
+        let loc = Self::loc_of_param(param);
+        if let [Value::Str(s)] = param.values.as_slice()
+            && param.ty == "spectrum"
+            && s.starts_with("metal-")
+        {
+            return Ok(scene::spectral::Conductor::named_spectrum(s));
+        }
+        match self.spectral(p, name)? {
+            Some((w, v)) => scene::spectral::PiecewiseLinear::new(w, v)
+                .map(Some)
+                .map_err(|e| {
+                    self.err(loc, format!("parameter \"spectrum {name}\": {e}"))
+                        .into_bad_spectrum()
+                }),
+            None => Ok(None),
+        }
+    }
+
+    /// A dielectric's `spectrum eta` as a dispersion law: a named glass, λ/value pairs or an
+    /// `.spd` file (at least 1 over 360–830 nm).
+    fn ior_law(&self, p: &Params, name: &str) -> Result<scene::spectral::Ior, LoadError> {
+        use scene::spectral::Ior;
+        let Some(param) = p.get(name) else {
+            return Ok(Ior::Constant(1.5));
+        };
+        let loc = Self::loc_of_param(param);
+        if let [Value::Str(s)] = param.values.as_slice()
+            && let Some(ior) = Ior::named(s)
+        {
+            return Ok(ior);
+        }
+        if let [Value::Str(s)] = param.values.as_slice()
+            && (s.starts_with("glass-") || s.starts_with("metal-"))
+        {
+            return Err(self.err(
+                loc,
+                format!(
+                    "parameter \"spectrum {name}\": unknown named spectrum \"{s}\" (glasses: {})",
+                    Ior::NAMES.join(", ")
+                ),
+            )
+            .into_bad_spectrum());
+        }
+        let measured = self.measured_or_named(p, name)?.ok_or_else(|| {
+            self.err(
+                loc,
+                format!("parameter \"spectrum {name}\" must be a glass or λ/value pairs"),
+            )
+        })?;
+        Ior::tabulated(measured).map_err(|e| {
+            self.err(loc, format!("parameter \"spectrum {name}\": {e}"))
+                .into_bad_spectrum()
+        })
     }
 }

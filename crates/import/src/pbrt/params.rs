@@ -4,16 +4,6 @@ use super::*;
 
 /// pbrt-v4's named glass spectra, as their refractive index at the sodium d line (587.6 nm);
 /// dispersion is dropped.
-const NAMED_GLASS: &[(&str, f32)] = &[
-    ("glass-BK7", 1.5168),
-    ("glass-BAF10", 1.6700),
-    ("glass-FK51A", 1.4866),
-    ("glass-LASF9", 1.8503),
-    ("glass-F5", 1.6034),
-    ("glass-F10", 1.6200),
-    ("glass-F11", 1.6210),
-];
-
 impl Parser {
     pub(super) fn loc_of_param(p: &Param) -> Loc {
         Loc {
@@ -249,10 +239,12 @@ impl Parser {
                         .ok_or_else(|| self.err(loc, "wavelengths must increase"))?
                 }
             },
-            "blackbody" => {
-                self.warn(format!("parameter \"blackbody {name}\": a blackbody stands in as white of the same brightness"));
-                Rgb::ONE
-            }
+            // pbrt-v4 divides every light's scale by its spectrum's luminance: a blackbody emits
+            // its colour at luminance 1 (times the light's scale).
+            "blackbody" => match self.blackbody(&p)? {
+                Some(b) => b.emission_srgb().max(glam::DVec3::ZERO).as_vec3(),
+                None => Rgb::ONE,
+            },
             "texture" => {
                 let [Value::Str(tex)] = p.values.as_slice() else {
                     return Err(self.err(
@@ -270,6 +262,42 @@ impl Parser {
             return Err(self.err(loc, format!("parameter \"{name}\" must be finite")));
         }
         Ok(Some(rgb))
+    }
+
+    /// A `blackbody` parameter's spectrum at luminance 1 (pbrt-v4's lights normalize so); an
+    /// error for a bad temperature.
+    pub(super) fn blackbody(
+        &self,
+        p: &Param,
+    ) -> Result<Option<scene::spectral::Spectrum>, LoadError> {
+        use scene::spectral::{Blackbody, Spectrum};
+        if p.ty != "blackbody" {
+            return Ok(None);
+        }
+        let loc = Self::loc_of_param(p);
+        // pbrt-v4 gives the temperature alone; pbrt-v3 a temperature and a scale.
+        let t = match self.nums(p)?.as_slice() {
+            [t] | [t, _] => *t,
+            v => {
+                return Err(self.err(
+                    loc,
+                    format!(
+                        "parameter \"blackbody {}\" expects a temperature, got {} values",
+                        p.name,
+                        v.len()
+                    ),
+                ));
+            }
+        };
+        let b = Blackbody::new(t).map_err(|e| {
+            self.err(loc, format!("parameter \"blackbody {}\": {e}", p.name))
+                .into_bad_spectrum()
+        })?;
+        let y = Spectrum::Blackbody(b).to_xyz().y;
+        Ok(Some(Spectrum::Scaled(
+            1.0 / y,
+            Box::new(Spectrum::Blackbody(b)),
+        )))
     }
 
     /// The samples of a `spectrum` parameter given as λ/value pairs or a `.spd` file; `None`
@@ -316,23 +344,26 @@ impl Parser {
         usage: SpectrumUse,
     ) -> Result<Rgb, LoadError> {
         if let Some(rest) = s.strip_prefix("metal-") {
-            let (metal, part) = rest
-                .rsplit_once('-')
-                .ok_or_else(|| self.err(loc, format!("unknown named spectrum \"{s}\"")))?;
+            let (metal, part) = rest.rsplit_once('-').ok_or_else(|| {
+                self.err(loc, format!("unknown named spectrum \"{s}\""))
+                    .into_bad_spectrum()
+            })?;
             let (eta, k) = spectrum::metal(metal).ok_or_else(|| {
                 self.err(loc, format!("named spectrum \"{s}\" is not known to fppm"))
+                    .into_bad_spectrum()
             })?;
             return match part {
                 "eta" => Ok(eta),
                 "k" => Ok(k),
-                _ => Err(self.err(loc, format!("unknown named spectrum \"{s}\""))),
+                _ => Err(self
+                    .err(loc, format!("unknown named spectrum \"{s}\""))
+                    .into_bad_spectrum()),
             };
         }
-        if let Some((_, ior)) = NAMED_GLASS.iter().find(|(n, _)| *n == s) {
-            self.warn(format!(
-                "spectrum \"{s}\": dispersion is dropped; ior {ior} (sodium d line) is used"
-            ));
-            return Ok(Rgb::splat(*ior));
+        if let Some(ior) = scene::spectral::Ior::named(s) {
+            // The RGB transport's index of a dispersive glass (`docs/spectral.md`); a dielectric
+            // keeps the whole law in its spectra.
+            return Ok(Rgb::splat(ior.eval(scene::REPRESENTATIVE_WAVELENGTH) as f32));
         }
         if s.starts_with("stdillum-") || s.starts_with("canon_") || s.starts_with("nikon_") {
             self.warn(format!("spectrum \"{s}\" stands in as white"));

@@ -79,7 +79,8 @@ pub(super) enum MaterialToml {
         cutout: Option<String>,
     },
     Dielectric {
-        ior: f32,
+        /// A number, or (extension) a named glass or a dispersion law.
+        ior: IorToml,
         /// Extension: GGX α of a rough dielectric (`docs/scene-format-extensions.md`).
         roughness: Option<f32>,
         emission: Option<ColorToml>,
@@ -92,6 +93,51 @@ pub(super) enum MaterialToml {
     },
     /// Extension: no scattering, a boundary of media.
     Interface {},
+    /// Extension: a conductor with exact Fresnel (`docs/scene-format-extensions.md`).
+    Conductor {
+        /// A named metal (`Au`, `metal-Au`, or one of Mitsuba's RGB conductors).
+        metal: Option<String>,
+        /// η as a colour or a spectrum (with `k`, instead of `metal`).
+        eta: Option<ColorToml>,
+        /// k as a colour or a spectrum.
+        k: Option<ColorToml>,
+        /// A tint multiplying the Fresnel reflectance (1 by default).
+        specular_reflectance: Option<ColorToml>,
+        /// GGX α; absent or 0 is the smooth conductor.
+        roughness: Option<f32>,
+        emission: Option<ColorToml>,
+        cutout: Option<String>,
+    },
+}
+
+/// An index of refraction (extension beyond a number): a named glass (`"glass-BK7"`), or
+/// `{ sellmeier = [B1, B2, B3, C1, C2, C3] }` (C in µm²), `{ cauchy = [A, B] }` or
+/// `[A, B, C]` (B in µm², C in µm⁴), `{ samples = [[nm, n], …] }`.
+#[derive(Deserialize)]
+#[serde(untagged)]
+pub(super) enum IorToml {
+    Number(f32),
+    Named(String),
+    Law(IorLawToml),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct IorLawToml {
+    pub(super) sellmeier: Option<Vec<f64>>,
+    pub(super) cauchy: Option<Vec<f64>>,
+    pub(super) samples: Option<Vec<[f64; 2]>>,
+}
+
+/// The spectrum forms of a colour (extension): exactly one of `blackbody` (K), `illuminant`
+/// (`"D65"`, `"A"`), `samples` ([[nm, value], …]) or `rgb`, with an optional `scale`.
+#[derive(Default)]
+pub(super) struct SpectrumToml {
+    pub(super) blackbody: Option<f64>,
+    pub(super) illuminant: Option<String>,
+    pub(super) samples: Option<Vec<[f64; 2]>>,
+    pub(super) rgb: Option<[f32; 3]>,
+    pub(super) scale: Option<f64>,
 }
 
 /// A colour: `[r, g, b]`, or (extension, `docs/scene-format-extensions.md`) an image texture
@@ -102,13 +148,27 @@ pub(super) enum ColorToml {
         texture: String,
         scale: Option<[f32; 3]>,
     },
+    /// Extension: a spectrum (`docs/scene-format-extensions.md`, "Spectra").
+    Spectrum(Box<SpectrumToml>),
+}
+
+/// A colour's table form: a texture or a spectrum, told apart by their keys.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ColourTableToml {
+    texture: Option<String>,
+    scale: Option<ScaleToml>,
+    blackbody: Option<f64>,
+    illuminant: Option<String>,
+    samples: Option<Vec<[f64; 2]>>,
+    rgb: Option<[f32; 3]>,
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct TextureToml {
-    texture: String,
-    scale: Option<[f32; 3]>,
+#[serde(untagged)]
+enum ScaleToml {
+    Number(f64),
+    Rgb([f32; 3]),
 }
 
 impl<'de> Deserialize<'de> for ColorToml {
@@ -130,12 +190,57 @@ impl<'de> Deserialize<'de> for ColorToml {
                 self,
                 map: A,
             ) -> Result<ColorToml, A::Error> {
-                let t =
-                    TextureToml::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
-                Ok(ColorToml::Texture {
-                    texture: t.texture,
-                    scale: t.scale,
-                })
+                use serde::de::Error;
+                let t = ColourTableToml::deserialize(
+                    serde::de::value::MapAccessDeserializer::new(map),
+                )?;
+                if let Some(texture) = t.texture {
+                    if t.blackbody.is_some()
+                        || t.illuminant.is_some()
+                        || t.samples.is_some()
+                        || t.rgb.is_some()
+                    {
+                        return Err(A::Error::custom(
+                            "a texture cannot be given with a spectrum",
+                        ));
+                    }
+                    let scale = match t.scale {
+                        None => None,
+                        Some(ScaleToml::Rgb(s)) => Some(s),
+                        Some(ScaleToml::Number(_)) => {
+                            return Err(A::Error::custom(
+                                "a texture's scale is a colour [r, g, b]",
+                            ));
+                        }
+                    };
+                    return Ok(ColorToml::Texture { texture, scale });
+                }
+                let scale = match t.scale {
+                    None => None,
+                    Some(ScaleToml::Number(s)) => Some(s),
+                    Some(ScaleToml::Rgb(_)) => {
+                        return Err(A::Error::custom("a spectrum's scale is a number"));
+                    }
+                };
+                let given = [
+                    t.blackbody.is_some(),
+                    t.illuminant.is_some(),
+                    t.samples.is_some(),
+                    t.rgb.is_some(),
+                ];
+                if given.iter().filter(|&&g| g).count() != 1 {
+                    return Err(A::Error::custom(
+                        "a colour table needs `texture` or exactly one of `blackbody`, \
+                         `illuminant`, `samples`, `rgb`",
+                    ));
+                }
+                Ok(ColorToml::Spectrum(Box::new(SpectrumToml {
+                    blackbody: t.blackbody,
+                    illuminant: t.illuminant,
+                    samples: t.samples,
+                    rgb: t.rgb,
+                    scale,
+                })))
             }
         }
         d.deserialize_any(Visitor)

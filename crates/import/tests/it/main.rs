@@ -15,6 +15,7 @@ mod pbrt;
 mod pbrt_media;
 mod rough_dielectric;
 mod shared_scenes;
+mod spectra;
 mod toml_scene;
 
 use std::path::{Path, PathBuf};

@@ -479,8 +479,8 @@ fn fov_axis_matches_mitsuba() {
 
 /// A conductor's η and k given as `<spectrum filename=".spd">` become RGB as Mitsuba 3.9.1
 /// loads them (`scalar_rgb`, `mi.traverse`: η (0.0798705, 0.404652, 1.55897), k (3.38675,
-/// 2.50071, 1.76891) for the shared gold files); the mirror's reflectance is the Fresnel
-/// reflectance at normal incidence of those.
+/// 2.50071, 1.76891) for the shared gold files), and the spectra are kept for spectral
+/// transport.
 #[test]
 fn spectral_eta_k_match_mitsuba() {
     let spds = shared_scenes().join("pbrt-v4/killeroos/spds");
@@ -498,14 +498,22 @@ fn spectral_eta_k_match_mitsuba() {
     let scene = load(&path).unwrap();
     let eta = glam::Vec3::new(0.079_870_5, 0.404_652, 1.558_97);
     let k = glam::Vec3::new(3.386_75, 2.500_71, 1.768_91);
-    let expected = ((eta - 1.0) * (eta - 1.0) + k * k) / ((eta + 1.0) * (eta + 1.0) + k * k);
-    let scene::MaterialKind::Mirror(scene::Mirror { reflectance }) = scene.materials[0].kind else {
+    let scene::MaterialKind::Conductor(c) = scene.materials[0].kind else {
         panic!("{:?}", scene.materials[0]);
     };
     assert!(
-        (reflectance - expected).abs().max_element() < 1e-4,
-        "{reflectance} vs {expected}"
+        (c.eta - eta).abs().max_element() < 1e-4 && (c.k - k).abs().max_element() < 1e-4,
+        "{c:?}"
     );
+    assert_eq!(
+        (c.roughness, c.specular_reflectance),
+        (0.0, glam::Vec3::ONE)
+    );
+    let spectra = scene.materials[0].spectra.as_deref().expect("spectra");
+    let gold = spectra.conductor.as_ref().expect("conductor spectra");
+    // Au.eta.spd at 600 nm: linear between its samples, as the file gives them.
+    let (n, _) = gold.eval(600.0);
+    assert!(n > 0.1 && n < 0.5, "{n}");
 }
 
 /// `shapegroup` and `instance`: a group of one unit rectangle (its corners at x, y = ±1 in

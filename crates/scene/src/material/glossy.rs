@@ -1,4 +1,5 @@
-//! The rough conductor: GGX (Trowbridge–Reitz) microfacets with Smith shadowing, over an optional
+//! The glossy model: GGX (Trowbridge–Reitz) microfacets with Smith shadowing and Schlick's Fresnel of a
+//! given normal-incidence colour (the exact Fresnel of a metal is `conductor.rs`), over an optional
 //! Lambertian base.
 //!
 //! The model is coupled so that it never reflects more than it receives (the MTL `Kd` + `Ks` it
@@ -176,7 +177,7 @@ fn ggx_eval(wo: Vec3, wi: Vec3, alpha: f32, reflectance: Rgb) -> Rgb {
 }
 
 /// Density of [`ggx_sample_visible_normal`] followed by reflection: D(ωm)·G₁(ωₒ)/(4 cos θₒ).
-fn ggx_pdf(wo: Vec3, wi: Vec3, alpha: f32) -> f32 {
+pub(super) fn ggx_pdf(wo: Vec3, wi: Vec3, alpha: f32) -> f32 {
     let wm = wo + wi;
     if wm == Vec3::ZERO || wo.z <= 0.0 || wi.z <= 0.0 {
         return 0.0;

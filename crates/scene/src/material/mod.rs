@@ -4,6 +4,8 @@
 //! - `mirror.rs`: a perfect specular conductor of constant reflectance;
 //! - `dielectric.rs`: a smooth dielectric with exact unpolarised Fresnel;
 //! - `glossy.rs`: a GGX conductor over an optional Lambertian base;
+//! - `conductor.rs`: a smooth or GGX conductor with exact Fresnel for a complex index of
+//!   refraction;
 //! - `rough_dielectric.rs`: GGX microfacet reflection and refraction with exact Fresnel;
 //! - `interface.rs`: no scattering at all, a boundary of participating media.
 //!
@@ -26,6 +28,9 @@
 //! from the light paths' adjoint only across a refraction of finite density (the rough
 //! dielectric), by the factor η′² that [`TransportMode`] describes.
 
+mod conductor;
+#[cfg(test)]
+mod conductor_tests;
 mod dielectric;
 mod diffuse;
 mod glossy;
@@ -41,6 +46,7 @@ mod tests;
 
 use glam::{Vec2, Vec3};
 
+pub use self::conductor::Conductor;
 pub use self::dielectric::{Dielectric, fresnel_dielectric};
 pub use self::diffuse::Diffuse;
 pub use self::glossy::Glossy;
@@ -137,6 +143,8 @@ pub enum MaterialKind {
     /// No scattering: a boundary of participating media that light crosses unchanged (an
     /// extension, `docs/media.md`). Only integrators that handle media render it.
     Interface(Interface),
+    /// A conductor with exact Fresnel for its complex index of refraction, smooth or GGX.
+    Conductor(Conductor),
 }
 
 /// Evaluates `$body` with `$model` bound to the model inside `$kind`, whichever it is: the one
@@ -150,6 +158,7 @@ macro_rules! with_model {
             MaterialKind::Glossy($model) => $body,
             MaterialKind::RoughDielectric($model) => $body,
             MaterialKind::Interface($model) => $body,
+            MaterialKind::Conductor($model) => $body,
         }
     };
 }
@@ -297,7 +306,7 @@ impl MaterialKind {
     }
 
     /// The model's name in scene files and summaries: `diffuse`, `mirror`, `dielectric`,
-    /// `glossy`, `interface`.
+    /// `glossy`, `roughdielectric`, `interface`, `conductor`.
     #[must_use]
     #[inline]
     pub fn name(&self) -> &'static str {

@@ -54,7 +54,19 @@ fn finite_models() -> Vec<MaterialKind> {
             ior: 1.33,
             roughness: 0.7,
         }),
+        gold(0.2),
+        gold(0.6),
     ]
+}
+
+/// A conductor with Mitsuba's RGB η and k of gold and GGX roughness `roughness` (zero: smooth).
+fn gold(roughness: f32) -> MaterialKind {
+    MaterialKind::Conductor(crate::Conductor {
+        eta: Rgb::new(0.143_119, 0.374_957, 1.442_48),
+        k: Rgb::new(3.983_16, 2.385_72, 1.603_22),
+        specular_reflectance: Rgb::new(1.0, 0.9, 0.8),
+        roughness,
+    })
 }
 
 /// The models with delta lobes, each on both faces (a dielectric's inside is behind its front).
@@ -62,7 +74,7 @@ fn delta_models() -> Vec<(MaterialKind, bool)> {
     let mirror = MaterialKind::Mirror(crate::Mirror {
         reflectance: Rgb::new(0.9, 0.8, 0.7),
     });
-    let mut models = vec![(mirror, true)];
+    let mut models = vec![(mirror, true), (gold(0.0), true), (gold(5e-4), false)];
     for ior in [1.5, 2.4] {
         for front_face in [true, false] {
             models.push((

@@ -598,6 +598,7 @@ fn scene_rejects_bad_cylinders() {
         }),
         emission: Vec3::ZERO,
         textures: None,
+        spectra: None,
     };
     for bad in [
         Cylinder {

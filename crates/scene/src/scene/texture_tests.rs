@@ -303,6 +303,7 @@ fn metallic_roughness_quad() -> Scene {
             kind: MaterialKind::Diffuse(crate::Diffuse { albedo: base }),
             emission: Vec3::ZERO,
             textures: None,
+            spectra: None,
         },
         MaterialTextures {
             metallic_roughness: Some(crate::texture::MetallicRoughness {

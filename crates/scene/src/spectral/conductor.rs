@@ -9,7 +9,7 @@ use super::metals::{
     TIO2_ETA, TIO2_K,
 };
 use super::sampled::{SampledSpectrum, SampledWavelengths};
-use super::spectra::PiecewiseLinear;
+use super::spectra::{PiecewiseLinear, Spectrum};
 
 /// The unpolarized Fresnel reflectance of a smooth interface into a medium of complex index
 /// of refraction `eta` + i `k` (relative to the side the light comes from), at `cos_theta` of
@@ -84,6 +84,29 @@ impl Conductor {
         }
         let metal = name.strip_suffix("-k")?;
         Self::named(metal).map(|c| c.k)
+    }
+
+    /// η as a measured spectrum.
+    pub fn eta(&self) -> &PiecewiseLinear {
+        &self.eta
+    }
+
+    /// k as a measured spectrum.
+    pub fn k(&self) -> &PiecewiseLinear {
+        &self.k
+    }
+
+    /// The RGB η and k that an RGB transport uses, as Mitsuba 3's RGB variants derive them for
+    /// its named conductors: each spectrum's XYZ without an illuminant (a constant 1 has Y = 1),
+    /// turned into linear sRGB and clamped to ≥ 0.
+    pub fn rgb(&self) -> ([f64; 3], [f64; 3]) {
+        let rgb = |s: &PiecewiseLinear| {
+            Spectrum::PiecewiseLinear(s.clone())
+                .emission_srgb()
+                .max(glam::DVec3::ZERO)
+                .to_array()
+        };
+        (rgb(&self.eta), rgb(&self.k))
     }
 
     /// (η, k) at `lambda` nm.

@@ -53,6 +53,11 @@ impl Sellmeier {
         Ok(law)
     }
 
+    /// The coefficients B₁, B₂, B₃ and C₁, C₂, C₃ (µm²).
+    pub fn coefficients(&self) -> ([f64; 3], [f64; 3]) {
+        (self.b, self.c)
+    }
+
     /// The index of refraction at `lambda` nm (NaN where n² < 0, which `new` refuses in range).
     pub fn ior(&self, lambda: f64) -> f64 {
         let l2 = (lambda * 1e-3) * (lambda * 1e-3);
@@ -87,6 +92,11 @@ impl Cauchy {
         let law = Self { a, b, c };
         check_range(|l| law.ior(l))?;
         Ok(law)
+    }
+
+    /// The coefficients a, b (µm²) and c (µm⁴).
+    pub fn coefficients(&self) -> [f64; 3] {
+        [self.a, self.b, self.c]
     }
 
     /// The index of refraction at `lambda` nm.

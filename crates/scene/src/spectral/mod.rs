@@ -68,6 +68,14 @@ pub enum SpectrumError {
         /// Its value.
         value: f64,
     },
+    /// A wavelength is zero or negative.
+    #[error("sample {index} has a wavelength of {wavelength} nm (it must be positive)")]
+    NonPositiveWavelength {
+        /// Index of the sample.
+        index: usize,
+        /// The wavelength, nm.
+        wavelength: f64,
+    },
     /// A value is negative.
     #[error("sample {index} is negative: {value} at {wavelength} nm")]
     Negative {

@@ -19,8 +19,8 @@ pub struct PiecewiseLinear {
 
 impl PiecewiseLinear {
     /// A measured spectrum from its wavelengths (nm) and values. Refused: lists of different
-    /// lengths, fewer than 2 samples, a non-finite wavelength or value, a negative value, a
-    /// repeated or decreasing wavelength.
+    /// lengths, fewer than 2 samples, a non-finite wavelength or value, a wavelength ≤ 0, a
+    /// negative value, a repeated or decreasing wavelength.
     pub fn new(lambdas: Vec<f64>, values: Vec<f64>) -> Result<Self, SpectrumError> {
         if lambdas.len() != values.len() {
             return Err(SpectrumError::LengthMismatch {
@@ -40,6 +40,9 @@ impl PiecewiseLinear {
                     wavelength,
                     value,
                 });
+            }
+            if wavelength <= 0.0 {
+                return Err(SpectrumError::NonPositiveWavelength { index, wavelength });
             }
             if value < 0.0 {
                 return Err(SpectrumError::Negative {
@@ -167,6 +170,12 @@ impl Blackbody {
     /// Its temperature, K.
     pub fn temperature(&self) -> f64 {
         self.t
+    }
+
+    /// Its spectral radiance at the peak, W / (m² sr m): the factor that turns the normalized
+    /// emission into Planck's law.
+    pub fn peak_radiance(&self) -> f64 {
+        1.0 / self.normalization
     }
 
     /// The normalized emission at `lambda` nm.
@@ -328,6 +337,9 @@ pub enum Spectrum {
     RgbUnbounded(RgbUnbounded),
     /// An uplifted emission.
     RgbIlluminant(RgbIlluminant),
+    /// Another spectrum times a factor (a blackbody or a named illuminant at a given
+    /// luminance).
+    Scaled(f64, Box<Spectrum>),
 }
 
 impl Spectrum {
@@ -340,6 +352,7 @@ impl Spectrum {
             Self::RgbAlbedo(s) => s.eval(lambda),
             Self::RgbUnbounded(s) => s.eval(lambda),
             Self::RgbIlluminant(s) => s.eval(lambda),
+            Self::Scaled(k, s) => k * s.eval(lambda),
         }
     }
 
@@ -362,6 +375,19 @@ impl Spectrum {
             })
             .sum::<glam::DVec3>()
             / CIE_Y_INTEGRAL
+    }
+
+    /// Its linear sRGB colour as an emission: [`super::xyz_to_srgb`] of [`Spectrum::to_xyz`] (a
+    /// spectrum of 1 everywhere has luminance 1; D65 normalized to luminance 1 is white).
+    pub fn emission_srgb(&self) -> glam::DVec3 {
+        super::xyz_to_srgb(self.to_xyz())
+    }
+
+    /// Its linear sRGB colour as a reflectance under D65, normalized as the uplift is (D65 of
+    /// luminance 1, trapezoid rule on the 1 nm nodes of 360–830 nm), so that a reflectance of 1
+    /// everywhere is white and an uplifted colour comes back as itself.
+    pub fn reflectance_srgb(&self) -> glam::DVec3 {
+        super::uplift::reflectance_srgb(|l| self.eval(l))
     }
 }
 
@@ -396,6 +422,28 @@ mod tests {
         );
         // Its normalization gives luminance 1.
         assert!((xyz.y / CIE_Y_INTEGRAL - 1.0).abs() < 1e-3, "{xyz}");
+    }
+
+    /// The RGB colour of a spectrum: D65 of luminance 1 is sRGB white as an emission, a
+    /// reflectance of 1 is white under D65, an uplifted reflectance comes back as its colour,
+    /// and a scaled spectrum scales its colour.
+    #[test]
+    fn colours_of_emissions_and_reflectances() {
+        let d65 = Spectrum::PiecewiseLinear(NamedIlluminant::D65.spectrum().clone());
+        let white = d65.emission_srgb();
+        assert!((white - DVec3::ONE).abs().max_element() < 2e-3, "{white}");
+        let one = Spectrum::Constant(1.0).reflectance_srgb();
+        assert!((one - DVec3::ONE).abs().max_element() < 2e-3, "{one}");
+        for rgb in [[0.8, 0.3, 0.1], [0.1, 0.5, 0.9], [0.5, 0.5, 0.5]] {
+            let s = Spectrum::RgbAlbedo(RgbAlbedo::new(rgb).unwrap());
+            let back = s.reflectance_srgb();
+            assert!(
+                (back - DVec3::from_array(rgb)).abs().max_element() < 0.01,
+                "{rgb:?}: {back}"
+            );
+        }
+        let scaled = Spectrum::Scaled(3.0, Box::new(d65.clone())).emission_srgb();
+        assert!((scaled - 3.0 * white).abs().max_element() < 1e-9);
     }
 
     /// Illuminant A is a 2856 K black body: its chromaticity is the CIE's (0.44757, 0.40745),
@@ -463,6 +511,10 @@ mod tests {
         assert!(matches!(
             err(vec![400.0, 500.0], vec![1.0, -0.1]),
             E::Negative { index: 1, .. }
+        ));
+        assert!(matches!(
+            err(vec![-400.0, 500.0], vec![1.0, 1.0]),
+            E::NonPositiveWavelength { index: 0, .. }
         ));
         assert!(matches!(
             err(vec![400.0, 500.0, 500.0], vec![1.0, 1.0, 1.0]),

@@ -107,6 +107,17 @@ impl SigmoidPolynomial {
     }
 }
 
+/// The linear sRGB colour under D65 of the reflectance `f` (of wavelength in nm), integrated
+/// as the fit integrates its spectra.
+pub(super) fn reflectance_srgb(f: impl Fn(f64) -> f64) -> DVec3 {
+    FitTables::get()
+        .rgb
+        .iter()
+        .enumerate()
+        .map(|(i, &rgb)| rgb * f(360.0 + i as f64))
+        .sum()
+}
+
 /// What the fit integrates against, computed once: for each wavelength node of 360, 361, …,
 /// 830 nm, the sRGB of the colour-matching functions times D65 (normalized to luminance 1)
 /// times the node's trapezoid weight, and D65's XYZ, the white of CIELAB.
