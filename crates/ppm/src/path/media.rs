@@ -71,59 +71,20 @@ pub(super) fn trace(scene: &Scene, params: &RenderParams, ray: Ray, sampler: &mu
                 break;
             }
             let q = beta / total;
-            // The distance of a medium vertex before the surface, if the flight ends in one;
-            // `beta` is weighted either way.
-            let scatter_at = if m.is_homogeneous() {
-                let sigma_t = m.sigma_t();
-                let (u_channel, u_distance) = (sampler.next_f32(), sampler.next_f32());
-                let channel = if u_channel < q.x {
-                    0
-                } else if u_channel < q.x + q.y {
-                    1
-                } else {
-                    2
-                };
-                let t = if sigma_t[channel] > 0.0 {
-                    -(1.0 - u_distance).ln() / sigma_t[channel]
-                } else {
-                    f32::INFINITY
-                };
-                if t < t_surface {
-                    // A medium vertex.
-                    let tr = m.transmittance(t);
-                    let pdf = (q * sigma_t * tr).element_sum();
-                    if pdf.is_nan() || pdf <= 0.0 {
-                        break;
-                    }
-                    beta *= m.sigma_s * tr / pdf;
-                    Some(t)
-                } else {
-                    // The surface (or infinity) is reached: weight by the transmittance over
-                    // the probability of getting there.
-                    let tr = m.transmittance(t_surface);
-                    let survive = (q * tr).element_sum();
-                    if survive.is_nan() || survive <= 0.0 {
-                        break;
-                    }
-                    beta *= tr / survive;
-                    None
-                }
-            } else {
-                // A grid: spectral delta tracking (`Medium::sample_free_flight`).
-                let flight =
-                    m.sample_free_flight(ray.origin, ray.direction, t_surface, q, &mut || {
-                        sampler.next_f32()
-                    });
-                let (t, weight) = match flight {
-                    FreeFlight::Scatter { t, weight } => (Some(t), weight),
-                    FreeFlight::Pass { weight } => (None, weight),
-                };
-                beta *= weight;
-                if beta == Rgb::ZERO || !beta.is_finite() {
-                    break;
-                }
-                t
+            // The distance of a medium vertex before the surface, if the flight ends in one
+            // (`Medium::sample_free_flight`: chromatic free-flight sampling in a homogeneous
+            // medium, spectral delta tracking in a grid); `beta` is weighted either way.
+            let flight = m.sample_free_flight(ray.origin, ray.direction, t_surface, q, &mut || {
+                sampler.next_f32()
+            });
+            let (scatter_at, weight) = match flight {
+                FreeFlight::Scatter { t, weight } => (Some(t), weight),
+                FreeFlight::Pass { weight } => (None, weight),
             };
+            beta *= weight;
+            if beta == Rgb::ZERO || !beta.is_finite() {
+                break;
+            }
             if let Some(t) = scatter_at {
                 let position = ray.at(t);
                 if depth >= params.budget.max_depth {

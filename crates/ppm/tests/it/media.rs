@@ -121,7 +121,17 @@ fn transmittance_through_a_dielectric_boundary_includes_fresnel() {
 /// with p(−1) = (1 − g²) / (4π (1 + g)³).
 #[test]
 fn single_scattering_matches_the_slab_integral() {
-    let toml = r#"
+    let image = path_render(HAZE, 1024, 4, 1);
+    assert_close(
+        channel_means(&image),
+        haze_radiance(),
+        0.03,
+        "single scattering",
+    );
+}
+
+/// The scene of [`single_scattering_matches_the_slab_integral`].
+const HAZE: &str = r#"
 format = 1
 [camera]
 position = [0.0, 0.0, 5.0]
@@ -147,15 +157,15 @@ type = "directional"
 direction = [0.0, 0.0, -1.0]
 irradiance = [1.0, 1.0, 1.0]
 "#;
-    let image = path_render(toml, 1024, 4, 1);
+
+/// The closed form of [`single_scattering_matches_the_slab_integral`] for [`HAZE`].
+fn haze_radiance() -> [f64; 3] {
     let g: f64 = 0.3;
     let p = (1.0 - g * g) / (4.0 * PI * (1.0 + g).powi(3));
-    let sigma_s = [0.1, 0.2, 0.4];
-    let expected = sigma_s.map(|s: f64| {
+    [0.1, 0.2, 0.4].map(|s: f64| {
         let t = s + 0.05;
         s * p * (1.0 - (-4.0 * t).exp()) / (2.0 * t)
-    });
-    assert_close(channel_means(&image), expected, 0.03, "single scattering");
+    })
 }
 
 /// A closed box whose black walls all emit L = 1 inward, filled with a medium of albedo one
@@ -351,43 +361,12 @@ fn a_clear_medium_changes_nothing() {
 /// rays, read the same closed form (with the default's light tracing and frequency photons on).
 #[test]
 fn photon_mappers_match_the_single_scattering_integral() {
-    let toml = r#"
-format = 1
-[camera]
-position = [0.0, 0.0, 5.0]
-look_at = [0.0, 0.0, 0.0]
-fov_y = 0.5
-[film]
-width = 4
-height = 4
-[media.haze]
-sigma_a = [0.05, 0.05, 0.05]
-sigma_s = [0.1, 0.2, 0.4]
-g = 0.3
-[materials.boundary]
-type = "interface"
-[[shapes]]
-type = "sphere"
-center = [0.0, 0.0, 0.0]
-radius = 1.0
-material = "boundary"
-interior = "haze"
-[[lights]]
-type = "directional"
-direction = [0.0, 0.0, -1.0]
-irradiance = [1.0, 1.0, 1.0]
-"#;
-    let g: f64 = 0.3;
-    let p = (1.0 - g * g) / (4.0 * PI * (1.0 + g).powi(3));
-    let expected = [0.1, 0.2, 0.4].map(|s: f64| {
-        let t = s + 0.05;
-        s * p * (1.0 - (-4.0 * t).exp()) / (2.0 * t)
-    });
+    let expected = haze_radiance();
     for method in [Method::Sppm, Method::FreqSppm, Method::Ppm, Method::Appm] {
         let mut params = params(method, 200_000);
         params.budget.max_depth = 1;
         params.kernel.initial_radius = Some(0.05);
-        let image = render(&scene(toml), params, 16);
+        let image = render(&scene(HAZE), params, 16);
         assert_close(
             channel_means(&image),
             expected,
