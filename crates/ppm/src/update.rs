@@ -164,5 +164,18 @@ fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
+/// Knaus and Zwicker's (2011) global radius schedule, shared by the pass-independent estimator,
+/// `vcm`'s merge radius and the volume gather: g² of pass `pass` (0-based), the product of
+/// (k + α)/(k + 1) for k = 1 … pass, taken in that order so that every machine gets the same
+/// bits.
+pub(crate) fn schedule_squared(pass: u64, alpha: f64) -> f64 {
+    let mut g2 = 1.0;
+    for k in 1..=pass {
+        let k = k as f64;
+        g2 *= (k + alpha) / (k + 1.0);
+    }
+    g2
+}
+
 #[cfg(test)]
 mod tests;

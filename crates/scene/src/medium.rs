@@ -12,6 +12,7 @@
 //! sides, leaves the ray in the medium it was in. A shape whose material is
 //! [`crate::MaterialKind::Interface`] does not scatter: it only bounds media.
 
+use std::ops::ControlFlow;
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
@@ -61,6 +62,54 @@ pub enum FreeFlight {
 /// The most tentative collisions one delta- or ratio-tracking walk takes; beyond it the walk
 /// ends with weight zero (a guard against a majorant so large that the steps stop advancing).
 const MAX_TRACKING_STEPS: u32 = 1 << 20;
+
+/// How a tracking walk ([`track`]) ended.
+enum Walk<R> {
+    /// A tentative collision ended it with this.
+    Ended(R),
+    /// It passed `t_max`.
+    Through,
+    /// It took more than [`MAX_TRACKING_STEPS`] steps.
+    TooLong,
+}
+
+/// The tentative collisions along `origin + t·direction`, 0 ≤ t ≤ `t_max`, in a grid: drawn from
+/// exponential steps of each majorant cell's σ̄ = `peak` × its largest density (memoryless, so
+/// the walk restarts at each cell's entry), numbers from `u`. `at(t, density, σ̄, u)` decides
+/// each; a `Break` ends the walk.
+fn track<R, U: FnMut() -> f32>(
+    grid: &DensityGrid,
+    origin: Vec3,
+    direction: Vec3,
+    t_max: f32,
+    peak: f32,
+    u: &mut U,
+    mut at: impl FnMut(f32, f32, f32, &mut U) -> ControlFlow<R>,
+) -> Walk<R> {
+    let mut steps = 0;
+    for segment in grid.majorant_segments(origin, direction, t_max) {
+        let majorant = peak * segment.max_density;
+        if majorant <= 0.0 {
+            continue;
+        }
+        let mut t = segment.t0;
+        loop {
+            steps += 1;
+            if steps > MAX_TRACKING_STEPS {
+                return Walk::TooLong;
+            }
+            t -= (1.0 - u()).ln() / majorant;
+            if t >= segment.t1 {
+                break;
+            }
+            let density = grid.density(origin + direction * t);
+            if let ControlFlow::Break(r) = at(t, density, majorant, u) {
+                return Walk::Ended(r);
+            }
+        }
+    }
+    Walk::Through
+}
 
 impl Medium {
     /// A homogeneous medium.
@@ -169,46 +218,41 @@ impl Medium {
         // largest density, a hair above it.
         let peak = sigma_t.max_element() * (1.0 + 1e-5);
         let mut weight = Rgb::ONE;
-        let mut steps = 0;
-        for segment in grid.majorant_segments(origin, direction, t_max) {
-            let majorant = peak * segment.max_density;
-            if majorant <= 0.0 {
-                continue;
-            }
-            // Exponential steps are memoryless: the walk restarts at each cell's entry.
-            let mut t = segment.t0;
-            loop {
-                steps += 1;
-                if steps > MAX_TRACKING_STEPS {
-                    return FreeFlight::Pass { weight: Rgb::ZERO };
-                }
-                t -= (1.0 - u()).ln() / majorant;
-                if t >= segment.t1 {
-                    break;
-                }
-                let d = grid.density(origin + direction * t);
+        let walk = track(
+            grid,
+            origin,
+            direction,
+            t_max,
+            peak,
+            u,
+            |t, d, majorant, u| {
                 let st = sigma_t * d;
                 let sn = (Rgb::splat(majorant) - st).max(Rgb::ZERO);
                 // The channel weights now: q scaled by what the walk has multiplied so far.
                 let qw = q * weight;
                 let total = qw.element_sum();
                 if total.is_nan() || total <= 0.0 {
-                    return FreeFlight::Pass { weight: Rgb::ZERO };
+                    return ControlFlow::Break(FreeFlight::Pass { weight: Rgb::ZERO });
                 }
                 let qn = qw / total;
                 let real = (qn * st).element_sum();
                 let null = (qn * sn).element_sum();
                 let p_real = real / (real + null);
                 if u() < p_real {
-                    return FreeFlight::Scatter {
+                    return ControlFlow::Break(FreeFlight::Scatter {
                         t,
                         weight: weight * (self.sigma_s * d) / real,
-                    };
+                    });
                 }
                 weight *= sn / null;
-            }
+                ControlFlow::Continue(())
+            },
+        );
+        match walk {
+            Walk::Ended(flight) => flight,
+            Walk::TooLong => FreeFlight::Pass { weight: Rgb::ZERO },
+            Walk::Through => FreeFlight::Pass { weight },
         }
-        FreeFlight::Pass { weight }
     }
 
     /// The transmittance along `origin + t·direction` from 0 to `t_max` (finite): exact for a
@@ -245,29 +289,25 @@ impl Medium {
         let sigma_t = self.sigma_t();
         let peak = sigma_t.max_element() * (1.0 + 1e-5);
         let mut tr = Rgb::ONE;
-        let mut steps = 0;
-        for segment in grid.majorant_segments(origin, direction, t_max) {
-            let majorant = peak * segment.max_density;
-            if majorant <= 0.0 {
-                continue;
-            }
-            let mut t = segment.t0;
-            loop {
-                steps += 1;
-                if steps > MAX_TRACKING_STEPS {
-                    return Rgb::ZERO;
-                }
-                t -= (1.0 - u()).ln() / majorant;
-                if t >= segment.t1 {
-                    break;
-                }
-                let st = sigma_t * grid.density(origin + direction * t);
-                tr *= (Rgb::ONE - st / majorant).max(Rgb::ZERO);
+        let walk = track(
+            grid,
+            origin,
+            direction,
+            t_max,
+            peak,
+            u,
+            |t, d, majorant, _| {
+                tr *= (Rgb::ONE - sigma_t * d / majorant).max(Rgb::ZERO);
                 visit(t, tr);
                 if tr == Rgb::ZERO {
-                    return tr;
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
                 }
-            }
+            },
+        );
+        if matches!(walk, Walk::TooLong) {
+            return Rgb::ZERO;
         }
         tr
     }

@@ -35,6 +35,7 @@ use crate::integrator::Integrator;
 use crate::params::{Method, ParamError, RenderParams};
 use crate::photon_mapper::{self, NO_VISIBLE_POINT, PhotonMapper, auto_initial_radius};
 use crate::stats::{MemoryEstimate, MemoryUse, PassStats};
+pub(crate) use crate::update::schedule_squared;
 
 /// The pass-independent estimator: the photon mappers' phases, with kernels fixed by a pilot.
 pub(crate) struct PassIndependent {
@@ -49,17 +50,6 @@ struct Independent {
     /// Per slot: r₀, the radius of the first pass.
     kernels: Vec<f64>,
     sums: PassSums,
-}
-
-/// g² of pass `pass` (0-based): the product of (k + α)/(k + 1) for k = 1 … pass, taken in that
-/// order so that every machine gets the same bits.
-pub(crate) fn schedule_squared(pass: u64, alpha: f64) -> f64 {
-    let mut g2 = 1.0;
-    for k in 1..=pass {
-        let k = k as f64;
-        g2 *= (k + alpha) / (k + 1.0);
-    }
-    g2
 }
 
 /// The pilot: `params.frequency.pilot` passes of freq-sppm from the same seed; each slot's radius

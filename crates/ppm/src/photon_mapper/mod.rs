@@ -322,7 +322,12 @@ impl PhotonMapper {
         let setup = &self.setup;
         self.volume.gather_pass(
             &setup.scene,
-            self.photons.traced.iter().map(|t| t.volume.as_slice()),
+            &self
+                .photons
+                .traced
+                .iter()
+                .map(|t| t.volume.as_slice())
+                .collect::<Vec<_>>(),
             (
                 setup.kernel_scale * setup.params.kernel.volume_radius,
                 setup.params.kernel.alpha,

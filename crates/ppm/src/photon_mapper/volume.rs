@@ -24,8 +24,11 @@
 //! not depend on the number of threads.
 
 use glam::{Vec2, Vec3};
+use photon::MortonScratch;
 use rayon::prelude::*;
 use scene::{Medium, Rgb, Scene};
+
+use crate::update::schedule_squared;
 
 /// Photons per leaf of [`VolumeTree`].
 const LEAF: usize = 8;
@@ -173,37 +176,23 @@ pub(crate) struct VolumeTree {
     /// `levels[0]` the leaves' boxes (grown by the radius), each level above the unions of
     /// pairs of the one below; the last has one box, the root.
     levels: Vec<Vec<Aabb>>,
-    keys: Vec<(u32, u32)>,
+    keys: MortonScratch,
 }
 
 impl VolumeTree {
-    /// Rebuilds the tree over `photons` (in trace order) for gathers of radius `radius`.
-    pub(crate) fn build(&mut self, photons: impl Iterator<Item = VolumePhoton>, radius: f32) {
-        let mut unsorted: Vec<VolumePhoton> = photons.collect();
+    /// Rebuilds the tree over the photons of `chunks` (in trace order) for gathers of radius
+    /// `radius`.
+    pub(crate) fn build<C: AsRef<[VolumePhoton]> + Sync>(&mut self, chunks: &[C], radius: f32) {
         self.levels.clear();
-        self.photons.clear();
-        if unsorted.is_empty() {
+        photon::morton_sort(
+            chunks,
+            |p: &VolumePhoton| p.position,
+            &mut self.keys,
+            &mut self.photons,
+        );
+        if self.photons.is_empty() {
             return;
         }
-        let bounds = unsorted.iter().fold(Aabb::EMPTY, |b, p| {
-            b.union(Aabb {
-                min: p.position,
-                max: p.position,
-            })
-        });
-        let scale = (bounds.max - bounds.min).max(Vec3::splat(f32::MIN_POSITIVE));
-        self.keys.clear();
-        self.keys
-            .par_extend(unsorted.par_iter().enumerate().map(|(i, p)| {
-                let q = ((p.position - bounds.min) / scale * 1023.0)
-                    .clamp(Vec3::ZERO, Vec3::splat(1023.0));
-                (morton(q.x as u32, q.y as u32, q.z as u32), i as u32)
-            }));
-        // The pairs are distinct, so the order does not depend on the sort.
-        self.keys.par_sort_unstable();
-        self.photons
-            .extend(self.keys.iter().map(|&(_, i)| unsorted[i as usize]));
-        unsorted.clear();
         let grow = Vec3::splat(radius);
         let leaves: Vec<Aabb> = self
             .photons
@@ -272,7 +261,7 @@ impl VolumeTree {
     pub(crate) fn heap_bytes(&self) -> usize {
         use std::mem::size_of;
         self.photons.capacity() * size_of::<VolumePhoton>()
-            + self.keys.capacity() * size_of::<(u32, u32)>()
+            + self.keys.heap_bytes()
             + self
                 .levels
                 .iter()
@@ -379,12 +368,13 @@ impl ScreenIndex {
                 });
             }
         }
-        let near = photons
+        let near: Vec<VolumePhoton> = photons
             .iter()
             .zip(&self.discs)
             .filter(|(_, disc)| disc.is_none())
-            .map(|(p, _)| *p);
-        self.near.build(near, radius);
+            .map(|(p, _)| *p)
+            .collect();
+        self.near.build(&[near], radius);
     }
 
     /// [`VolumeTree::gather`] for a primary stretch of the slot of pixel `pixel`.
@@ -413,27 +403,10 @@ impl ScreenIndex {
     }
 }
 
-/// Interleaves the low 10 bits of x, y and z.
-fn morton(x: u32, y: u32, z: u32) -> u32 {
-    fn spread(v: u32) -> u32 {
-        let mut v = v & 0x3ff;
-        v = (v | (v << 16)) & 0x0300_00ff;
-        v = (v | (v << 8)) & 0x0300_f00f;
-        v = (v | (v << 4)) & 0x030c_30c3;
-        (v | (v << 2)) & 0x0924_9249
-    }
-    spread(x) | (spread(y) << 1) | (spread(z) << 2)
-}
-
 /// The volume gather's radius in pass `pass` (0-based) from `initial`: r²ₖ₊₁ = r²ₖ (k + α)/(k + 1)
 /// (Knaus and Zwicker 2011, for a kernel over two dimensions), k counted from 1.
 pub(crate) fn radius_after(initial: f64, alpha: f64, pass: u32) -> f64 {
-    let mut r2 = initial * initial;
-    for k in 1..=pass {
-        let k = f64::from(k);
-        r2 *= (k + alpha) / (k + 1.0);
-    }
-    r2.sqrt()
+    initial * schedule_squared(u64::from(pass), alpha).sqrt()
 }
 
 /// What the volume gather keeps between passes: the sum of the passes' estimates per slot,
@@ -489,10 +462,10 @@ impl Volume {
     /// depends on the pass's index alone, so that the pass-independent estimator's passes can be
     /// rendered apart.
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn gather_pass<'a>(
+    pub(crate) fn gather_pass(
         &mut self,
         scene: &Scene,
-        photons: impl Iterator<Item = &'a [VolumePhoton]>,
+        photons: &[&[VolumePhoton]],
         (initial_radius, alpha): (f64, f64),
         pass: u32,
         emitted: u64,
@@ -500,7 +473,7 @@ impl Volume {
         n_slots: usize,
     ) -> u64 {
         let radius = radius_after(initial_radius, alpha, pass) as f32;
-        self.tree.build(photons.flatten().copied(), radius);
+        self.tree.build(photons, radius);
         let primary = self.segments.iter().any(|s| s.primary);
         if primary {
             self.screen
@@ -607,7 +580,7 @@ mod tests {
             .collect();
         let radius = 0.07;
         let mut tree = VolumeTree::default();
-        tree.build(photons.iter().copied(), radius);
+        tree.build(&[photons.as_slice()], radius);
         for _ in 0..200 {
             let origin = Vec3::new(next(), next(), next()) * 4.0 - 2.0;
             let direction = (Vec3::new(next(), next(), next()) - 0.5).normalize();
@@ -679,7 +652,7 @@ mod tests {
             .collect();
         let radius = 0.05;
         let mut tree = VolumeTree::default();
-        tree.build(photons.iter().copied(), radius);
+        tree.build(&[photons.as_slice()], radius);
         let mut screen = ScreenIndex::default();
         screen.build(&camera, &tree.photons, radius);
         assert!(!screen.near.photons.is_empty() && !screen.entries.is_empty());

@@ -78,6 +78,12 @@ pub(crate) fn emissive_box(camera: &str) -> String {
          [materials.silver]\ntype = \"mirror\"\n\
          [[shapes]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 0.1\nmaterial = \"silver\"\n"
     );
+    toml += &cube_walls("wall");
+    toml
+}
+
+/// The six faces of the cube [−1, 1]³ as quads of `material`, facing inward (TOML shapes).
+pub(crate) fn cube_walls(material: &str) -> String {
     // Corner and edges of each face, edge1 × edge2 pointing into the cube.
     let faces: [[[f64; 3]; 3]; 6] = [
         [[-1.0, -1.0, -1.0], [0.0, 0.0, 2.0], [2.0, 0.0, 0.0]],
@@ -87,12 +93,14 @@ pub(crate) fn emissive_box(camera: &str) -> String {
         [[-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
         [[-1.0, -1.0, 1.0], [0.0, 2.0, 0.0], [2.0, 0.0, 0.0]],
     ];
-    for [corner, edge1, edge2] in faces {
-        toml += &format!(
-            "[[shapes]]\ntype = \"quad\"\ncorner = {corner:?}\nedge1 = {edge1:?}\nedge2 = {edge2:?}\nmaterial = \"wall\"\n"
-        );
-    }
-    toml
+    faces
+        .iter()
+        .map(|[corner, edge1, edge2]| {
+            format!(
+                "[[shapes]]\ntype = \"quad\"\ncorner = {corner:?}\nedge1 = {edge1:?}\nedge2 = {edge2:?}\nmaterial = \"{material}\"\n"
+            )
+        })
+        .collect()
 }
 
 /// `max_depth` bounds the scattering events of the whole light path, the same way for every

@@ -220,48 +220,16 @@ fn transmittance_through_a_constant_grid_is_beer_lambert() {
 /// shadow ray toward the sun).
 #[test]
 fn single_scattering_in_a_grid_matches_the_slab_integral() {
-    let toml = r#"
-format = 1
-[camera]
-position = [0.0, 0.0, 5.0]
-look_at = [0.0, 0.0, 0.0]
-fov_y = 0.5
-[film]
-width = 4
-height = 4
-[media.haze]
-sigma_a = [0.1, 0.1, 0.1]
-sigma_s = [0.2, 0.4, 0.8]
-g = 0.3
-[media.haze.grid]
-size = [1, 2, 1]
-density = [0.5, 0.5]
-min = [-1.5, -1.5, -1.5]
-max = [1.5, 1.5, 1.5]
-[materials.boundary]
-type = "interface"
-[[shapes]]
-type = "sphere"
-center = [0.0, 0.0, 0.0]
-radius = 1.0
-material = "boundary"
-interior = "haze"
-[[lights]]
-type = "directional"
-direction = [0.0, 0.0, -1.0]
-irradiance = [1.0, 1.0, 1.0]
-"#;
-    let image = path_render(toml, 1024, 4, 1);
-    let g: f64 = 0.3;
-    let p = (1.0 - g * g) / (4.0 * PI * (1.0 + g).powi(3));
-    let sigma_s = [0.1, 0.2, 0.4];
-    let expected = sigma_s.map(|s: f64| {
-        let t = s + 0.05;
-        s * p * (1.0 - (-4.0 * t).exp()) / (2.0 * t)
-    });
+    let toml = HAZE.replace(
+        "sigma_a = [0.05, 0.05, 0.05]\nsigma_s = [0.1, 0.2, 0.4]\ng = 0.3\n",
+        "sigma_a = [0.1, 0.1, 0.1]\nsigma_s = [0.2, 0.4, 0.8]\ng = 0.3\n[media.haze.grid]\n\
+         size = [1, 2, 1]\ndensity = [0.5, 0.5]\nmin = [-1.5, -1.5, -1.5]\nmax = [1.5, 1.5, 1.5]\n",
+    );
+    assert!(toml.contains("[media.haze.grid]"));
+    let image = path_render(&toml, 1024, 4, 1);
     assert_close(
         channel_means(&image),
-        expected,
+        haze_radiance(),
         0.03,
         "single scattering in a grid",
     );
@@ -432,20 +400,7 @@ albedo = [0.0, 0.0, 0.0]
 emission = [1.0, 1.0, 1.0]
 "#,
     );
-    // Corner and edges of each face, edge1 × edge2 pointing into the cube.
-    let faces: [[[f64; 3]; 3]; 6] = [
-        [[-1.0, -1.0, -1.0], [0.0, 0.0, 2.0], [2.0, 0.0, 0.0]],
-        [[-1.0, 1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 0.0, 2.0]],
-        [[-1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]],
-        [[1.0, -1.0, -1.0], [0.0, 0.0, 2.0], [0.0, 2.0, 0.0]],
-        [[-1.0, -1.0, -1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
-        [[-1.0, -1.0, 1.0], [0.0, 2.0, 0.0], [2.0, 0.0, 0.0]],
-    ];
-    for [corner, edge1, edge2] in faces {
-        toml += &format!(
-            "[[shapes]]\ntype = \"quad\"\ncorner = {corner:?}\nedge1 = {edge1:?}\nedge2 = {edge2:?}\nmaterial = \"wall\"\n"
-        );
-    }
+    toml += &crate::analytic::cube_walls("wall");
     toml
 }
 
