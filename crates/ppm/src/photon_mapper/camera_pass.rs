@@ -8,6 +8,7 @@ use rayon::prelude::*;
 use scene::{Bsdf, Hit, Rgb, TransportMode, medium_after};
 
 use super::frequency::SlotFrequency;
+use super::pool::{SurfacePoint, same_surface};
 use super::volume::{Segment, stretch_transmittance};
 use super::{NO_VISIBLE_POINT, PhotonMapper, SLOT_CHUNK, Setup};
 use crate::path::{MAX_CROSSINGS, bsdf_emission_weight, next_event};
@@ -124,6 +125,11 @@ impl PhotonMapper {
             self.photon_bounces = vec![NO_VISIBLE_POINT; n_slots];
             self.mean_weight = vec![Vec3::ZERO; n_slots];
             self.weight_passes = 0;
+            self.mixed = if setup.pools() && setup.params.method.is_stochastic() {
+                vec![false; n_slots]
+            } else {
+                Vec::new()
+            };
         }
         self.weight_passes += 1;
         // Each slot's running mean of its weights, m += (w − m)/n: the same passes give the same
@@ -154,10 +160,38 @@ impl PhotonMapper {
             *mean += (point.weight - *mean) * inv_passes;
             // Visible points have bounces < max_depth ≤ 1024 (`trace_camera_path`).
             let budget = (setup.params.budget.max_depth - 1).saturating_sub(point.bounces);
-            self.photon_bounces[slot] = match sample.visible {
+            let budget = match sample.visible {
                 Some(_) => u16::try_from(budget).unwrap_or(NO_VISIBLE_POINT - 1),
                 None => NO_VISIBLE_POINT,
             };
+            if !first && let Some(mixed) = self.mixed.get_mut(slot) {
+                let surface = |position, normal, shading_normal, material, budget| {
+                    (budget != NO_VISIBLE_POINT).then_some(SurfacePoint {
+                        position,
+                        normal,
+                        shading_normal,
+                        material,
+                        budget,
+                    })
+                };
+                let slots = &self.slots;
+                let before = surface(
+                    slots.position()[slot],
+                    slots.geometric_normal()[slot],
+                    slots.shading_normal()[slot],
+                    slots.material_idx()[slot],
+                    self.photon_bounces[slot],
+                );
+                let now = surface(
+                    point.position,
+                    point.geometric_normal,
+                    point.shading_normal,
+                    point.material,
+                    budget,
+                );
+                *mixed |= !same_surface(before, now);
+            }
+            self.photon_bounces[slot] = budget;
             let new = NewHitPoint {
                 position: point.position,
                 shading_normal: point.shading_normal,

@@ -21,21 +21,23 @@ const LIGHT_BYTES_PER_SLOT: u64 = 28;
 /// slot of the pixel per connected photon, for up to the 4.8 stored photons per emitted one
 /// (rounded up).
 const LIGHT_BYTES_PER_PHOTON: u64 = 80;
-/// Checkpoint bytes per slot while writing: the encoded record (at most 200) and its
-/// compressed copy (about a third).
-const CHECKPOINT_BYTES_PER_SLOT: u64 = 272;
+/// Checkpoint bytes per slot while writing: the encoded record (at most 200, 24 for the volume
+/// sums and 4 for whether the visible point moved between surfaces) and its compressed copy
+/// (about a third).
+const CHECKPOINT_BYTES_PER_SLOT: u64 = 312;
 
 /// Memory per hitpoint slot of the photon mappers' fixed columns: the hitpoint record
 /// (`photon::HitPoints` with the frequency state) plus the renderer's per-slot photon-bounce
-/// budget (which also says whether the slot is valid), direct-emission sum and mean visible-point
-/// weight. The hash grid and its slot map come on top; [`crate::Renderer::memory`] measures
-/// everything.
+/// budget (which also says whether the slot is valid), direct-emission sum, mean visible-point
+/// weight and whether its visible point has moved between surfaces. The hash grid and its slot
+/// map come on top; [`crate::Renderer::memory`] measures everything.
 #[must_use]
 pub fn bytes_per_hitpoint() -> usize {
     HitPoints::<SlotFrequency>::bytes_per_hitpoint()
         + std::mem::size_of::<u16>()
         + std::mem::size_of::<[f64; 3]>()
         + std::mem::size_of::<[f32; 3]>()
+        + std::mem::size_of::<bool>()
 }
 
 /// What a render of `pixels` pixels with `params` will hold (the film aside), with the
@@ -86,6 +88,7 @@ impl PhotonMapper {
             records: self.slots.heap_bytes(),
             slot_columns: self.photon_bounces.capacity() * size_of::<u16>()
                 + self.direct.capacity() * size_of::<[f64; 3]>()
+                + self.mixed.capacity()
                 + self.mean_weight.capacity() * size_of::<glam::Vec3>()
                 + volume_sums,
             grid: self.index.heap_bytes(),

@@ -86,6 +86,10 @@ pub(crate) struct PhotonMapper {
     mean_weight: Vec<glam::Vec3>,
     /// The camera passes that placed visible points (every pass for SPPM, the first for PPM).
     weight_passes: u32,
+    /// Per slot: whether its visible point has ever moved to another surface from one camera
+    /// pass to the next (`pool::same_surface`); such a slot is not pooled. Kept only by the
+    /// renders that pool and move their visible points (empty otherwise).
+    mixed: Vec<bool>,
     /// Phase 2's grid.
     index: Index,
     /// Phase 3's buffers, and M and Φ of the last pass for phase 4.
@@ -161,6 +165,7 @@ impl PhotonMapper {
             camera_passes: 0,
             mean_weight: Vec::new(),
             weight_passes: 0,
+            mixed: Vec::new(),
             index: Index::default(),
             photons: PhotonPass::default(),
             frequency: FrequencyDeposits::default(),

@@ -35,7 +35,7 @@ use std::ops::{Range, Sub};
 use rayon::prelude::*;
 use wide::{f32x8, u32x8};
 
-use super::{NO_VISIBLE_POINT, PhotonMapper};
+use super::{NO_VISIBLE_POINT, PhotonMapper, Setup};
 use crate::params::PoolMode;
 
 /// Photons counted after which the pooling width starts to shrink.
@@ -51,6 +51,7 @@ const NORMAL_COS: f32 = 0.9;
 const PLANE_SLOPE: f32 = 0.1;
 /// The largest relative difference of the hitpoint weights, per channel.
 const WEIGHT_TOLERANCE: f32 = 0.1;
+
 /// Taps beyond this many standard deviations carry nothing worth the work.
 const CUTOFF_SIGMAS: f32 = 3.0;
 /// Pixels of a row pooled at once, one per lane of a vector.
@@ -141,17 +142,9 @@ impl PhotonMapper {
         )
     }
 
-    /// Whether this render pools at all (never `appm`, whose image is its exact pass sums).
+    /// Whether this render pools at all.
     pub(super) fn pools(&self) -> bool {
-        let params = &self.setup.params;
-        if params.method.is_pass_independent() {
-            return false;
-        }
-        match params.pool.mode {
-            PoolMode::Off => false,
-            PoolMode::Frequency => params.method.uses_frequency() && params.pool.max_pixels > 0,
-            PoolMode::Geometry => params.pool.max_pixels > 0,
-        }
+        self.setup.pools()
     }
 
     /// The photon radiance of every slot, pooled as the parameters say (or each slot's own
@@ -456,6 +449,58 @@ impl WidthRule {
     }
 }
 
+/// Whether two visible points of one slot in successive passes lie on the same surface, by the
+/// tests that decide whether a neighbour pools (same material and photon-bounce budget, both
+/// normals within about 25°, each close to the other's tangent plane), the weights aside: a
+/// slot whose visible point moves between surfaces (a pixel on a silhouette, or one that sees
+/// the sky in some passes) sums their radiance in one estimate, which the last pass's geometry
+/// does not describe, so it neither pools nor is pooled from (`PhotonMapper::mixed`).
+pub(super) fn same_surface(a: Surface, b: Surface) -> bool {
+    let (Some(a), Some(b)) = (a, b) else {
+        return a.is_none() && b.is_none();
+    };
+    let offset = b.position - a.position;
+    let d2 = offset.length_squared();
+    let near_plane = |n: glam::Vec3| {
+        let h = n.dot(offset);
+        h * h <= PLANE_SLOPE * PLANE_SLOPE * d2
+    };
+    a.material == b.material
+        && a.budget == b.budget
+        && a.normal.dot(b.normal) >= NORMAL_COS
+        && a.shading_normal.dot(b.shading_normal) >= NORMAL_COS
+        && near_plane(a.normal)
+        && near_plane(b.normal)
+}
+
+/// A slot's visible point as [`same_surface`] compares it (`None`: the slot has none).
+pub(super) type Surface = Option<SurfacePoint>;
+
+/// What [`same_surface`] compares of a visible point.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SurfacePoint {
+    pub(super) position: glam::Vec3,
+    pub(super) normal: glam::Vec3,
+    pub(super) shading_normal: glam::Vec3,
+    pub(super) material: u32,
+    pub(super) budget: u16,
+}
+
+impl Setup {
+    /// Whether this render pools at all (never `appm`, whose image is its exact pass sums).
+    pub(super) fn pools(&self) -> bool {
+        let params = &self.params;
+        if params.method.is_pass_independent() {
+            return false;
+        }
+        match params.pool.mode {
+            PoolMode::Off => false,
+            PoolMode::Frequency => params.method.uses_frequency() && params.pool.max_pixels > 0,
+            PoolMode::Geometry => params.pool.max_pixels > 0,
+        }
+    }
+}
+
 /// One band's results in slot order from its first slot, and what its slots' own state gives.
 #[derive(Default)]
 struct Band {
@@ -698,7 +743,9 @@ impl Planes {
                 let col = x + halo;
                 let slot = film.slot(x, y, sample);
                 let budget = mapper.photon_bounces[slot];
-                let visible = budget != NO_VISIBLE_POINT;
+                // A slot whose visible point has moved between surfaces is left as it is.
+                let visible =
+                    budget != NO_VISIBLE_POINT && !mapper.mixed.get(slot).is_some_and(|&m| m);
                 if !visible && !in_band {
                     out.clear_one(col);
                     continue;
@@ -1123,5 +1170,39 @@ mod tests {
                 assert!((v - expected).abs() < 1e-5, "{name} = {v}");
             }
         }
+    }
+
+    #[test]
+    fn a_visible_point_stays_on_its_surface_only_along_it() {
+        use glam::Vec3;
+        let at = |position: Vec3, normal: Vec3| {
+            Some(SurfacePoint {
+                position,
+                normal,
+                shading_normal: normal,
+                material: 3,
+                budget: 7,
+            })
+        };
+        let here = at(Vec3::ZERO, Vec3::Y);
+        // Along the plane, however far, and with a slightly turned normal: the same surface.
+        assert!(same_surface(here, at(Vec3::new(5.0, 0.0, -2.0), Vec3::Y)));
+        let tilted = Vec3::new(0.0, 1.0, 0.3).normalize();
+        assert!(same_surface(here, at(Vec3::new(0.1, 0.0, 0.0), tilted)));
+        assert!(same_surface(None, None));
+        // A parallel plane behind it (a silhouette), a turned surface, another material or
+        // budget, or no visible point on one side: another surface.
+        assert!(!same_surface(here, at(Vec3::new(0.1, 0.5, 0.0), Vec3::Y)));
+        assert!(!same_surface(here, at(Vec3::new(0.1, 0.0, 0.0), Vec3::X)));
+        let other = |f: fn(&mut SurfacePoint)| {
+            let mut p = here.unwrap();
+            p.position.x = 0.1;
+            f(&mut p);
+            Some(p)
+        };
+        assert!(!same_surface(here, other(|p| p.material = 4)));
+        assert!(!same_surface(here, other(|p| p.budget = 6)));
+        assert!(!same_surface(here, None));
+        assert!(!same_surface(None, here));
     }
 }

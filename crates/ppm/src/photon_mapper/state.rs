@@ -1,6 +1,7 @@
 //! What a checkpoint keeps of a photon mapper: every hitpoint slot's record, its photon-bounce
 //! budget, directly seen emission and mean visible-point weight, the photon and camera-pass
-//! counts, and in a scene with media the volume gather's sums.
+//! counts, in a scene with media the volume gather's sums, and which slots' visible points have
+//! moved between surfaces.
 
 use glam::Vec3;
 use photon::{HitPoints, NewHitPoint};
@@ -15,7 +16,15 @@ const SLOT_RECORD_MAX: usize = 5 * 12 + 4 + 4 + 8 + 8 + 24 + 4 + 4 + 4 + 4 + 32 
 
 /// The most bytes [`PhotonMapper::write_state`] writes for `n_slots` slots.
 pub(super) fn bound(n_slots: usize) -> usize {
-    8 + 4 + 4 + 8 + n_slots.saturating_mul(SLOT_RECORD_MAX) + 4 + 8 + n_slots.saturating_mul(24)
+    8 + 4
+        + 4
+        + 8
+        + n_slots.saturating_mul(SLOT_RECORD_MAX)
+        + 4
+        + 8
+        + n_slots.saturating_mul(24)
+        + 8
+        + n_slots.saturating_mul(4)
 }
 
 impl PhotonMapper {
@@ -75,6 +84,11 @@ impl PhotonMapper {
         w.u64(p.volume.sum.len() as u64);
         for sum in &p.volume.sum {
             sum.iter().for_each(|&c| w.f64(c));
+        }
+        // Which slots' visible points have moved between surfaces (none where not kept).
+        w.u64(p.mixed.len() as u64);
+        for &m in &p.mixed {
+            w.u32(u32::from(m));
         }
     }
 
@@ -171,8 +185,18 @@ impl PhotonMapper {
         for _ in 0..n_volume {
             volume_sum.push([r.f64()?, r.f64()?, r.f64()?]);
         }
+        let n_mixed = r.len()?;
+        let kept = p.setup.pools() && p.setup.params.method.is_stochastic();
+        if (n_mixed != 0 || kept) && n_mixed != n {
+            return Err(StateError::Corrupt);
+        }
+        let mut mixed = Vec::with_capacity(n_mixed);
+        for _ in 0..n_mixed {
+            mixed.push(r.bool()?);
+        }
         p.volume.gathers = gathers;
         p.volume.sum = volume_sum;
+        p.mixed = mixed;
         p.pass = passes;
         p.n_emitted = n_emitted;
         p.camera_passes = camera_passes;

@@ -160,7 +160,10 @@ fn reference_pooling(m: &PhotonMapper) -> (Vec<[f64; 3]>, Vec<f32>) {
     let spp = m.setup.params.film.samples_per_pixel as usize;
     let n = s.len();
     let own: Vec<[f64; 3]> = (0..n).map(|i| m.own_radiance(i)).collect();
-    let valid = |i: usize| m.photon_bounces[i] != super::NO_VISIBLE_POINT;
+    // A slot whose visible point has moved between surfaces neither pools nor is pooled from.
+    let valid = |i: usize| {
+        m.photon_bounces[i] != super::NO_VISIBLE_POINT && !m.mixed.get(i).is_some_and(|&x| x)
+    };
     let same = |p: usize, q: usize| {
         let off = s.position()[q] - s.position()[p];
         let agree = |a: Vec3, b: Vec3| (0..3).all(|c| (a[c] - b[c]).abs() <= 0.1 * a[c].max(b[c]));
