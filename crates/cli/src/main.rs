@@ -85,11 +85,12 @@ fn main() -> ExitCode {
         Ok(Outcome::Done) => ExitCode::SUCCESS,
         Ok(Outcome::Interrupted) => ExitCode::from(130),
         Err(err) => {
-            // A bad spectrum in a scene is a usage error, as the issue of spectra asks.
-            let bad_spectrum = err
+            // A bad spectrum, medium or density grid in a scene is a usage error, as the issues
+            // of spectra and media ask.
+            let bad_value = err
                 .downcast_ref::<import::LoadError>()
-                .is_some_and(import::LoadError::is_bad_spectrum);
-            let code = if err.downcast_ref::<UsageError>().is_some() || bad_spectrum {
+                .is_some_and(import::LoadError::is_bad_value);
+            let code = if err.downcast_ref::<UsageError>().is_some() || bad_value {
                 2
             } else {
                 1

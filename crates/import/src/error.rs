@@ -152,6 +152,17 @@ pub enum LoadError {
         /// Where (line, material, value) and what is wrong.
         message: String,
     },
+    /// A participating medium that cannot be used: a negative or non-finite coefficient, g
+    /// outside (−1, 1), a medium on a mesh that is not closed, an index out of range. The CLI
+    /// treats it as a usage error (exit 2), as it does a bad density grid file
+    /// ([`LoadError::VolumeFile`]).
+    #[error("{}: {message}", path.display())]
+    BadMedium {
+        /// The file.
+        path: PathBuf,
+        /// Which value and what is wrong.
+        message: String,
+    },
     /// `format` is not 1.
     #[error("{}: unsupported scene format version {found} (this loader reads format = 1)", path.display())]
     UnsupportedVersion {
@@ -352,6 +363,28 @@ impl LoadError {
         matches!(self, Self::BadSpectrum { .. })
     }
 
+    /// The same error as a [`LoadError::BadMedium`]: its message (after the file name) kept.
+    #[must_use]
+    pub fn into_bad_medium(self) -> Self {
+        let path = self.path().to_path_buf();
+        let text = self.to_string();
+        let prefix = format!("{}: ", path.display());
+        let message = text.strip_prefix(&prefix).unwrap_or(&text).to_owned();
+        Self::BadMedium { path, message }
+    }
+
+    /// Whether the error is a value the scene's author must change that the issues of spectra
+    /// and media ask to be reported as a usage error (exit 2): a bad spectrum or dispersion law
+    /// ([`LoadError::BadSpectrum`]), a bad medium ([`LoadError::BadMedium`]) or a bad density
+    /// grid file ([`LoadError::VolumeFile`]).
+    #[must_use]
+    pub fn is_bad_value(&self) -> bool {
+        matches!(
+            self,
+            Self::BadSpectrum { .. } | Self::BadMedium { .. } | Self::VolumeFile { .. }
+        )
+    }
+
     /// The file the error is about.
     #[must_use]
     pub fn path(&self) -> &std::path::Path {
@@ -367,6 +400,7 @@ impl LoadError {
             | Self::UnknownMaterial { path, .. }
             | Self::InvalidValue { path, .. }
             | Self::BadSpectrum { path, .. }
+            | Self::BadMedium { path, .. }
             | Self::UnsupportedVersion { path, .. }
             | Self::Obj { path, .. }
             | Self::Mtl { path, .. }

@@ -480,7 +480,7 @@ pub(crate) fn finish(
         notes,
     };
     validate::primitives(&description).map_err(|e| invalid_in_file(e, path))?;
-    validate::media(&description).map_err(|e| invalid_in_file(e, path))?;
+    validate::media(&description).map_err(|e| invalid_in_file(e, path).into_bad_medium())?;
     Ok(description)
 }
 

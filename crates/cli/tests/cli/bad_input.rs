@@ -615,8 +615,9 @@ material = "lamp"
 }
 
 /// A medium's density grid that is broken (a `.vol` whose header and size disagree, a negative
-/// density, absurd dimensions): one line naming the grid file and the problem, exit 1 like
-/// every other bad scene file, and no output. A good grid renders with the path tracer.
+/// density, absurd dimensions): one line naming the grid file and the problem, exit 2 (a usage
+/// error, as issue #35 asks of bad media input), and no output. A good grid renders with the
+/// path tracer.
 #[test]
 fn bad_density_grids() {
     let dir = temp_dir("bad_grid");
@@ -670,7 +671,7 @@ interior = "smoke"
         check_in(
             &dir,
             &["render", "smoke.toml", "--method", "path", "--passes", "1"],
-            1,
+            2,
             &["smoke.vol", "invalid volume grid file", needle],
             &["smoke.toml", "smoke.vol"],
         );
@@ -681,6 +682,96 @@ interior = "smoke"
         &["render", "smoke.toml", "--method", "path", "--passes", "1"],
     )
     .ok();
+}
+
+/// Bad media (issue #35): a negative coefficient, g outside (−1, 1), a medium inside a mesh that
+/// is not closed, in the TOML, Mitsuba and pbrt formats: one line naming the file, the medium or
+/// shape and the value, exit 2, and no output.
+#[test]
+fn bad_media_are_usage_errors() {
+    let dir = temp_dir("bad_media");
+    let toml = |medium: &str, shape: &str| {
+        format!(
+            r#"format = 1
+[camera]
+position = [0.0, 0.0, 5.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 30.0
+[film]
+width = 8
+height = 8
+[media.fog]
+{medium}
+[materials.boundary]
+type = "interface"
+[[lights]]
+type = "point"
+position = [0.0, 3.0, 0.0]
+intensity = [1.0, 1.0, 1.0]
+{shape}
+"#
+        )
+    };
+    let sphere = "[[shapes]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = \"boundary\"\ninterior = \"fog\"";
+    // One face of a cube: a mesh that bounds nothing.
+    std::fs::write(
+        dir.join("face.obj"),
+        "v -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    let open = "[[shapes]]\ntype = \"mesh\"\nfile = \"face.obj\"\nmaterial = \"boundary\"\ninterior = \"fog\"";
+    let good = "sigma_a = [0.1, 0.1, 0.1]\nsigma_s = [0.2, 0.2, 0.2]";
+    let cases: [(&str, String, &[&str]); 3] = [
+        (
+            "negative.toml",
+            toml(
+                "sigma_a = [0.1, -0.1, 0.1]\nsigma_s = [0.2, 0.2, 0.2]",
+                sphere,
+            ),
+            &["negative.toml", "[media.fog] sigma_a", "-0.1"],
+        ),
+        (
+            "anisotropy.toml",
+            toml(&format!("{good}\ng = 1.0"), sphere),
+            &["anisotropy.toml", "[media.fog] g", "(-1, 1)"],
+        ),
+        (
+            "open.toml",
+            toml(good, open),
+            &["open.toml", "bounds a medium but is not closed"],
+        ),
+    ];
+    let mut files = vec!["face.obj".to_owned()];
+    for (name, text, needles) in cases {
+        std::fs::write(dir.join(name), text).unwrap();
+        files.push(name.to_owned());
+        files.sort();
+        let keep: Vec<&str> = files.iter().map(String::as_str).collect();
+        check_in(&dir, &["render", name, "--passes", "1"], 2, needles, &keep);
+    }
+    let mitsuba = r#"<scene version="3.0.0">
+  <sensor type="perspective"><float name="fov" value="30"/><film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>
+  <emitter type="point"><point name="position" x="0" y="3" z="0"/></emitter>
+  <shape type="sphere"><bsdf type="null"/>
+    <medium type="homogeneous" name="interior"><rgb name="sigma_t" value="1"/><rgb name="albedo" value="0.5"/>
+      <phase type="hg"><float name="g" value="-1.5"/></phase></medium></shape>
+</scene>"#;
+    std::fs::write(dir.join("hg.xml"), mitsuba).unwrap();
+    fppm(&dir, &["render", "hg.xml", "--passes", "1"]).fails(2, &["hg.xml", "g", "(-1, 1)"]);
+    let pbrt = r#"LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+WorldBegin
+LightSource "point" "point3 from" [0 3 0]
+MakeNamedMedium "fog" "string type" "homogeneous" "rgb sigma_a" [-1 0 0] "rgb sigma_s" [1 1 1]
+AttributeBegin
+MediumInterface "fog" ""
+Material "interface"
+Shape "sphere" "float radius" 1
+AttributeEnd
+"#;
+    std::fs::write(dir.join("fog.pbrt"), pbrt).unwrap();
+    fppm(&dir, &["render", "fog.pbrt", "--passes", "1"]).fails(2, &["fog.pbrt", "sigma_a"]);
 }
 
 /// Bad spectral input (issue #34): a negative or decreasing wavelength list, a Sellmeier law

@@ -156,7 +156,9 @@ impl<'a> Importer<'a> {
             .string(volume, "filename")?
             .ok_or_else(|| self.err(volume, "needs a filename"))?;
         let path = self.doc.resolve(volume, file);
-        let vol = crate::vol::load_vol(&path).map_err(|e| self.err(volume, e.to_string()))?;
+        // A bad grid file is a bad medium (exit 2), named with the XML line that refers to it.
+        let vol = crate::vol::load_vol(&path)
+            .map_err(|e| self.err(volume, e.to_string()).into_bad_medium())?;
         let (min, max) = if self.boolean(volume, "use_grid_bbox")?.unwrap_or(false) {
             (vol.min, vol.max)
         } else {
@@ -171,7 +173,10 @@ impl<'a> Importer<'a> {
             max,
             to_world,
         )
-        .map_err(|e| self.err(volume, crate::vol::vol_error(&path, e).to_string()))
+        .map_err(|e| {
+            self.err(volume, crate::vol::vol_error(&path, e).to_string())
+                .into_bad_medium()
+        })
     }
 
     /// The media a shape or sensor names: its `<medium name="…">` children and `<ref name="…">`

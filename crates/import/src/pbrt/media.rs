@@ -103,7 +103,8 @@ impl Parser {
                 .map_err(|_| parser.err(loc, format!("{label}: \"{axis}\" must be >= 0, got {n}")))
         };
         let size = [dim(self, "nx")?, dim(self, "ny")?, dim(self, "nz")?];
-        let bad = |e: scene::GridError| self.err(loc, format!("{label}: {e}"));
+        // A bad grid is a bad medium (exit 2), as a bad `.vol` file is.
+        let bad = |e: scene::GridError| self.err(loc, format!("{label}: {e}")).into_bad_medium();
         // The dimensions are checked before the values are converted.
         scene::check_grid_size(u64::from(size[0]), u64::from(size[1]), u64::from(size[2]))
             .map_err(bad)?;
@@ -122,8 +123,7 @@ impl Parser {
         let p0 = point(self, "p0", Vec3::ZERO)?;
         let p1 = point(self, "p1", Vec3::ONE)?;
         let to_world = glam::Affine3A::from_mat4(self.state.ctm.as_mat4());
-        scene::DensityGrid::new(size, density, scene::GridEdge::Zero, p0, p1, to_world)
-            .map_err(|e| self.err(loc, format!("{label}: {e}")))
+        scene::DensityGrid::new(size, density, scene::GridEdge::Zero, p0, p1, to_world).map_err(bad)
     }
 
     /// The index of the medium `name` ("" is vacuum), or an error at `loc` if none was made.

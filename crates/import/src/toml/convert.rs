@@ -72,7 +72,14 @@ impl Converter<'_> {
         mut file: SceneFile,
         options: &LoadOptions,
     ) -> Result<SceneDescription, LoadError> {
-        let media = self.media(std::mem::take(&mut file.media))?;
+        // A medium's bad value is a usage error (exit 2); a grid file that cannot be read
+        // keeps its own error.
+        let media = self
+            .media(std::mem::take(&mut file.media))
+            .map_err(|e| match e {
+                LoadError::InvalidValue { .. } => e.into_bad_medium(),
+                e => e,
+            })?;
         let camera_medium = file.camera.as_mut().and_then(|c| c.medium.take());
         let camera_medium = self.medium_ref(&media, "[camera] medium", camera_medium.as_deref())?;
         let mut shape_media = Vec::new();
