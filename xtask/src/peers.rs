@@ -29,7 +29,7 @@ Renders every scene of scenes/peers/ (or those named: a name of scenes/peers/, `
 e.g. ../shared/scenes/cornell_box/CornellBox-Water.obj) with each fppm method and each Mitsuba 3
 integrator for the same wall-clock time, one renderer at a time, all with --threads threads,
 and scores them against a Mitsuba `path` reference (`volpath` for a scene with participating
-media; max_depth unlimited) rendered as two
+media; max_depth the scene's own, as fppm renders it, else unlimited) rendered as two
 independent halves of --reference-seconds / 2 each (kept in DIR/SCENE/ and reused; delete them
 to re-render). Reports relMSE (mean of (x - ref)^2 / (ref^2 + 0.01)) over all pixels, over
 the pixels whose first hit is diffuse and over those whose first hit is a mirror or glass, the
@@ -539,11 +539,12 @@ fn run_mitsuba(
 /// (`raw`); a homogeneous medium is a `homogeneous` medium ([`medium_xml`]), a grid medium a
 /// `heterogeneous` one with its `.vol` beside the XML ([`grid_medium_xml`]), that shapes refer
 /// to as `interior` and `exterior` and the sensor as its `medium`, the interface material a
-/// `null` BSDF; the integrator is `$integrator` with unlimited depth (by default `volpath`
+/// `null` BSDF; the integrator is `$integrator` with the scene's depth, else unlimited (by default `volpath`
 /// for a scene with media, else `path`); the environment is Mitsuba's
 /// `constant` or `envmap` ([`environment_emitter`]); a rough dielectric is `roughdielectric`
 /// (GGX), a glossy conductor a two-sided `roughconductor` of the η whose exact Fresnel fppm's
-/// Schlick approximates, a glossy coat over a diffuse base a two-sided `roughplastic`. Lights
+/// Schlick approximates, a glossy coat over a diffuse base fppm's own model as the Python BSDF
+/// `fppmglossy` (`xtask/peers/fppm_glossy.py`, which `render_mitsuba.py` registers). Lights
 /// other than emissive surfaces, point and directional lights and the environment are refused:
 /// the peer scenes do not use them.
 pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -> Result<PathBuf> {
@@ -556,9 +557,16 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
         reference_integrator(description)
     )?;
     writeln!(xml, "  <default name=\"spp\" value=\"16\"/>")?;
+    // The depth fppm renders: a scene's own `max_depth` (read from a Mitsuba or pbrt file)
+    // counts scattering events, Mitsuba's path segments, one more; else unlimited.
+    let max_depth = description
+        .render
+        .get("max_depth")
+        .and_then(|d| d.parse::<i64>().ok())
+        .map_or(-1, |d| d + 1);
     writeln!(
         xml,
-        "  <integrator type=\"$integrator\"><integer name=\"max_depth\" value=\"-1\"/></integrator>"
+        "  <integrator type=\"$integrator\"><integer name=\"max_depth\" value=\"{max_depth}\"/></integrator>"
     )?;
     let c = &description.camera;
     if c.aperture_radius > 0.0 {
@@ -659,20 +667,26 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
                     rgb(fits.map(|f| f.1))
                 )
             }
-            // A coat over a diffuse base: Mitsuba's `roughplastic` with the coat's ior 1.5
-            // (F₀ = 0.04), as the Mitsuba importer reads it back (`specular_reflectance`
-            // scales the coat's Fresnel, `diffuse_reflectance` is under it). Its base scatters
-            // inside the coat, fppm's is coupled by Ashikhmin and Shirley's factor: close, not
-            // equal.
+            // A coat over a diffuse base: fppm's own model, a Python BSDF of the peers'
+            // script (no built-in Mitsuba BSDF is it: `roughplastic` scatters its base inside
+            // the coat and put CornellBox-Glossy's mean 3.7 % away).
             scene::MaterialKind::Glossy(scene::Glossy {
                 reflectance,
                 roughness,
                 diffuse,
-            }) => format!(
-                "<bsdf type=\"twosided\"><bsdf type=\"roughplastic\"><string name=\"distribution\" value=\"ggx\"/><float name=\"int_ior\" value=\"1.5\"/><float name=\"ext_ior\" value=\"1.0\"/><float name=\"alpha\" value=\"{roughness}\"/><rgb name=\"specular_reflectance\" value=\"{}\"/><rgb name=\"diffuse_reflectance\" value=\"{}\"/></bsdf></bsdf>",
-                rgb((reflectance / 0.04).min(Vec3::ONE).to_array()),
-                rgb((diffuse / 0.96).min(Vec3::ONE).to_array())
-            ),
+            }) => {
+                let c = |name: &str, v: Vec3| {
+                    format!(
+                        "<float name=\"{name}_r\" value=\"{}\"/><float name=\"{name}_g\" value=\"{}\"/><float name=\"{name}_b\" value=\"{}\"/>",
+                        v.x, v.y, v.z
+                    )
+                };
+                format!(
+                    "<bsdf type=\"fppmglossy\">{}{}<float name=\"alpha\" value=\"{roughness}\"/></bsdf>",
+                    c("ks", reflectance),
+                    c("kd", diffuse)
+                )
+            }
             // The conductor with its RGB η and k, as Mitsuba's RGB variants render it.
             scene::MaterialKind::Conductor(c) => {
                 let kind = if c.is_smooth() {

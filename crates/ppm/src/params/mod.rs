@@ -260,6 +260,16 @@ pub struct FrequencyParams {
     /// shrinks at once to the distance where the disc leaves the surface, which removes most of
     /// photon mapping's corner bias.
     pub clear_cap: bool,
+    /// Where the frequency prediction is smaller than a slot's radius, cap the radius there
+    /// (rescaling N and τ as a PPM shrink), never below this fraction of R₀; `None` leaves
+    /// such slots to the PPM schedule. A directly seen slot whose kernel shrinks below a camera
+    /// sample or two is then estimated by its connections to the camera (light tracing), so the
+    /// floor can lie far below `clear_cap`'s R₀/4.
+    pub cap_floor: Option<f64>,
+    /// The cap is this multiple of the frequency radius, in [1, 64]: the prediction is made to
+    /// stop shrinking where the light is smooth, and a cap at a multiple of it shrinks only where
+    /// the light is much sharper than the kernel.
+    pub cap_scale: f64,
     /// Whether the candidates of a 2 × 2 block of pixels (every slot of it under `clear_cap`)
     /// share one clear-disc probe for 16 passes where their visible points lie in one plane
     /// well inside the probed disc (`PhotonMapper::probe_clear_radii`); otherwise every
@@ -449,6 +459,8 @@ impl RenderParams {
                 hold_alpha: 0.9,
                 pilot: 4,
                 clear_cap: true,
+                cap_floor: None,
+                cap_scale: 1.0,
                 probe_share: true,
             },
             pool: Pooling {
@@ -508,6 +520,14 @@ impl RenderParams {
         }
         if !(1.0..=64.0).contains(&self.frequency.grow) {
             return Err(out("freq_grow", self.frequency.grow, "[1, 64]"));
+        }
+        if let Some(f) = self.frequency.cap_floor
+            && !(f > 0.0 && f <= 1.0)
+        {
+            return Err(out("freq_cap", f, "(0, 1] or off"));
+        }
+        if !(1.0..=64.0).contains(&self.frequency.cap_scale) {
+            return Err(out("freq_cap_scale", self.frequency.cap_scale, "[1, 64]"));
         }
         if !(self.frequency.hold_alpha > 0.0 && self.frequency.hold_alpha <= 1.0) {
             return Err(out("freq_hold_alpha", self.frequency.hold_alpha, "(0, 1]"));

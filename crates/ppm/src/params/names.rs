@@ -344,6 +344,42 @@ pub const PARAMS: &[Param] = &[
         },
     },
     Param {
+        name: "freq_cap",
+        flag: "freq-cap",
+        help: "Cap every slot of a frequency method at its frequency radius where that is smaller, never below FLOOR times the initial radius, FLOOR in (0, 1]; off leaves such slots to the SPPM schedule [default: off]",
+        kind: ParamKind::Value {
+            value_name: "FLOOR",
+            choices: &[],
+        },
+        get: |p| {
+            p.frequency
+                .cap_floor
+                .map_or_else(|| "off".to_owned(), |f| f.to_string())
+        },
+        set: |p, v| {
+            p.frequency.cap_floor = if v == "off" {
+                None
+            } else {
+                Some(parse_number(v)?)
+            };
+            Ok(())
+        },
+    },
+    Param {
+        name: "freq_cap_scale",
+        flag: "freq-cap-scale",
+        help: "With --freq-cap: cap at this multiple of the frequency radius, in [1, 64] [default: 1]",
+        kind: ParamKind::Value {
+            value_name: "C",
+            choices: &[],
+        },
+        get: |p| p.frequency.cap_scale.to_string(),
+        set: |p, v| {
+            p.frequency.cap_scale = parse_number(v)?;
+            Ok(())
+        },
+    },
+    Param {
         name: "freq_probe_share",
         flag: "no-freq-probe-share",
         help: "Let every candidate of a frequency method probe its own clear disc (by default the candidates of a 2x2 block of pixels share one probe for 16 passes where their points lie in one plane inside it)",
@@ -686,6 +722,8 @@ mod tests {
         params.frequency.hold_alpha = 1.0;
         params.frequency.pilot = 0;
         params.frequency.clear_cap = false;
+        params.frequency.cap_floor = Some(0.0625);
+        params.frequency.cap_scale = 4.0;
         params.connections.light_tracing = false;
         params.frequency.probe_share = false;
         for base in [RenderParams::preview(), params] {

@@ -4,9 +4,10 @@
 use std::time::Instant;
 
 use rayon::prelude::*;
+use scene::MaterialKind;
 
-use super::{PassStats, PhotonMapper, frequency};
-use crate::update::GatherStats;
+use super::{NO_VISIBLE_POINT, PassStats, PhotonMapper, frequency};
+use crate::update::{FrequencyRadius, GatherStats};
 
 impl PhotonMapper {
     /// Folds the last photon pass into every slot, and reports the radii and the share of
@@ -28,6 +29,34 @@ impl PhotonMapper {
         // The cap never goes below a quarter of the initial radius: a smaller disc collects
         // too few photons per pass for its bias gain to pay (measured, docs/integrators.md).
         let r_min = 0.25 * self.setup.kernel_scale;
+        // The frequency cap, only where the camera sees the slot directly and connections to
+        // the camera take over as its kernel shrinks below a camera sample or two: a slot seen
+        // through mirrors or glass has no other estimate than its merges.
+        let freq_cap = params
+            .frequency
+            .cap_floor
+            .filter(|_| uses_frequency && params.connections.light_tracing)
+            .map(|f| (f * self.setup.kernel_scale, params.frequency.cap_scale));
+        // Which slots it caps: a diffuse visible point seen directly (seen on a glossy surface
+        // or through mirrors and glass, a connection is a poor estimate or none).
+        let capped: Vec<bool> = if freq_cap.is_some() {
+            let direct_budget = u16::try_from(params.budget.max_depth - 1).unwrap_or(u16::MAX);
+            let scene = &self.setup.scene;
+            let materials = self.slots.material_idx();
+            self.photon_bounces
+                .par_iter()
+                .zip(materials.par_iter())
+                .map(|(&budget, &material)| {
+                    budget != NO_VISIBLE_POINT
+                        && budget >= direct_budget
+                        && scene
+                            .material(material)
+                            .is_some_and(|m| matches!(m.kind, MaterialKind::Diffuse(_)))
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         let photons = &self.photons;
         let n_slots = self.slots.len();
         let columns = self.slots.columns_mut();
@@ -59,6 +88,12 @@ impl PhotonMapper {
                     stats.update_with_hold(m, phi, alpha, r_freq, floor, hold_alpha);
                     if clear_cap && let Some(clear) = freq.clear_radius(r_top) {
                         stats.cap_radius(clear.max(r_min));
+                    }
+                    if let (Some((floor, scale)), FrequencyRadius::Predicted(r)) =
+                        (freq_cap, r_freq)
+                        && capped.get(slot).copied().unwrap_or(false)
+                    {
+                        stats.cap_radius((scale * r).max(floor));
                     }
                     *radius = stats.radius;
                     *photon_count = stats.photon_count;

@@ -133,3 +133,162 @@ fn capping_a_radius_keeps_the_estimate_of_a_uniform_density() {
     stats.cap_radius(1.0);
     assert_eq!(stats, copy);
 }
+
+/// The plane under its point light with a black square at half the light's height: the floor's
+/// shadow is the square scaled by 2, |x|, |z| < 0.4, with edges as sharp as the light.
+const SHADOWED_PLANE: &str = r#"
+format = 1
+[camera]
+position = [0.0, 2.0, 2.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 50.0
+[film]
+width = 40
+height = 40
+[materials.floor]
+type = "diffuse"
+albedo = [0.8, 0.8, 0.8]
+[materials.black]
+type = "diffuse"
+albedo = [0.0, 0.0, 0.0]
+[[shapes]]
+type = "quad"
+corner = [-100.0, 0.0, 100.0]
+edge1 = [200.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, -200.0]
+material = "floor"
+[[shapes]]
+type = "quad"
+corner = [-0.2, 0.5, 0.2]
+edge1 = [0.4, 0.0, 0.0]
+edge2 = [0.0, 0.0, -0.4]
+material = "black"
+[[lights]]
+type = "point"
+position = [0.0, 1.0, 0.0]
+intensity = [10.0, 10.0, 10.0]
+"#;
+
+/// The exact pixel averages of [`SHADOWED_PLANE`] (8×8 sub-pixel rays): 0 on the black square
+/// and in its shadow, the inverse-square law elsewhere.
+fn shadowed_plane_reference(scene: &scene::Scene) -> Vec<f64> {
+    use glam::{Vec2, Vec3};
+    let (width, height) = scene.camera().resolution();
+    let light = Vec3::new(0.0, 1.0, 0.0);
+    let mut out = Vec::new();
+    for y in 0..height {
+        for x in 0..width {
+            let mut sum = 0.0;
+            for j in 0..8 {
+                for i in 0..8 {
+                    let film = Vec2::new(
+                        x as f32 + (i as f32 + 0.5) / 8.0,
+                        y as f32 + (j as f32 + 0.5) / 8.0,
+                    );
+                    let ray = scene.camera().generate_ray(film, Vec2::splat(0.5));
+                    let top = ray.at((0.5 - ray.origin.y) / ray.direction.y);
+                    if top.x.abs() < 0.2 && top.z.abs() < 0.2 {
+                        continue;
+                    }
+                    let t = -ray.origin.y / ray.direction.y;
+                    let p = ray.at(t);
+                    if t <= 0.0 || (p.x.abs() < 0.4 && p.z.abs() < 0.4) {
+                        continue;
+                    }
+                    let to_light = light - p;
+                    let d2 = f64::from(to_light.length_squared());
+                    sum +=
+                        0.8 / std::f64::consts::PI * 10.0 * f64::from(to_light.y) / d2.sqrt() / d2;
+                }
+            }
+            out.push(sum / 64.0);
+        }
+    }
+    out
+}
+
+#[test]
+fn the_frequency_cap_sharpens_a_shadow_edge_towards_the_analytic_image() {
+    // Kernels of a few pixels blur the shadow's edge; the frequency photons' occlusion probes
+    // predict radii far below that there, and the cap (`freq_cap`) brings the kernels down to
+    // them, where the connections to the camera take over. Scored against the analytic pixel
+    // averages over the pixels within two of the edge, and over the lit floor for the mean.
+    let scene = scene(SHADOWED_PLANE);
+    let reference = shadowed_plane_reference(&scene);
+    let (width, height) = scene.camera().resolution();
+    let (w, h) = (width as usize, height as usize);
+    let peak = reference.iter().copied().fold(0.0, f64::max);
+    // A pixel near the edge: its 5×5 neighbourhood holds both lit and shadowed pixels.
+    let near_edge: Vec<bool> = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as i64, (i / w) as i64);
+            let mut lit = false;
+            let mut dark = false;
+            for dy in -2..=2 {
+                for dx in -2..=2 {
+                    let (u, v) = (x + dx, y + dy);
+                    if u < 0 || v < 0 || u >= w as i64 || v >= h as i64 {
+                        continue;
+                    }
+                    let r = reference[v as usize * w + u as usize];
+                    lit |= r > 0.3 * peak;
+                    dark |= r == 0.0;
+                }
+            }
+            lit && dark
+        })
+        .collect();
+    let edge_error = |image: &[[f32; 3]]| {
+        let (mut sum, mut n) = (0.0, 0);
+        for (i, pixel) in image.iter().enumerate() {
+            if near_edge[i] {
+                let d = f64::from(pixel[1]) - reference[i];
+                sum += d * d / (reference[i] * reference[i] + 0.01 * peak * peak);
+                n += 1;
+            }
+        }
+        (sum / f64::from(n), n)
+    };
+    let mut errors = Vec::new();
+    for cap in [None, Some(1.0 / 16.0)] {
+        let mut p = params(Method::FreqSppm, 100_000);
+        p.kernel.initial_radius = Some(0.3);
+        p.connections.direct_lighting = false;
+        p.frequency.cap_floor = cap;
+        p.frequency.cap_scale = 4.0;
+        let image = render(&scene, p, 16);
+        let (error, n) = edge_error(&image);
+        assert!(n >= 60, "only {n} pixels near the edge");
+        // The lit floor away from the edge, where blur cannot move the mean.
+        let lit: Vec<usize> = (0..w * h)
+            .filter(|&i| reference[i] >= 0.5 * peak && !near_edge[i])
+            .collect();
+        let ratio = lit
+            .iter()
+            .map(|&i| f64::from(image[i][1]) / reference[i])
+            .sum::<f64>()
+            / lit.len() as f64;
+        println!("cap {cap:?}: relMSE near the edge {error:.5}, lit mean ratio {ratio:.4}");
+        assert!(
+            (ratio - 1.0).abs() < 0.03,
+            "cap {cap:?}: mean ratio to the analytic radiance {ratio} on the lit floor"
+        );
+        errors.push(error);
+    }
+    assert!(
+        errors[1] < 0.5 * errors[0],
+        "the cap left the shadow edge's error at {} against {} without it",
+        errors[1],
+        errors[0]
+    );
+}
+
+#[test]
+fn the_frequency_cap_keeps_the_furnace_radiance() {
+    let scene = scene(FURNACE);
+    let mut p = params(Method::FreqSppm, 20_000);
+    p.budget.max_depth = 64;
+    p.frequency.cap_floor = Some(1.0 / 64.0);
+    let m = mean(&render(&scene, p, 8));
+    assert!((m - 1.0).abs() < 0.02, "mean radiance {m}, expected 1");
+}
