@@ -264,9 +264,9 @@ pub struct FrequencyParams {
     /// (rescaling N and τ as a PPM shrink), never below this fraction of R₀; `None` leaves
     /// such slots to the PPM schedule. A directly seen slot whose kernel shrinks below a camera
     /// sample or two is then estimated by its connections to the camera (light tracing), so the
-    /// floor can lie far below `clear_cap`'s R₀/4.
+    /// floor can lie far below `clear_cap`'s R₀/4. R₀/16 by default (docs/integrators.md).
     pub cap_floor: Option<f64>,
-    /// The cap is this multiple of the frequency radius, in [1, 64]: the prediction is made to
+    /// The cap is this multiple of the frequency radius, in [1, 64] (4 by default): the prediction is made to
     /// stop shrinking where the light is smooth, and a cap at a multiple of it shrinks only where
     /// the light is much sharper than the kernel.
     pub cap_scale: f64,
@@ -459,8 +459,8 @@ impl RenderParams {
                 hold_alpha: 0.9,
                 pilot: 4,
                 clear_cap: true,
-                cap_floor: None,
-                cap_scale: 1.0,
+                cap_floor: Some(1.0 / 16.0),
+                cap_scale: 4.0,
                 probe_share: true,
             },
             pool: Pooling {

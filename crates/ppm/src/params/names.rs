@@ -346,7 +346,7 @@ pub const PARAMS: &[Param] = &[
     Param {
         name: "freq_cap",
         flag: "freq-cap",
-        help: "Cap every slot of a frequency method at its frequency radius where that is smaller, never below FLOOR times the initial radius, FLOOR in (0, 1]; off leaves such slots to the SPPM schedule [default: off]",
+        help: "Cap every slot of a frequency method at its frequency radius where that is smaller, at a diffuse point seen directly (where connections to the camera take over), never below FLOOR times the initial radius, FLOOR in (0, 1]; off leaves such slots to the SPPM schedule [default: 0.0625, measured in docs/integrators.md]",
         kind: ParamKind::Value {
             value_name: "FLOOR",
             choices: &[],
@@ -368,7 +368,7 @@ pub const PARAMS: &[Param] = &[
     Param {
         name: "freq_cap_scale",
         flag: "freq-cap-scale",
-        help: "With --freq-cap: cap at this multiple of the frequency radius, in [1, 64] [default: 1]",
+        help: "With --freq-cap: cap at this multiple of the frequency radius, in [1, 64] [default: 4]",
         kind: ParamKind::Value {
             value_name: "C",
             choices: &[],
@@ -722,8 +722,8 @@ mod tests {
         params.frequency.hold_alpha = 1.0;
         params.frequency.pilot = 0;
         params.frequency.clear_cap = false;
-        params.frequency.cap_floor = Some(0.0625);
-        params.frequency.cap_scale = 4.0;
+        params.frequency.cap_floor = None;
+        params.frequency.cap_scale = 2.0;
         params.connections.light_tracing = false;
         params.frequency.probe_share = false;
         for base in [RenderParams::preview(), params] {
