@@ -179,11 +179,13 @@ position = [0.0, 1.0, 0.0]
 intensity = [10.0, 10.0, 10.0]
 "#;
 
-/// The exact pixel averages of the plane scene: 8×8 sub-pixel rays per pixel through the
-/// camera model, intersected with y = 0 analytically.
-pub(crate) fn plane_reference(scene: &scene::Scene) -> Vec<f64> {
+/// The pixel averages of `radiance` (of a camera ray through the lens centre) over 8×8
+/// sub-pixel rays per pixel, in film order.
+pub(crate) fn pixel_averages(
+    scene: &scene::Scene,
+    radiance: impl Fn(&scene::Ray) -> f64,
+) -> Vec<f64> {
     let (width, height) = scene.camera().resolution();
-    let light = glam::Vec3::new(0.0, 1.0, 0.0);
     let mut out = Vec::new();
     for y in 0..height {
         for x in 0..width {
@@ -194,21 +196,28 @@ pub(crate) fn plane_reference(scene: &scene::Scene) -> Vec<f64> {
                         x as f32 + (i as f32 + 0.5) / 8.0,
                         y as f32 + (j as f32 + 0.5) / 8.0,
                     );
-                    let ray = scene.camera().generate_ray(film, Vec2::splat(0.5));
-                    let t = -ray.origin.y / ray.direction.y;
-                    if t > 0.0 {
-                        let p = ray.at(t);
-                        let to_light = light - p;
-                        let d2 = f64::from(to_light.length_squared());
-                        let cos = f64::from(to_light.y) / d2.sqrt();
-                        sum += 0.8 / PI * 10.0 * cos / d2;
-                    }
+                    sum += radiance(&scene.camera().generate_ray(film, Vec2::splat(0.5)));
                 }
             }
             out.push(sum / 64.0);
         }
     }
     out
+}
+
+/// The exact pixel averages of the plane scene: 8×8 sub-pixel rays per pixel through the
+/// camera model, intersected with y = 0 analytically.
+pub(crate) fn plane_reference(scene: &scene::Scene) -> Vec<f64> {
+    let light = glam::Vec3::new(0.0, 1.0, 0.0);
+    pixel_averages(scene, |ray| {
+        let t = -ray.origin.y / ray.direction.y;
+        if t <= 0.0 {
+            return 0.0;
+        }
+        let to_light = light - ray.at(t);
+        let d2 = f64::from(to_light.length_squared());
+        0.8 / PI * 10.0 * f64::from(to_light.y) / d2.sqrt() / d2
+    })
 }
 
 #[test]

@@ -4,7 +4,7 @@
 
 use ppm::{FrequencyFloor, FrequencyRadius, GatherStats, Method, Renderer};
 
-use crate::analytic::{FURNACE, PLANE};
+use crate::analytic::{FURNACE, PLANE, pixel_averages};
 use crate::support::{mean, params, render, scene};
 
 #[test]
@@ -172,39 +172,21 @@ intensity = [10.0, 10.0, 10.0]
 /// The exact pixel averages of [`SHADOWED_PLANE`] (8×8 sub-pixel rays): 0 on the black square
 /// and in its shadow, the inverse-square law elsewhere.
 fn shadowed_plane_reference(scene: &scene::Scene) -> Vec<f64> {
-    use glam::{Vec2, Vec3};
-    let (width, height) = scene.camera().resolution();
-    let light = Vec3::new(0.0, 1.0, 0.0);
-    let mut out = Vec::new();
-    for y in 0..height {
-        for x in 0..width {
-            let mut sum = 0.0;
-            for j in 0..8 {
-                for i in 0..8 {
-                    let film = Vec2::new(
-                        x as f32 + (i as f32 + 0.5) / 8.0,
-                        y as f32 + (j as f32 + 0.5) / 8.0,
-                    );
-                    let ray = scene.camera().generate_ray(film, Vec2::splat(0.5));
-                    let top = ray.at((0.5 - ray.origin.y) / ray.direction.y);
-                    if top.x.abs() < 0.2 && top.z.abs() < 0.2 {
-                        continue;
-                    }
-                    let t = -ray.origin.y / ray.direction.y;
-                    let p = ray.at(t);
-                    if t <= 0.0 || (p.x.abs() < 0.4 && p.z.abs() < 0.4) {
-                        continue;
-                    }
-                    let to_light = light - p;
-                    let d2 = f64::from(to_light.length_squared());
-                    sum +=
-                        0.8 / std::f64::consts::PI * 10.0 * f64::from(to_light.y) / d2.sqrt() / d2;
-                }
-            }
-            out.push(sum / 64.0);
+    let light = glam::Vec3::new(0.0, 1.0, 0.0);
+    pixel_averages(scene, |ray| {
+        let top = ray.at((0.5 - ray.origin.y) / ray.direction.y);
+        let t = -ray.origin.y / ray.direction.y;
+        let p = ray.at(t);
+        if (top.x.abs() < 0.2 && top.z.abs() < 0.2)
+            || t <= 0.0
+            || (p.x.abs() < 0.4 && p.z.abs() < 0.4)
+        {
+            return 0.0;
         }
-    }
-    out
+        let to_light = light - p;
+        let d2 = f64::from(to_light.length_squared());
+        0.8 / std::f64::consts::PI * 10.0 * f64::from(to_light.y) / d2.sqrt() / d2
+    })
 }
 
 #[test]
