@@ -350,10 +350,7 @@ impl LoadError {
     /// The same error as a [`LoadError::BadSpectrum`]: its message (after the file name) kept.
     #[must_use]
     pub fn into_bad_spectrum(self) -> Self {
-        let path = self.path().to_path_buf();
-        let text = self.to_string();
-        let prefix = format!("{}: ", path.display());
-        let message = text.strip_prefix(&prefix).unwrap_or(&text).to_owned();
+        let (path, message) = self.into_path_and_message();
         Self::BadSpectrum { path, message }
     }
 
@@ -366,11 +363,17 @@ impl LoadError {
     /// The same error as a [`LoadError::BadMedium`]: its message (after the file name) kept.
     #[must_use]
     pub fn into_bad_medium(self) -> Self {
+        let (path, message) = self.into_path_and_message();
+        Self::BadMedium { path, message }
+    }
+
+    /// The file and the message after its name, to carry into another kind of error.
+    fn into_path_and_message(self) -> (PathBuf, String) {
         let path = self.path().to_path_buf();
         let text = self.to_string();
         let prefix = format!("{}: ", path.display());
         let message = text.strip_prefix(&prefix).unwrap_or(&text).to_owned();
-        Self::BadMedium { path, message }
+        (path, message)
     }
 
     /// Whether the error is a value the scene's author must change that the issues of spectra

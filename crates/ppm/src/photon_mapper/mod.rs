@@ -110,6 +110,14 @@ pub(crate) const NO_VISIBLE_POINT: u16 = u16::MAX;
 /// The largest photon-bounce budget a slot can have.
 const MAX_PHOTON_BUDGET: u16 = NO_VISIBLE_POINT - 1;
 
+/// Whether a slot's photon-bounce budget says the camera sees its visible point directly (no
+/// specular bounce before it), where a photon can be connected to the camera: the budget of a
+/// direct hit is `max_depth` − 1.
+pub(crate) fn seen_directly(budget: u16, max_depth: u32) -> bool {
+    let direct = u16::try_from(max_depth - 1).unwrap_or(u16::MAX);
+    budget != NO_VISIBLE_POINT && budget >= direct
+}
+
 /// The smallppm choice of initial radius: twice the mean extent of the scene's bounding box
 /// divided by the mean film size in pixels, about a two-pixel footprint.
 #[must_use]

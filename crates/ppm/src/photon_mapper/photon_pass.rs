@@ -12,7 +12,7 @@ use scene::{Bsdf, Rgb};
 use super::frequency::FrequencyPhoton;
 use super::index::NOT_IN_GRID;
 use super::trace::{LightTracing, TracedPhotons};
-use super::{NO_VISIBLE_POINT, PHOTON_CHUNK, PassStats, PhotonMapper};
+use super::{PHOTON_CHUNK, PassStats, PhotonMapper, seen_directly};
 use crate::rng::CONNECT_ONLY_STREAM;
 
 /// The photon pass's buffers and what it leaves for the update: M and Φ per grid entry.
@@ -194,8 +194,7 @@ impl PhotonMapper {
             // visible point; 1 where the camera sees it only through specular bounces (a
             // connection cannot reach it).
             let camera = setup.scene.camera();
-            let direct_budget =
-                u16::try_from(setup.params.budget.max_depth - 1).unwrap_or(u16::MAX);
+            let max_depth = setup.params.budget.max_depth;
             let (positions, normals) = (self.slots.position(), self.slots.geometric_normal());
             let (budgets, radii) = (&self.photon_bounces, self.slots.radius());
             let spp = setup.params.film.samples_per_pixel as usize;
@@ -204,7 +203,7 @@ impl PhotonMapper {
                 .merge_weight
                 .par_extend((0..n_slots).into_par_iter().map(|slot| {
                     let budget = budgets[slot];
-                    if budget == NO_VISIBLE_POINT || budget < direct_budget {
+                    if !seen_directly(budget, max_depth) {
                         return 1.0;
                     }
                     let rho = f64::from(camera.film_density(positions[slot], normals[slot]));

@@ -6,7 +6,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use scene::MaterialKind;
 
-use super::{NO_VISIBLE_POINT, PassStats, PhotonMapper, frequency};
+use super::{PassStats, PhotonMapper, frequency, seen_directly};
 use crate::update::{FrequencyRadius, GatherStats};
 
 impl PhotonMapper {
@@ -40,15 +40,14 @@ impl PhotonMapper {
         // Which slots it caps: a diffuse visible point seen directly (seen on a glossy surface
         // or through mirrors and glass, a connection is a poor estimate or none).
         let capped: Vec<bool> = if freq_cap.is_some() {
-            let direct_budget = u16::try_from(params.budget.max_depth - 1).unwrap_or(u16::MAX);
+            let max_depth = params.budget.max_depth;
             let scene = &self.setup.scene;
             let materials = self.slots.material_idx();
             self.photon_bounces
                 .par_iter()
                 .zip(materials.par_iter())
                 .map(|(&budget, &material)| {
-                    budget != NO_VISIBLE_POINT
-                        && budget >= direct_budget
+                    seen_directly(budget, max_depth)
                         && scene
                             .material(material)
                             .is_some_and(|m| matches!(m.kind, MaterialKind::Diffuse(_)))
