@@ -230,7 +230,7 @@ fn next_event_through(
 /// Russian roulette after a scattering event at `depth`: from `rr_depth` on, the path survives
 /// with the throughput's largest channel (at most one) and is divided by it; whether it goes on
 /// (a zero or non-finite throughput ends it too).
-fn roulette(beta: &mut Rgb, depth: u32, params: &RenderParams, u: f32) -> bool {
+pub(crate) fn roulette(beta: &mut Rgb, depth: u32, params: &RenderParams, u: f32) -> bool {
     if depth + 1 >= params.budget.rr_depth {
         let survive = beta.max_element().min(1.0);
         if survive <= 0.0 || u >= survive {

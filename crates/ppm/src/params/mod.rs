@@ -218,6 +218,15 @@ pub struct Connections {
     /// to what they light) and the camera pass is cheap beside the photons: 4 against 1 gave
     /// 0.50–1.07× the error at equal time on thirteen scenes (docs/convergence.md).
     pub direct_samples: u32,
+    /// SPPM and `freq-sppm`: camera paths pass through glossy surfaces whose GGX α is at most
+    /// this (0: none), as through mirrors, instead of leaving a visible point there; at each
+    /// such vertex the direct light is estimated by a light sample and a BSDF sample combined
+    /// by multiple importance sampling (the path tracer's next-event estimation) and the path
+    /// goes on along the BSDF sample to a rougher surface. Photons are neither stored nor
+    /// connected to the camera on those surfaces: the camera path accounts for all their
+    /// light. A sharp lobe seen through merging blurs and a connection to the camera rarely
+    /// lands in it; see docs/integrators.md for the measurement that chose the default.
+    pub glossy_continue: f64,
 }
 
 /// The frequency analysis of the frequency-guided methods (`freq`, `freq-sppm`, and `appm`'s
@@ -447,6 +456,7 @@ impl RenderParams {
                 extra_light_paths: 0.0,
                 direct_lighting: false,
                 direct_samples: 4,
+                glossy_continue: 0.0,
             },
             frequency: FrequencyParams {
                 fraction: 0.1,
@@ -560,6 +570,13 @@ impl RenderParams {
                 "direct_samples",
                 self.connections.direct_samples,
                 "[1, 64]",
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.connections.glossy_continue) {
+            return Err(out(
+                "glossy_continue",
+                self.connections.glossy_continue,
+                "[0, 1]",
             ));
         }
         if self.frequency.pilot > 1_000_000 {

@@ -513,6 +513,26 @@ pub const PARAMS: &[Param] = &[
         },
     },
     Param {
+        name: "glossy_continue",
+        flag: "glossy-continue",
+        help: "sppm and freq-sppm: camera paths go on through glossy surfaces of GGX alpha up to ALPHA, in [0, 1], with light and BSDF sampling there, instead of merging photons on them; off (or 0) merges on every non-specular surface [default: off]",
+        kind: ParamKind::Value {
+            value_name: "ALPHA",
+            choices: &[],
+        },
+        get: |p| {
+            if p.connections.glossy_continue == 0.0 {
+                "off".to_owned()
+            } else {
+                p.connections.glossy_continue.to_string()
+            }
+        },
+        set: |p, v| {
+            p.connections.glossy_continue = if v == "off" { 0.0 } else { parse_number(v)? };
+            Ok(())
+        },
+    },
+    Param {
         name: "pool",
         flag: "pool",
         help: "Photon mappers: pool the estimates of neighbouring pixels on the same surface when the image is read [default: freq]",

@@ -5,13 +5,13 @@
 use glam::{Vec2, Vec3};
 use photon::{HitPoints, NewHitPoint};
 use rayon::prelude::*;
-use scene::{Bsdf, Hit, Rgb, TransportMode, medium_after};
+use scene::{Bsdf, BsdfSample, Hit, Rgb, TransportMode, medium_after};
 
 use super::frequency::SlotFrequency;
 use super::pool::{SurfacePoint, same_surface};
 use super::volume::{Segment, stretch_transmittance};
 use super::{NO_VISIBLE_POINT, PhotonMapper, SLOT_CHUNK, Setup};
-use crate::path::{MAX_CROSSINGS, bsdf_emission_weight, next_event};
+use crate::path::{MAX_CROSSINGS, bsdf_emission_weight, next_event, roulette};
 use crate::rng::{CAMERA_STREAM, Sampler};
 
 /// Where a camera path records its stretches through media and their ratio-tracking walks.
@@ -341,6 +341,10 @@ impl Setup {
         // ends a light path with that many; a hitpoint adds one (its own scattering) to the
         // photon's, so it needs bounces < max_depth.
         let mut bounces = 0;
+        // The last vertex the path passed through on a glossy lobe (`glossy_continue`) and the
+        // BSDF sample it went on with: emission found next shares the light with the light
+        // sample taken there (`bsdf_emission_weight`).
+        let mut glossy: Option<(Hit, BsdfSample)> = None;
         loop {
             let hit = self.scene.intersect(&ray);
             if let Some(m) = medium.and_then(|m| self.scene.media().list.get(m as usize)) {
@@ -375,9 +379,18 @@ impl Setup {
                 }
                 throughput *= tr;
             }
+            // How much of the emission found next the path counts: all of it after the camera
+            // or a specular bounce, the MIS share after a glossy vertex.
+            let emission_weight = |next: Option<&Hit>| match &glossy {
+                Some((at, sample)) => bsdf_emission_weight(&self.scene, at, sample, next, &ray),
+                None => 1.0,
+            };
             let Some(hit) = hit else {
                 // An escaped camera path sees the environment (zero without one).
-                direct += throughput * self.scene.lights().environment_radiance(ray.direction);
+                let environment = self.scene.lights().environment_radiance(ray.direction);
+                if environment != Rgb::ZERO {
+                    direct += throughput * environment * emission_weight(None);
+                }
                 break;
             };
             if has_media && self.scene.is_interface(&hit) {
@@ -390,7 +403,10 @@ impl Setup {
                 left = hit.geometric_normal;
                 continue;
             }
-            direct += throughput * self.scene.emitted(&hit);
+            let emitted = self.scene.emitted(&hit);
+            if emitted != Rgb::ZERO {
+                direct += throughput * emitted * emission_weight(Some(&hit));
+            }
             if bounces == max_depth {
                 break;
             }
@@ -399,6 +415,28 @@ impl Setup {
             };
             let bsdf = self.scene.material_bsdf(material, &hit);
             let outgoing = -ray.direction;
+            glossy = None;
+            if self.passes_through(material) {
+                // The direct light here by next-event estimation, the rest along the BSDF.
+                let u_light = sampler.next_f32();
+                let u_light_2d = sampler.next_2d();
+                direct += throughput
+                    * next_event(&self.scene, &hit, &bsdf, outgoing, u_light, u_light_2d);
+                let u_lobe = sampler.next_f32();
+                let u = sampler.next_2d();
+                let u_roulette = sampler.next_f32();
+                let Some(sample) = bsdf.sample(outgoing, u_lobe, u, TransportMode::Radiance) else {
+                    break;
+                };
+                throughput *= sample.weight;
+                if !roulette(&mut throughput, bounces, &self.params, u_roulette) {
+                    break;
+                }
+                ray = hit.spawn_ray(sample.incoming);
+                glossy = Some((hit, sample));
+                bounces += 1;
+                continue;
+            }
             if bsdf.is_specular() {
                 let u_lobe = sampler.next_f32();
                 let u = sampler.next_2d();

@@ -33,7 +33,7 @@ use std::time::Instant;
 
 use photon::HitPoints;
 use rayon::prelude::*;
-use scene::Scene;
+use scene::{Lobe, Scene};
 use spectrum::Caps;
 
 pub use self::memory::bytes_per_hitpoint;
@@ -43,7 +43,7 @@ use self::{frequency::FrequencyDeposits, frequency::SlotFrequency, index::Index}
 use crate::aov::Aov;
 use crate::checkpoint::codec::{Reader, StateError, Writer};
 use crate::integrator::Integrator;
-use crate::params::{ParamError, RenderParams};
+use crate::params::{Method, ParamError, RenderParams};
 use crate::stats::{MemoryUse, PassStats};
 
 /// Photons per parallel work item. Fixed (not derived from the thread count) so that the
@@ -62,6 +62,9 @@ struct Setup {
     kernel_scale: f64,
     width: u32,
     height: u32,
+    /// The GGX α up to which camera paths pass through glossy surfaces (`glossy_continue`,
+    /// where this render honours it; 0 otherwise): [`Setup::passes_through`].
+    glossy_continue: f32,
 }
 
 /// The photon mappers' state: hitpoint slots with their statistics, the grid, the direct
@@ -131,6 +134,17 @@ pub fn auto_initial_radius(scene: &Scene) -> f64 {
     if r > 0.0 && r.is_finite() { r } else { 1e-3 }
 }
 
+impl Setup {
+    /// Whether camera paths pass through `material` (a glossy lobe no rougher than
+    /// `glossy_continue`) rather than leave a visible point on it; photons are then neither
+    /// stored nor connected to the camera there.
+    #[inline]
+    fn passes_through(&self, material: &scene::Material) -> bool {
+        self.glossy_continue > 0.0
+            && matches!(material.kind.lobe(), Lobe::Ggx { alpha } if alpha <= self.glossy_continue)
+    }
+}
+
 impl PhotonMapper {
     /// A renderer for `scene` with `params`; nothing is traced until the first pass.
     ///
@@ -156,6 +170,15 @@ impl PhotonMapper {
             .kernel
             .initial_radius
             .unwrap_or_else(|| auto_initial_radius(&scene));
+        // Only the methods that trace new camera paths every pass can pass through a glossy
+        // lobe (a fixed visible point behind it would keep one direction of the lobe for
+        // ever), and the light samples at those vertices do not render media.
+        let glossy_continue =
+            if matches!(params.method, Method::Sppm | Method::FreqSppm) && !scene.has_media() {
+                params.connections.glossy_continue as f32
+            } else {
+                0.0
+            };
         Ok(Self {
             setup: Setup {
                 scene,
@@ -164,6 +187,7 @@ impl PhotonMapper {
                 kernel_scale,
                 width: film.width,
                 height: film.height,
+                glossy_continue,
             },
             pass: 0,
             n_emitted: 0,

@@ -218,13 +218,16 @@ impl Setup {
             // With direct lighting by light sampling, photons straight from an emitter are
             // already accounted for at the hitpoints.
             let counted_by_light_sampling = direct_lighting && depth == 0;
-            if !bsdf.is_specular() && !counted_by_light_sampling && !STORE {
+            // Camera paths pass through the sharp glossy surfaces as through mirrors
+            // (`glossy_continue`): the light there is theirs, so nothing is stored or connected.
+            let merged_here = !bsdf.is_specular() && !self.passes_through(material);
+            if merged_here && !counted_by_light_sampling && !STORE {
                 if let Some(light) = light {
                     self.connect_to_camera::<MEDIA>(
                         &hit, &bsdf, incoming, power, medium, &sampler, depth, light, out,
                     );
                 }
-            } else if !bsdf.is_specular() && !counted_by_light_sampling {
+            } else if merged_here && !counted_by_light_sampling {
                 let tag = self.record_frequency_photon(
                     here,
                     &hit,

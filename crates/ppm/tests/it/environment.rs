@@ -167,33 +167,46 @@ fn sun_map() -> scene::EnvironmentMap {
     }
 }
 
-/// The irradiance on an upward surface under `map` (unrotated, +y up), per channel, summed
-/// texel by texel in closed form: a texel of rows θ₀..θ₁ gives L·(2π/W)·(sin²θ₁ − sin²θ₀)/2
-/// over the upper hemisphere.
+/// The irradiance on an upward surface under `map` (unrotated, +y up), per channel, for the
+/// radiance Mitsuba 3's `envmap` reads from it (`eval_spectrum`, written out here): texel (x, y)
+/// at u = (x + ½)/W, v = y/(H − 1), bilinear between them and periodic in u. Over u the
+/// interpolation integrates to the row's mean; over v the row means are interpolated linearly,
+/// and E = ∫ L cos θ dω = π² ∫₀^½ R(v) sin 2πv dv (θ = πv) by the midpoint rule.
 fn upward_irradiance(map: &scene::EnvironmentMap) -> [f64; 3] {
     let (w, h) = (map.width as usize, map.height as usize);
-    let mut e = [0.0f64; 3];
-    for y in 0..h / 2 {
-        let t0 = std::f64::consts::PI * y as f64 / h as f64;
-        let t1 = std::f64::consts::PI * (y + 1) as f64 / h as f64;
-        let weight =
-            2.0 * std::f64::consts::PI / w as f64 * (t1.sin().powi(2) - t0.sin().powi(2)) / 2.0;
-        for x in 0..w {
-            let l = map.texels[y * w + x];
-            for (c, e) in e.iter_mut().enumerate() {
-                *e += f64::from(l[c]) * weight;
+    let rows: Vec<[f64; 3]> = (0..h)
+        .map(|y| {
+            let mut m = [0.0f64; 3];
+            for t in &map.texels[y * w..(y + 1) * w] {
+                for c in 0..3 {
+                    m[c] += f64::from(t[c]) / w as f64;
+                }
             }
+            m
+        })
+        .collect();
+    let n = 200_000;
+    let dv = 0.5 / n as f64;
+    let mut e = [0.0f64; 3];
+    for i in 0..n {
+        let v = (i as f64 + 0.5) * dv;
+        let t = v * (h - 1) as f64;
+        let y0 = (t as usize).min(h - 2);
+        let f = t - y0 as f64;
+        let s = (2.0 * std::f64::consts::PI * v).sin() * dv;
+        for c in 0..3 {
+            e[c] += (rows[y0][c] * (1.0 - f) + rows[y0 + 1][c] * f) * s;
         }
     }
-    e
+    e.map(|e| e * std::f64::consts::PI * std::f64::consts::PI)
 }
 
 /// A grey floor seen from straight above under a map with a sun: its radiance is
-/// albedo/π × the irradiance summed over the texels, for the path tracer (light sampling and
+/// albedo/π × the irradiance of the interpolated map, for the path tracer (light sampling and
 /// BSDF sampling of the sky, MIS-weighted), for every photon mapper (photons from the
 /// sky's disc) and for their direct lighting (the same two samples at visible points).
 #[test]
-fn floor_under_a_sun_map_matches_the_texel_sum() {
+fn floor_under_a_sun_map_matches_the_irradiance_of_mitsubas_interpolation() {
     let map = sun_map();
     let e = upward_irradiance(&map);
     let albedo = 0.5;

@@ -131,6 +131,8 @@ fn over_seeds(
 /// pixels and of the whole image differ by less than 4 standard errors of the difference, each
 /// method's standard error estimated from 16 independent seeds; on the box with glass and
 /// mirror spheres (caustics, specular chains) and on the same box with the mirror made glossy.
+/// So do `sppm` and `freq-sppm` whose camera paths pass through the glossy sphere
+/// (`glossy_continue`), with light and BSDF sampling there and merging behind it.
 /// (With 8 seeds of 64 paths per pixel the path tracer's light reflected by the glossy sphere
 /// onto the floor read 2.8 % low with a standard error of 0.5 %: its error is heavy-tailed, and
 /// too few seeds underestimate it.)
@@ -155,7 +157,15 @@ fn bdpt_and_vcm_agree_with_the_path_tracer() {
         let mut path = params(Method::Path, 1);
         path.film.samples_per_pixel = 256;
         let reference = over_seeds(&scene, path, 1, SEEDS, SIZE);
-        for (method, mut p) in configurations((SIZE * SIZE) as u32) {
+        let through_glossy = |method| {
+            let mut p = params(method, (SIZE * SIZE * 4) as u32);
+            p.connections.glossy_continue = 0.5;
+            p
+        };
+        let mut methods = configurations((SIZE * SIZE) as u32).to_vec();
+        methods.push(("sppm through glossy", through_glossy(Method::Sppm)));
+        methods.push(("freq-sppm through glossy", through_glossy(Method::FreqSppm)));
+        for (method, mut p) in methods {
             p.film.samples_per_pixel = 4;
             // About a sixth of a pixel's footprint (0.12 at the walls): merging's kernel bias
             // stays below the noise.
