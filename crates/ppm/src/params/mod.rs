@@ -456,7 +456,7 @@ impl RenderParams {
                 extra_light_paths: 0.0,
                 direct_lighting: false,
                 direct_samples: 4,
-                glossy_continue: 0.0,
+                glossy_continue: 0.3,
             },
             frequency: FrequencyParams {
                 fraction: 0.1,

@@ -515,7 +515,7 @@ pub const PARAMS: &[Param] = &[
     Param {
         name: "glossy_continue",
         flag: "glossy-continue",
-        help: "sppm and freq-sppm: camera paths go on through glossy surfaces of GGX alpha up to ALPHA, in [0, 1], with light and BSDF sampling there, instead of merging photons on them; off (or 0) merges on every non-specular surface [default: off]",
+        help: "sppm and freq-sppm: camera paths go on through glossy surfaces of GGX alpha up to ALPHA, in [0, 1], with light and BSDF sampling there, instead of merging photons on them; off (or 0) merges on every non-specular surface [default: 0.3, measured in docs/integrators.md]",
         kind: ParamKind::Value {
             value_name: "ALPHA",
             choices: &[],
