@@ -135,16 +135,11 @@ impl PathTracer {
                 radiance +=
                     beta * next_event(&self.scene, &hit, &bsdf, outgoing, u_light, u_light_2d);
             }
-            let u_lobe = sampler.next_f32();
-            let u = sampler.next_2d();
-            let u_roulette = sampler.next_f32();
-            let Some(sample) = bsdf.sample(outgoing, u_lobe, u, TransportMode::Radiance) else {
+            let Some(sample) =
+                sample_and_roulette(&bsdf, outgoing, &mut beta, depth, &self.params, sampler)
+            else {
                 break;
             };
-            beta *= sample.weight;
-            if !roulette(&mut beta, depth, &self.params, u_roulette) {
-                break;
-            }
             let ray = hit.spawn_ray(sample.incoming);
             let Some(next) = self.scene.intersect(&ray) else {
                 // The path escapes: it sees the environment, shared with light sampling as an
@@ -227,10 +222,29 @@ fn next_event_through(
     f * tr * sample.radiance * (cos * weight / sample.pdf)
 }
 
+/// A camera path's next direction at a vertex after `depth` bounces: a BSDF sample (lobe, then
+/// direction) and Russian roulette, drawn in that order from `sampler`; `beta` takes the
+/// sample's weight and the roulette's. `None` where the path ends.
+pub(crate) fn sample_and_roulette(
+    bsdf: &Bsdf,
+    outgoing: glam::Vec3,
+    beta: &mut Rgb,
+    depth: u32,
+    params: &RenderParams,
+    sampler: &mut Sampler,
+) -> Option<BsdfSample> {
+    let u_lobe = sampler.next_f32();
+    let u = sampler.next_2d();
+    let u_roulette = sampler.next_f32();
+    let sample = bsdf.sample(outgoing, u_lobe, u, TransportMode::Radiance)?;
+    *beta *= sample.weight;
+    roulette(beta, depth, params, u_roulette).then_some(sample)
+}
+
 /// Russian roulette after a scattering event at `depth`: from `rr_depth` on, the path survives
 /// with the throughput's largest channel (at most one) and is divided by it; whether it goes on
 /// (a zero or non-finite throughput ends it too).
-pub(crate) fn roulette(beta: &mut Rgb, depth: u32, params: &RenderParams, u: f32) -> bool {
+fn roulette(beta: &mut Rgb, depth: u32, params: &RenderParams, u: f32) -> bool {
     if depth + 1 >= params.budget.rr_depth {
         let survive = beta.max_element().min(1.0);
         if survive <= 0.0 || u >= survive {

@@ -21,9 +21,9 @@
 //!   the combination unbiased.
 
 use glam::Vec3;
-use scene::{FreeFlight, Hit, Ray, Rgb, Scene, TransportMode, medium_after};
+use scene::{FreeFlight, Hit, Ray, Rgb, Scene, medium_after};
 
-use super::{next_event_through, power_heuristic, roulette};
+use super::{next_event_through, power_heuristic, roulette, sample_and_roulette};
 use crate::params::RenderParams;
 use crate::rng::Sampler;
 
@@ -173,16 +173,10 @@ pub(super) fn trace(scene: &Scene, params: &RenderParams, ray: Ray, sampler: &mu
                     scene, &hit, &bsdf, outgoing, medium, u_light, u_light_2d, sampler,
                 );
         }
-        let u_lobe = sampler.next_f32();
-        let u = sampler.next_2d();
-        let u_roulette = sampler.next_f32();
-        let Some(sample) = bsdf.sample(outgoing, u_lobe, u, TransportMode::Radiance) else {
+        let Some(sample) = sample_and_roulette(&bsdf, outgoing, &mut beta, depth, params, sampler)
+        else {
             break;
         };
-        beta *= sample.weight;
-        if !roulette(&mut beta, depth, params, u_roulette) {
-            break;
-        }
         medium = medium_after(scene.shape_media(&hit), &hit, sample.incoming, medium);
         last = Scatter {
             position: hit.position,

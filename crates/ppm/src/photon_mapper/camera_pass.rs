@@ -11,7 +11,7 @@ use super::frequency::SlotFrequency;
 use super::pool::{SurfacePoint, same_surface};
 use super::volume::{Segment, stretch_transmittance};
 use super::{NO_VISIBLE_POINT, PhotonMapper, SLOT_CHUNK, Setup};
-use crate::path::{MAX_CROSSINGS, bsdf_emission_weight, next_event, roulette};
+use crate::path::{MAX_CROSSINGS, bsdf_emission_weight, next_event, sample_and_roulette};
 use crate::rng::{CAMERA_STREAM, Sampler};
 
 /// Where a camera path records its stretches through media and their ratio-tracking walks.
@@ -422,16 +422,16 @@ impl Setup {
                 let u_light_2d = sampler.next_2d();
                 direct += throughput
                     * next_event(&self.scene, &hit, &bsdf, outgoing, u_light, u_light_2d);
-                let u_lobe = sampler.next_f32();
-                let u = sampler.next_2d();
-                let u_roulette = sampler.next_f32();
-                let Some(sample) = bsdf.sample(outgoing, u_lobe, u, TransportMode::Radiance) else {
+                let Some(sample) = sample_and_roulette(
+                    &bsdf,
+                    outgoing,
+                    &mut throughput,
+                    bounces,
+                    &self.params,
+                    &mut sampler,
+                ) else {
                     break;
                 };
-                throughput *= sample.weight;
-                if !roulette(&mut throughput, bounces, &self.params, u_roulette) {
-                    break;
-                }
                 ray = hit.spawn_ray(sample.incoming);
                 glossy = Some((hit, sample));
                 bounces += 1;
