@@ -541,6 +541,7 @@ mod seeds {
         let mut params = ppm::RenderParams::preview();
         params.method = ppm::Method::Appm;
         params.budget.photons_per_pass = 64;
+        params.budget.photons_auto = false;
         params.budget.max_depth = 8;
         let mut renderer = ppm::Renderer::new(std::sync::Arc::clone(&scene), params)?;
         renderer.iterate();

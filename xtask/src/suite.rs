@@ -118,6 +118,7 @@ pub(crate) fn params(
     params.seed = seed;
     params.budget.max_depth = entry.max_depth;
     params.budget.photons_per_pass = entry.photons;
+    params.budget.photons_auto = false;
     params.film.samples_per_pixel = if method == ppm::Method::Path {
         1
     } else {

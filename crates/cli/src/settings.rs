@@ -116,7 +116,13 @@ pub(crate) fn render_job(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Res
     let base = RenderParams::preview()
         .with_scene_defaults(&defaults)
         .map_err(|e| anyhow::anyhow!("{}: [render] {}", source.display(), param_message(&e)))?;
-    let params = apply_flags(base, &args.params)?;
+    let mut params = apply_flags(base, &args.params)?;
+    // The photons per pass the render will use, so that the memory check, the image's metadata
+    // and a checkpoint see the number, not `auto`.
+    let film = description.film;
+    params.resolve_photons_per_pass(
+        u64::from(film.width) * u64::from(film.height) * u64::from(params.film.samples_per_pixel),
+    );
     params
         .validate()
         .map_err(|e| anyhow::anyhow!("{}: [render] {}", source.display(), param_message(&e)))?;

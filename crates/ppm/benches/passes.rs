@@ -107,6 +107,7 @@ fn run(
             let mut params = RenderParams::preview();
             params.method = method;
             params.budget.photons_per_pass = photons_per_pass;
+            params.budget.photons_auto = false;
             params.connections.light_tracing = env_or("FPPM_BENCH_LIGHT_TRACING", 1u8) != 0;
             let mut renderer = Renderer::new(std::sync::Arc::clone(scene), params).unwrap();
             // The first pass traces the hitpoints and builds the grid: not the steady state.

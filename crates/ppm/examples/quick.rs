@@ -38,6 +38,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     if let Ok(photons) = std::env::var("QUICK_PHOTONS") {
         params.budget.photons_per_pass = photons.parse()?;
+        params.budget.photons_auto = false;
     }
     if let Ok(seed) = std::env::var("QUICK_SEED") {
         params.seed = seed.parse()?;

@@ -68,8 +68,12 @@ fn entry(method: Method) -> Entry {
 /// has media that the method does not render.
 pub(crate) fn integrator(
     scene: Arc<Scene>,
-    params: RenderParams,
+    mut params: RenderParams,
 ) -> Result<Box<dyn Integrator>, ParamError> {
+    let film = scene.description().film;
+    params.resolve_photons_per_pass(
+        u64::from(film.width) * u64::from(film.height) * u64::from(params.film.samples_per_pixel),
+    );
     params.validate()?;
     check_media(&scene, &params)?;
     (entry(params.method).build)(scene, params)
@@ -100,7 +104,9 @@ impl MemoryEstimate {
     #[must_use]
     pub fn of(width: u32, height: u32, params: &RenderParams) -> Self {
         let pixels = u64::from(width) * u64::from(height);
-        let mut estimate = (entry(params.method).estimate)(pixels, params);
+        let mut params = *params;
+        params.resolve_photons_per_pass(pixels * u64::from(params.film.samples_per_pixel));
+        let mut estimate = (entry(params.method).estimate)(pixels, &params);
         estimate.film = pixels.saturating_mul(FILM_BYTES_PER_PIXEL);
         estimate
     }

@@ -264,6 +264,7 @@ fn base_params(
 ) -> Result<ppm::RenderParams> {
     let mut params = suite::params(entry, scene, method, flags.seed)?;
     params.budget.photons_per_pass = flags.photons;
+    params.budget.photons_auto = false;
     // Against the pointwise reference (the radiance at PPM's fixed hitpoints) the renders
     // gather only: light-traced connections and direct lighting (a light sample per camera
     // pass, at jittered points) converge to the pixel's average instead.

@@ -107,13 +107,25 @@ pub const PARAMS: &[Param] = &[
     Param {
         name: "photons_per_pass",
         flag: "photons-per-pass",
-        help: "Photons traced per pass, e.g. 200000, 200_000, 200k or 2M [default: scene, else 100k]",
+        help: "Photons traced per pass, e.g. 200000, 200_000, 200k or 2M, or auto: for the photon mappers the larger of 100k and one per hitpoint slot (pixels times samples per pixel) [default: scene, else auto]",
         kind: ParamKind::Value {
             value_name: "N",
             choices: &[],
         },
-        get: |p| p.budget.photons_per_pass.to_string(),
+        get: |p| {
+            if p.budget.photons_auto {
+                "auto".to_owned()
+            } else {
+                p.budget.photons_per_pass.to_string()
+            }
+        },
         set: |p, v| {
+            if v == "auto" {
+                p.budget.photons_per_pass = 100_000;
+                p.budget.photons_auto = true;
+                return Ok(());
+            }
+            p.budget.photons_auto = false;
             let n = parse_count(v)?;
             if n <= 0 {
                 return Err("must be positive".to_owned());
@@ -770,6 +782,33 @@ mod tests {
             param("photons-per-pass").map(|p| p.name),
             Some("photons_per_pass")
         );
+    }
+
+    /// `auto` photons per pass: the larger of 100 000 and one per slot for the photon mappers,
+    /// 100 000 for the other methods; a number given is kept; the resolved number is what the
+    /// parameters then show.
+    #[test]
+    fn automatic_photons_per_pass() {
+        let shown = |p: &RenderParams| param("photons_per_pass").unwrap().get(p);
+        assert_eq!(shown(&RenderParams::preview()), "auto");
+        let resolved = |method: Method, text: &str, slots: u64| {
+            let mut p = RenderParams::preview();
+            p.method = method;
+            p.set("photons_per_pass", text).unwrap();
+            p.resolve_photons_per_pass(slots);
+            (p.budget.photons_per_pass, shown(&p))
+        };
+        assert_eq!(
+            resolved(Method::FreqSppm, "auto", 256 * 256),
+            (100_000, "100000".to_owned())
+        );
+        assert_eq!(
+            resolved(Method::Sppm, "auto", 1152 * 864),
+            (995_328, "995328".to_owned())
+        );
+        assert_eq!(resolved(Method::Ppm, "auto", 1 << 40).0, u32::MAX);
+        assert_eq!(resolved(Method::Vcm, "auto", 1152 * 864).0, 100_000);
+        assert_eq!(resolved(Method::FreqSppm, "50k", 1152 * 864).0, 50_000);
     }
 
     #[test]

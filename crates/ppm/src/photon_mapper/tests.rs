@@ -49,6 +49,7 @@ fn global_tags_deposit_exactly_what_packed_tags_do() {
     let mut params = RenderParams::preview();
     params.method = Method::FreqPpm;
     params.budget.photons_per_pass = 5_000;
+    params.budget.photons_auto = false;
     let render = |force_global_tags| {
         let mut mapper = PhotonMapper::new(Arc::clone(&scene), params).unwrap();
         mapper.frequency.force_global_tags = force_global_tags;
@@ -81,6 +82,7 @@ fn block_discs_recomputed_mid_epoch_are_those_of_the_epoch_start() {
     let mut params = RenderParams::preview();
     params.method = Method::FreqSppm;
     params.budget.photons_per_pass = 5_000;
+    params.budget.photons_auto = false;
     let mut kept = PhotonMapper::new(Arc::clone(&scene), params).unwrap();
     let mut forgot = PhotonMapper::new(Arc::clone(&scene), params).unwrap();
     for _ in 0..19 {
@@ -117,6 +119,7 @@ fn pooling_matches_a_per_pixel_reference() {
     let mut params = RenderParams::preview();
     params.method = Method::FreqSppm;
     params.budget.photons_per_pass = 20_000;
+    params.budget.photons_auto = false;
     params.film.samples_per_pixel = 2;
     params.pool.mode = crate::PoolMode::Geometry;
     params.pool.max_pixels = 5;
@@ -284,6 +287,7 @@ fn mean_weight_is_the_mean_of_the_passes_weights() {
     let mut params = RenderParams::preview();
     params.method = Method::FreqSppm;
     params.budget.photons_per_pass = 5_000;
+    params.budget.photons_auto = false;
     let mut mapper = PhotonMapper::new(scene, params).unwrap();
     let passes = 6;
     let mut seen: Vec<Vec<glam::Vec3>> = Vec::new();

@@ -469,6 +469,7 @@ fn furnace_mean(scene: &Arc<Scene>, strategies: Strategies, max_depth: u32, radi
     params.method = Method::Vcm;
     params.seed = 11;
     params.budget.photons_per_pass = 4096;
+    params.budget.photons_auto = false;
     params.budget.max_depth = max_depth;
     // About a tenth of a facet: merging's bias where a kernel crosses a facet's edge stays
     // far below the tolerance (measured: 0.02 % with merging alone at 8192 paths × 32 passes).

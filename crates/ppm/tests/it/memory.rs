@@ -104,6 +104,7 @@ fn the_estimate_follows_the_flags() {
     p.film.samples_per_pixel = 4;
     p.connections.light_tracing = false;
     p.budget.photons_per_pass = 1_000_000;
+    p.budget.photons_auto = false;
     assert_eq!(MemoryEstimate::of(100, 100, &p).photons, 10 * base.photons);
     let path = params(Method::Path, 100_000);
     let path = MemoryEstimate::of(100, 100, &path);
@@ -111,5 +112,6 @@ fn the_estimate_follows_the_flags() {
     // No overflow on the largest films and photon counts.
     p.film.samples_per_pixel = 1024;
     p.budget.photons_per_pass = u32::MAX;
+    p.budget.photons_auto = false;
     assert!(MemoryEstimate::of(u32::MAX, u32::MAX, &p).total(true) == u64::MAX);
 }

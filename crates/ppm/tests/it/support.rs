@@ -27,6 +27,7 @@ pub(crate) fn params(method: Method, photons_per_pass: u32) -> RenderParams {
     let mut params = RenderParams::preview();
     params.method = method;
     params.budget.photons_per_pass = photons_per_pass;
+    params.budget.photons_auto = false;
     params.seed = 7;
     params
 }
