@@ -121,7 +121,8 @@ pub(crate) fn render_job(scene: Option<&Path>, args: &RenderArgs) -> anyhow::Res
     // and a checkpoint see the number, not `auto`.
     let film = description.film;
     params.resolve_photons_per_pass(
-        u64::from(film.width) * u64::from(film.height) * u64::from(params.film.samples_per_pixel),
+        (u64::from(film.width) * u64::from(film.height))
+            .saturating_mul(u64::from(params.film.samples_per_pixel)),
     );
     params
         .validate()

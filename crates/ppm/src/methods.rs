@@ -72,7 +72,8 @@ pub(crate) fn integrator(
 ) -> Result<Box<dyn Integrator>, ParamError> {
     let film = scene.description().film;
     params.resolve_photons_per_pass(
-        u64::from(film.width) * u64::from(film.height) * u64::from(params.film.samples_per_pixel),
+        (u64::from(film.width) * u64::from(film.height))
+            .saturating_mul(u64::from(params.film.samples_per_pixel)),
     );
     params.validate()?;
     check_media(&scene, &params)?;
@@ -105,7 +106,9 @@ impl MemoryEstimate {
     pub fn of(width: u32, height: u32, params: &RenderParams) -> Self {
         let pixels = u64::from(width) * u64::from(height);
         let mut params = *params;
-        params.resolve_photons_per_pass(pixels * u64::from(params.film.samples_per_pixel));
+        params.resolve_photons_per_pass(
+            pixels.saturating_mul(u64::from(params.film.samples_per_pixel)),
+        );
         let mut estimate = (entry(params.method).estimate)(pixels, &params);
         estimate.film = pixels.saturating_mul(FILM_BYTES_PER_PIXEL);
         estimate
