@@ -15,14 +15,13 @@
 //! cell: the sky seen directly then differed from Mitsuba's by 3.6 % per pixel on average, which
 //! no amount of sampling removes.)
 //!
-//! Next-event estimation draws directions with density ∝ luminance × sin θ over cells
-//! u ∈ [x/W, (x+1)/W), v ∈ [y/H, (y+1)/H): a marginal over rows, then a conditional within the
-//! row, each piecewise constant and inverted continuously; the density in solid angle is
-//! p(u, v) / (2π² sin θ). A cell's weight is the interpolated luminance averaged over it (four
-//! points), and never less than a thousandth of the brightest texel whose interpolation reaches
-//! into it, so that every direction with light has a positive density: the estimates divide the
-//! interpolated radiance by that density, and are unbiased. A constant sky is sampled
-//! uniformly.
+//! Next-event estimation draws directions with density ∝ luminance × sin θ over the
+//! interpolation's patches (the W × (H − 1) rectangles between four texels, [`MapSampler`]): a
+//! marginal over rows, then a conditional within the row, each piecewise constant and inverted
+//! continuously; the density in solid angle is p(u, v) / (2π² sin θ). A patch's weight is the
+//! mean of its corners' luminance, the interpolation's mean over it, so the density is positive
+//! exactly where there is light and the estimates, which divide the interpolated radiance by it,
+//! are unbiased. A constant sky is sampled uniformly.
 //! Photons start on a disc of the scene's bounding radius r perpendicular to a direction drawn
 //! the same way, outside the scene (pbrt-v4's `ImageInfiniteLight::SampleLe`), so the emitted
 //! power is π r² ∫ L dω.
