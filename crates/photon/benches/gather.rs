@@ -279,7 +279,6 @@ fn gather_pass_sorted(bencher: Bencher, threads: usize) {
             normal: position,
             bounces: 0,
             tag: 0,
-            densities: [0.0; 2],
         })
         .collect();
     let pool = pool(threads);

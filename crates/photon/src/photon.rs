@@ -4,7 +4,7 @@ use glam::Vec3;
 
 /// A photon stored on a surface: plain data, public fields.
 ///
-/// 64 bytes.
+/// 56 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Photon {
     /// Where the photon hit the surface.
@@ -23,10 +23,6 @@ pub struct Photon {
     /// state about some of the photons, which a gather's contribution can carry to the
     /// accumulators ([`crate::gather_with`], [`crate::Gathered::accumulate_again`]).
     pub tag: u32,
-    /// Free for the caller: this crate never reads them. E.g. the densities with which other
-    /// sampling strategies produce the photon's light path, for the multiple importance sampling
-    /// weight of a merge.
-    pub densities: [f32; 2],
 }
 
 impl AsRef<Photon> for Photon {
@@ -118,7 +114,6 @@ mod tests {
             power: Vec3::ONE,
             normal,
             tag: 0,
-            densities: [0.0; 2],
         }
     }
 

@@ -4,9 +4,7 @@
 //! their paths with these, so that both draw the same random numbers for the same path.
 
 use glam::{Vec2, Vec3};
-use scene::{
-    Bsdf, BsdfSample, EmissionPdf, EmissionSample, Hit, LensConnection, Rgb, Scene, TransportMode,
-};
+use scene::{Bsdf, BsdfSample, EmissionSample, Hit, LensConnection, Rgb, Scene, TransportMode};
 
 use crate::rng::Sampler;
 
@@ -35,30 +33,6 @@ pub(crate) fn emit(
         return None;
     }
     Some((sampler, emission))
-}
-
-/// [`emit`] with the densities of the emission it drew (the same sample, bit for bit), for the
-/// weights of the direct lighting against the photons straight from the emitters.
-#[inline]
-pub(crate) fn emit_with_pdf(
-    scene: &Scene,
-    seed: u64,
-    pass: u32,
-    index: u64,
-    non_finite: &mut u64,
-) -> Option<(Sampler, EmissionSample, EmissionPdf)> {
-    let mut sampler = Sampler::new(seed, pass, index);
-    let u_light = sampler.next_f32();
-    let u_pos = sampler.next_2d();
-    let u_dir = sampler.next_2d();
-    let (emission, pdf) = scene
-        .lights()
-        .sample_emission_with_pdf(u_light, u_pos, u_dir)?;
-    if !emission.power.is_finite() {
-        *non_finite += 1;
-        return None;
-    }
-    Some((sampler, emission, pdf))
 }
 
 /// How a light path goes on after [`scatter`].

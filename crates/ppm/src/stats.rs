@@ -155,11 +155,9 @@ pub struct MemoryEstimate {
 
 /// Photon-buffer bytes per photon emitted in a pass: the stored photons (traced, Morton-sorted,
 /// their keys) and the gather's photon–hitpoint pairs. Measured 250–1,360 bytes on a caustic,
-/// a Cornell box and an indirectly lit room with 56-byte photons (0.7–4.8 stored photons per
-/// emitted one; see docs/reliability.md), 1,556 in the room with 64-byte ones (the densities
-/// of the direct lighting's weights); the estimate takes the upper end with room to spare, as
-/// deep paths store more.
-const PHOTON_BYTES: u64 = 1792;
+/// a Cornell box and an indirectly lit room (0.7–4.8 stored photons per emitted one; see
+/// docs/reliability.md); the estimate takes the upper end, as deep paths store more.
+const PHOTON_BYTES: u64 = 1536;
 /// Output bytes per pixel: the image, its copy in the EXR writer, the PNG, and up to ten AOV
 /// channels.
 pub(crate) const FILM_BYTES_PER_PIXEL: u64 = 12 + 12 + 4 + 40;

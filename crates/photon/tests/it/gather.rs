@@ -50,7 +50,6 @@ fn scene(seed: u64) -> Scene {
                 normal,
                 bounces: 0,
                 tag: rng.random_range(0..4),
-                densities: [0.0; 2],
             }
         })
         .collect();

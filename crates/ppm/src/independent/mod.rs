@@ -239,14 +239,7 @@ impl Integrator for PassIndependent {
         let Independent { kernels, sums } = state;
         let kernels: &[f64] = kernels;
         let pass = mapper.passes();
-        // Direct lighting weighs its samples against the merges of this pass's radii, which
-        // are set only after the camera pass.
-        let radii: Option<Vec<f64>> = mapper.params().connections.direct_lighting.then(|| {
-            let g = schedule_squared(u64::from(pass), mapper.params().kernel.alpha).sqrt();
-            kernels.iter().map(|&r0| r0 * g).collect()
-        });
         mapper.run_pass(
-            radii.as_deref(),
             |m| {
                 schedule_radii(kernels, m, pass);
                 false

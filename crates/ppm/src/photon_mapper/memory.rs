@@ -14,9 +14,9 @@ const GRID_BYTES_PER_SLOT: u64 = 48;
 const PASS_BYTES_PER_SLOT: u64 = 36;
 /// A frequency estimate per grid entry, for the frequency-guided methods.
 const FREQUENCY_PASS_BYTES_PER_SLOT: u64 = 32;
-/// Light tracing's buffers per slot: the pass's connected radiance (24 bytes), and a merge's
-/// weight against the connection with the connection's kq/ρ (16).
-const LIGHT_BYTES_PER_SLOT: u64 = 40;
+/// Light tracing's buffers per slot: the pass's connected radiance (24 bytes) and the camera
+/// sample density at the visible point (4).
+const LIGHT_BYTES_PER_SLOT: u64 = 28;
 /// Light tracing's buffers per photon emitted and slot per pixel: one 16-byte contribution per
 /// slot of the pixel per connected photon, for up to the 4.8 stored photons per emitted one
 /// (rounded up).

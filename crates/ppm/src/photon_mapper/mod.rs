@@ -15,7 +15,6 @@
 //! the image.
 
 mod camera_pass;
-mod direct;
 mod frequency;
 mod index;
 mod media;
@@ -66,9 +65,6 @@ struct Setup {
     /// The GGX α up to which camera paths pass through glossy surfaces (`glossy_continue`,
     /// where this render honours it; 0 otherwise): [`Setup::passes_through`].
     glossy_continue: f32,
-    /// With `direct_lighting`, what the weights of the light and BSDF samples at the visible
-    /// points against the photons straight from the emitters need (`direct.rs`).
-    direct: Option<direct::DirectMis>,
 }
 
 /// The photon mappers' state: hitpoint slots with their statistics, the grid, the direct
@@ -192,12 +188,6 @@ impl PhotonMapper {
                 width: film.width,
                 height: film.height,
                 glossy_continue,
-                direct: params.connections.direct_lighting.then(|| {
-                    direct::DirectMis::new(
-                        params.budget.photons_per_pass,
-                        params.connections.direct_samples,
-                    )
-                }),
             },
             pass: 0,
             n_emitted: 0,
@@ -322,7 +312,6 @@ impl PhotonMapper {
     /// the estimate).
     pub(crate) fn run_pass(
         &mut self,
-        pass_radii: Option<&[f64]>,
         before_grid: impl FnOnce(&mut Self) -> bool,
         after_photons: impl FnOnce(&mut Self, &mut PassStats),
     ) -> PassStats {
@@ -330,7 +319,7 @@ impl PhotonMapper {
         let clock = Instant::now();
         let stochastic = self.setup.params.method.is_stochastic();
         let retrace = self.slots.is_empty() || stochastic;
-        stats.non_finite += self.camera_pass(retrace, pass_radii);
+        stats.non_finite += self.camera_pass(retrace);
         let radii_changed = before_grid(self);
         stats.camera_paths = self.slots.len() as u64;
         let camera = clock.elapsed().as_secs_f64();
@@ -463,7 +452,6 @@ impl Integrator for PhotonMapper {
     /// (once, after its pilot), and after the photons every slot folds the pass into R, N, τ.
     fn iterate(&mut self) -> PassStats {
         self.run_pass(
-            None,
             |m| {
                 let grow = m.setup.params.growth_pass() == Some(m.pass);
                 if grow {

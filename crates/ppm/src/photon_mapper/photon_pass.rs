@@ -9,7 +9,6 @@ use photon::{AcceptParams, GatherScratch, MortonScratch, Photon};
 use rayon::prelude::*;
 use scene::{Bsdf, Rgb};
 
-use super::direct::{PhotonDensities, SlotKernel};
 use super::frequency::FrequencyPhoton;
 use super::index::NOT_IN_GRID;
 use super::trace::{LightTracing, TracedPhotons};
@@ -43,10 +42,8 @@ pub(crate) struct PhotonPass {
     /// (`light_tracing` only; empty otherwise).
     light: Vec<[f64; 3]>,
     /// Per slot: the MIS weight of a merge at its visible point against the photon's
-    /// connection to the camera, and kq/ρ of that connection for the photons straight from an
-    /// emitter (`direct.rs`; zero where the camera does not see the slot directly)
-    /// (`light_tracing` only; empty otherwise).
-    merge_weight: Vec<(f32, f64)>,
+    /// connection to the camera (`light_tracing` only; empty otherwise).
+    merge_weight: Vec<f32>,
 }
 
 impl PhotonPass {
@@ -87,7 +84,7 @@ impl PhotonPass {
             self.per_entry.capacity() * size_of::<(u32, [f64; 3])>()
                 + self.slot_entry.capacity() * size_of::<u32>()
                 + self.light.capacity() * size_of::<[f64; 3]>()
-                + self.merge_weight.capacity() * size_of::<(f32, f64)>(),
+                + self.merge_weight.capacity() * size_of::<f32>(),
         )
     }
 }
@@ -207,20 +204,12 @@ impl PhotonMapper {
                 .par_extend((0..n_slots).into_par_iter().map(|slot| {
                     let budget = budgets[slot];
                     if !seen_directly(budget, max_depth) {
-                        return (1.0, 0.0);
+                        return 1.0;
                     }
                     let rho = f64::from(camera.film_density(positions[slot], normals[slot]));
                     let n = std::f64::consts::PI * radii[slot] * radii[slot] * rho;
                     let q = light.connection_rate((slot / spp) as u32, rho);
-                    let kq = light.paths_per_photon * q;
-                    let connect_area = if kq == 0.0 {
-                        0.0
-                    } else if rho > 0.0 {
-                        kq / rho
-                    } else {
-                        f64::INFINITY
-                    };
-                    ((n / (kq + n)) as f32, connect_area)
+                    (n / (light.paths_per_photon * q + n)) as f32
                 }));
         }
         let frequency_photons = buffers.traced.iter().map(|c| c.frequency_photons).sum();
@@ -296,22 +285,7 @@ impl PhotonMapper {
                 let (normal, outgoing) = (slots.shading_normal()[slot], slots.outgoing()[slot]);
                 let f = Bsdf::eval_about(material.kind, normal, outgoing, photon.incoming);
                 let mut flux = f * photon.power * slots.weight()[slot];
-                let terms = merge_weight.get(slot).copied();
-                if photon.bounces == 0
-                    && let Some(mis) = &setup.direct
-                {
-                    // Straight from an emitter: shared with the light and BSDF samples too.
-                    let r = slots.radius()[slot];
-                    let kernel = SlotKernel {
-                        merge_area: std::f64::consts::PI * r * r,
-                        connect_area: terms.map_or(0.0, |t| t.1),
-                    };
-                    let densities = PhotonDensities::decode(photon.densities);
-                    let weight = mis.merge_weight(&densities, kernel, || {
-                        Bsdf::pdf_about(material.kind, normal, outgoing, photon.incoming)
-                    });
-                    flux *= weight as f32;
-                } else if let Some((weight, _)) = terms {
+                if let Some(&weight) = merge_weight.get(slot) {
                     flux *= weight;
                 }
                 if flux.is_finite() {

@@ -6,13 +6,10 @@ use photon::Photon;
 use scene::{Bsdf, Hit, Rgb, medium_after};
 
 use super::Setup;
-use super::direct::{PhotonDensities, photon_densities};
 use super::frequency::{FrequencyPhoton, arrived, scatter_spectrum};
 use super::media::Flight;
 use super::volume::VolumePhoton;
-use crate::light_path::{
-    Scatter, emit, emit_with_pdf, lens_point, lens_radiance, lens_radiance_through, scatter,
-};
+use crate::light_path::{Scatter, emit, lens_point, lens_radiance, lens_radiance_through, scatter};
 use crate::path::{MAX_CROSSINGS, transmittance};
 use crate::rng::Sampler;
 
@@ -125,24 +122,11 @@ impl Setup {
         out: &mut TracedPhotons,
     ) {
         let seed = self.params.seed;
-        // With direct lighting, the emission's densities weigh the photons straight from it
-        // against the light and BSDF samples at the visible points (`direct.rs`).
-        let (mut sampler, emission, emitted) = if self.direct.is_some() {
-            let Some((sampler, emission, pdf)) =
-                emit_with_pdf(&self.scene, seed, pass, index, &mut out.non_finite)
-            else {
-                return;
-            };
-            (sampler, emission, Some(pdf))
-        } else {
-            let Some((sampler, emission)) =
-                emit(&self.scene, seed, pass, index, &mut out.non_finite)
-            else {
-                return;
-            };
-            (sampler, emission, None)
+        let Some((mut sampler, emission)) =
+            emit(&self.scene, seed, pass, index, &mut out.non_finite)
+        else {
+            return;
         };
-        let origin = emission.origin;
         let mut power = emission.power;
         let mut ray = emission.ray();
         let mut spectrum = if STORE {
@@ -157,6 +141,7 @@ impl Setup {
         // reload them through `self.params` at every bounce.
         let max_depth = self.params.budget.max_depth;
         let rr_depth = self.params.budget.rr_depth;
+        let direct_lighting = self.params.connections.direct_lighting;
         let mut medium = if MEDIA {
             self.medium_at(ray.origin)
         } else {
@@ -230,30 +215,16 @@ impl Setup {
             // The frequency photon's field where it lands: the sharper of its two axes.
             let here = spectrum.map(arrived);
             let bsdf = self.scene.material_bsdf(material, &hit);
+            // With direct lighting by light sampling, photons straight from an emitter are
+            // already accounted for at the hitpoints.
+            let counted_by_light_sampling = direct_lighting && depth == 0;
             // Camera paths pass through the sharp glossy surfaces as through mirrors
             // (`glossy_continue`): the light there is theirs, so nothing is stored or connected.
             let merged_here = !bsdf.is_specular() && !self.passes_through(material);
-            // With direct lighting, a photon straight from an emitter carries the densities of
-            // the light and BSDF samples that share its path; one whose densities are not
-            // finite (it left the emitter at a grazing angle) has no light to share.
-            let densities = match (&self.direct, &emitted) {
-                (Some(mis), Some(pdf)) if merged_here && depth == 0 => Some(photon_densities(
-                    self.scene.lights(),
-                    mis,
-                    pdf,
-                    origin,
-                    &hit,
-                    incoming,
-                )),
-                _ => None,
-            };
-            let counted_by_light_sampling = matches!(densities, Some(None));
-            let densities = densities.flatten();
             if merged_here && !counted_by_light_sampling && !STORE {
                 if let Some(light) = light {
                     self.connect_to_camera::<MEDIA>(
-                        &hit, &bsdf, incoming, power, medium, &sampler, depth, densities, light,
-                        out,
+                        &hit, &bsdf, incoming, power, medium, &sampler, depth, light, out,
                     );
                 }
             } else if merged_here && !counted_by_light_sampling {
@@ -273,12 +244,10 @@ impl Setup {
                     normal: hit.geometric_normal,
                     bounces: depth,
                     tag,
-                    densities: densities.map_or([0.0; 2], PhotonDensities::encode),
                 });
                 if let Some(light) = light {
                     self.connect_to_camera::<MEDIA>(
-                        &hit, &bsdf, incoming, power, medium, &sampler, depth, densities, light,
-                        out,
+                        &hit, &bsdf, incoming, power, medium, &sampler, depth, light, out,
                     );
                 }
             }
@@ -340,7 +309,6 @@ impl Setup {
         medium: Option<u32>,
         sampler: &Sampler,
         depth: u32,
-        densities: Option<PhotonDensities>,
         light: LightTracing<'_>,
         out: &mut TracedPhotons,
     ) {
@@ -374,18 +342,10 @@ impl Setup {
         out.connections += 1;
         let spp = light.samples_per_pixel;
         let k = light.paths_per_photon;
-        // A photon straight from an emitter shares its path with the light and BSDF samples
-        // of direct lighting too (`direct.rs`).
-        let direct = match (densities, &self.direct) {
-            (Some(d), Some(mis)) => mis.connection_term(&d, rho, || {
-                bsdf.pdf((connection.lens - hit.position).normalize(), incoming)
-            }),
-            _ => 0.0,
-        };
         for (i, n) in light.kernel_samples(pixel, rho).enumerate() {
             // Weight kq/(kq + N) over the connection's probability q (q = 1 here) and over the
             // k connecting paths per photon emitted.
-            let weight = 1.0 / ((k * rate + n + direct) * f64::from(spp));
+            let weight = 1.0 / ((k * rate + n) * f64::from(spp));
             let v = value * weight as f32;
             out.splats.push((pixel * spp + i as u32, [v.x, v.y, v.z]));
         }

@@ -448,13 +448,6 @@ impl Bsdf {
         }
     }
 
-    /// [`Bsdf::pdf`] of the untextured `kind` about the unit shading `normal`, the density that
-    /// goes with [`Bsdf::eval_about`]'s value (a merge's weight against a BSDF sample).
-    #[inline]
-    pub fn pdf_about(kind: MaterialKind, normal: Vec3, outgoing: Vec3, incoming: Vec3) -> f32 {
-        Self::from_normal(kind, normal, true).pdf(outgoing, incoming)
-    }
-
     /// The BSDF value f(outgoing, incoming), without the cosine; zero for delta lobes.
     pub fn eval(&self, outgoing: Vec3, incoming: Vec3) -> Rgb {
         let s = &self.shading;
