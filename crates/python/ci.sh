@@ -37,8 +37,8 @@ fi
 
 echo "== pip install ./crates/python (maturin, ${FPPM_MODULE_PROFILE:-release})"
 # The README's command, without build isolation: the venv's maturin builds, so that CI does not
-# fetch maturin into a fresh environment for every run. The build shares target/release with
-# the command's.
+# fetch maturin into a fresh environment for every run. The build shares target/<profile> with
+# the command's when both are built in the same profile.
 "$venv/bin/python" -m pip install --quiet --disable-pip-version-check --no-build-isolation \
     --force-reinstall --no-deps ./crates/python
 

@@ -133,7 +133,8 @@ fn over_seeds(
 /// mirror spheres (caustics, specular chains) and on the same box with the mirror made glossy.
 /// So do `sppm` and `freq-sppm` whose camera paths pass through the glossy sphere
 /// (`glossy_continue`), with light and BSDF sampling there and merging behind it, and with
-/// direct lighting at their visible points weighed against the photons straight from the lamp.
+/// direct lighting at their visible points taking the light straight from the lamp in place of
+/// the photons that bring it.
 /// (With 8 seeds of 64 paths per pixel the path tracer's light reflected by the glossy sphere
 /// onto the floor read 2.8 % low with a standard error of 0.5 %: its error is heavy-tailed, and
 /// too few seeds underestimate it.)
@@ -166,8 +167,8 @@ fn bdpt_and_vcm_agree_with_the_path_tracer() {
         let mut methods = configurations((SIZE * SIZE) as u32).to_vec();
         methods.push(("sppm through glossy", through_glossy(Method::Sppm)));
         methods.push(("freq-sppm through glossy", through_glossy(Method::FreqSppm)));
-        // Direct lighting shares the light straight from the lamp with the merges and the
-        // connections of the photons that bring it (`photon_mapper/direct.rs`).
+        // Direct lighting: light and BSDF samples at the visible points, and the photons
+        // straight from the lamp neither merged nor connected (`direct_lighting`).
         let direct = |method| {
             let mut p = through_glossy(method);
             p.connections.direct_lighting = true;
