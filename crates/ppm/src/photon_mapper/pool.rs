@@ -997,6 +997,9 @@ struct Fit {
     moments: [f32x8; 6],
     /// Σk·L·[1, u, v] per channel.
     values: [[f32x8; 3]; 3],
+    /// The smallest and the largest value per channel of the taps that count (k > 0) and of
+    /// the centre: the range the fit's value is held to.
+    range: [[f32x8; 3]; 2],
 }
 
 impl Fit {
@@ -1004,9 +1007,11 @@ impl Fit {
         let zero = [f32x8::ZERO; 3];
         let mut moments = [f32x8::ZERO; 6];
         moments[0] = f32x8::ONE;
+        let own = [own.x, own.y, own.z];
         Self {
             moments,
-            values: [[own.x, own.y, own.z], zero, zero],
+            values: [own, zero, zero],
+            range: [own, own],
         }
     }
 
@@ -1030,20 +1035,28 @@ impl Fit {
     #[inline]
     fn add_values(&mut self, taps: &[Weighted], flat: &Slices3) {
         let mut values = self.values;
+        let [mut lo, mut hi] = self.range;
         for &Weighted { k, u, v, at } in taps {
             let (ku, kv) = (k * u, k * v);
+            let counts = k.simd_gt(f32x8::ZERO);
             let value = flat.load(at);
             for (c, value) in [value.x, value.y, value.z].into_iter().enumerate() {
                 values[0][c] += k * value;
                 values[1][c] += ku * value;
                 values[2][c] += kv * value;
+                lo[c] = counts.select(lo[c].min(value), lo[c]);
+                hi[c] = counts.select(hi[c].max(value), hi[c]);
             }
         }
         self.values = values;
+        self.range = [lo, hi];
     }
 
     /// Each lane's plane value at the centre, or the weighted mean where the neighbours do not
-    /// span the plane (all on one line) well enough to fit a gradient.
+    /// span the plane (all on one line) well enough to fit a gradient; held to the range of the
+    /// values it was fitted to. A plane extrapolated over a curved falloff (beside a lamp, at a
+    /// shadow's rim) overshoots that range, as far as below zero: a linear field read where its
+    /// samples surround the centre, and the mean, never leave it.
     #[inline]
     fn centre(&self) -> [f32x8; 3] {
         let [m0, mu, mv, muu, muv, mvv] = self.moments;
@@ -1066,7 +1079,8 @@ impl Fit {
             let lv = self.values[2][c] * inv - cv * mean;
             let gu = (svv * lu - suv * lv) * inv_det;
             let gv = (suu * lv - suv * lu) * inv_det;
-            spans.select(mean - gu * cu - gv * cv, mean)
+            let [lo, hi] = [self.range[0][c], self.range[1][c]];
+            spans.select(mean - gu * cu - gv * cv, mean).max(lo).min(hi)
         })
     }
 }
@@ -1094,6 +1108,61 @@ mod tests {
         }
         assert!(taps(0).is_empty());
         assert!(taps(8).len() < 80);
+    }
+
+    /// Fits the centre (value `own` at u = v = 0) to taps at `(u, v)` with `values`, every
+    /// lane alike, weights k = 1.
+    fn fit_centre(own: f32, taps: &[((f32, f32), f32)]) -> f32 {
+        let plane: Vec<f32> = taps.iter().flat_map(|&(_, value)| [value; LANES]).collect();
+        let flat = Slices3 {
+            x: &plane,
+            y: &plane,
+            z: &plane,
+        };
+        let weighted: Vec<Weighted> = taps
+            .iter()
+            .enumerate()
+            .map(|(i, &((u, v), _))| Weighted {
+                k: f32x8::ONE,
+                u: f32x8::splat(u),
+                v: f32x8::splat(v),
+                at: i * LANES,
+            })
+            .collect();
+        let own = f32x8::splat(own);
+        let mut fit = Fit::new(V3 {
+            x: own,
+            y: own,
+            z: own,
+        });
+        fit.add_moments(&weighted);
+        fit.add_values(&weighted, &flat);
+        fit.centre()[0].to_array()[0]
+    }
+
+    #[test]
+    fn the_fit_stays_within_the_values_it_reads() {
+        // A step seen from one side: dark at the centre and the column beside it, lit beyond.
+        // The least-squares plane through these reads −0.19 at the centre.
+        let mut step = Vec::new();
+        for v in [-1.0f32, 0.0, 1.0] {
+            for u in [1.0f32, 2.0, 3.0] {
+                step.push(((u, v), if u < 1.5 { 0.0 } else { 1.0 }));
+            }
+        }
+        let value = fit_centre(0.0, &step);
+        assert!((0.0..=1.0).contains(&value), "{value}");
+        // A linear field whose taps surround the centre is read exactly, as before.
+        let mut ramp = Vec::new();
+        for v in [-2.0f32, -1.0, 0.0, 1.0, 2.0] {
+            for u in [-2.0f32, -1.0, 0.0, 1.0, 2.0] {
+                if u != 0.0 || v != 0.0 {
+                    ramp.push(((u, v), 0.5 + 0.1 * u - 0.05 * v));
+                }
+            }
+        }
+        let value = fit_centre(0.5, &ramp);
+        assert!((value - 0.5).abs() < 1e-5, "{value}");
     }
 
     #[test]

@@ -225,6 +225,8 @@ fn reference_pooling(m: &PhotonMapper) -> (Vec<[f64; 3]>, Vec<f32>) {
             })
         };
         let mut va = [flat(p), [0.0; 3], [0.0; 3]];
+        // The fit is held to the range of the values it reads.
+        let (mut lo, mut hi) = (flat(p), flat(p));
         for dy in -max..=max {
             for dx in -max..=max {
                 let ring = dx.abs().max(dy.abs()) > 2;
@@ -248,6 +250,10 @@ fn reference_pooling(m: &PhotonMapper) -> (Vec<[f64; 3]>, Vec<f32>) {
                 }
                 let l = flat(q);
                 for c in 0..3 {
+                    if k > 0.0 {
+                        lo[c] = lo[c].min(l[c]);
+                        hi[c] = hi[c].max(l[c]);
+                    }
                     va[0][c] += k * l[c];
                     va[1][c] += k * u * l[c];
                     va[2][c] += k * v * l[c];
@@ -268,7 +274,9 @@ fn reference_pooling(m: &PhotonMapper) -> (Vec<[f64; 3]>, Vec<f32>) {
                 let gu = (svv * lu - suv * lv) / det;
                 let gv = (suu * lv - suv * lu) / det;
                 mean - gu * cu - gv * cv
-            };
+            }
+            .max(lo[c])
+            .min(hi[c]);
             if wp[c] > 0.0 {
                 radiance[p][c] = f64::from(wp[c]) * value;
             }
