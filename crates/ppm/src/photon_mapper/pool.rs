@@ -51,6 +51,9 @@ const NORMAL_COS: f32 = 0.9;
 const PLANE_SLOPE: f32 = 0.1;
 /// The largest relative difference of the hitpoint weights, per channel.
 const WEIGHT_TOLERANCE: f32 = 0.1;
+/// How many of its own standard errors a slot's pooled value may lie from its own estimate
+/// (the channels' sum): further, the window has pooled light the slot does not see.
+const AGREEMENT_SIGMAS: f64 = 3.0;
 
 /// Taps beyond this many standard deviations carry nothing worth the work.
 const CUTOFF_SIGMAS: f32 = 3.0;
@@ -346,13 +349,28 @@ fn pool_group(
         }
         let slot = band_slot(lane);
         let radiance = &mut band.radiance[slot];
+        let mut value = *radiance;
         for c in 0..3 {
             if has[c][lane] != 0.0 {
-                radiance[c] = f64::from(pooled[c][lane]);
+                value[c] = f64::from(pooled[c][lane]);
             }
         }
+        if !agrees(*radiance, value, band.spread[slot]) {
+            continue;
+        }
+        *radiance = value;
         band.width[slot] = s[lane];
     }
+}
+
+/// Whether a slot's pooled value lies within [`AGREEMENT_SIGMAS`] of its own estimate's standard
+/// errors (relative `spread`, taken of the larger of the two: the test errs towards pooling).
+/// A window that reaches over a change of the light the prediction did not see (the ceiling in
+/// the shadow of a lamp hung just below it) pools a value the slot's own photons contradict.
+#[inline]
+pub(super) fn agrees(own: [f64; 3], pooled: [f64; 3], spread: f64) -> bool {
+    let (own, pooled) = (own.iter().sum::<f64>(), pooled.iter().sum::<f64>());
+    (pooled - own).abs() <= AGREEMENT_SIGMAS * spread * own.max(pooled)
 }
 
 /// The photon radiance τ/(πR²N) of a slot of radius `radius` and flux `flux` after `n`
@@ -510,6 +528,8 @@ struct Band {
     width: Vec<f32>,
     /// [`WidthRule::cap`] of each slot with a visible point.
     cap: Vec<f64>,
+    /// The relative standard error of each slot's own estimate, 1/√N.
+    spread: Vec<f64>,
 }
 
 impl Band {
@@ -521,6 +541,7 @@ impl Band {
         self.width.clear();
         self.width.resize(slots, 0.0);
         self.cap.resize(slots, 0.0);
+        self.spread.resize(slots, 0.0);
     }
 }
 
@@ -760,6 +781,8 @@ impl Planes {
                 }
                 if in_band {
                     band.cap[slot - first_slot] = rule.cap(mapper, slot);
+                    band.spread[slot - first_slot] =
+                        1.0 / mapper.slots.photon_count()[slot].max(1.0).sqrt();
                 }
                 // The mean weight of the passes, which the radiance carries (not the last one's).
                 let weight = mapper.mean_weight[slot];

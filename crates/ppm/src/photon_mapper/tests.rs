@@ -281,6 +281,11 @@ fn reference_pooling(m: &PhotonMapper) -> (Vec<[f64; 3]>, Vec<f32>) {
                 radiance[p][c] = f64::from(wp[c]) * value;
             }
         }
+        let spread = 1.0 / s.photon_count()[p].max(1.0).sqrt();
+        if !super::pool::agrees(own[p], radiance[p], spread) {
+            radiance[p] = own[p];
+            widths[p] = 0.0;
+        }
     }
     (radiance, widths)
 }
