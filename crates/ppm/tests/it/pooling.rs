@@ -219,9 +219,11 @@ fn a_hard_shadow_edge_keeps_its_width_where_the_light_says_so() {
         bias[1] < 0.8 * bias[0],
         "frequency pooling blurred the edge: {bias:?} (off, freq, geometry)"
     );
-    // ... where the same pooling blind to the light blurs it.
+    // ... where the same pooling blind to the light blurs it (0.045 against 0.038; 0.052 before
+    // slots refused pooled values their own photons contradict, which spares the control's edge
+    // too).
     assert!(
-        bias[2] > 1.3 * bias[1],
+        bias[2] > 1.15 * bias[1],
         "the geometry-only width should blur the edge: {bias:?} (off, freq, geometry)"
     );
 }
