@@ -368,7 +368,7 @@ fn pool_group(
 /// A window that reaches over a change of the light the prediction did not see (the ceiling in
 /// the shadow of a lamp hung just below it) pools a value the slot's own photons contradict.
 #[inline]
-pub(super) fn agrees(own: [f64; 3], pooled: [f64; 3], spread: f64) -> bool {
+fn agrees(own: [f64; 3], pooled: [f64; 3], spread: f64) -> bool {
     let (own, pooled) = (own.iter().sum::<f64>(), pooled.iter().sum::<f64>());
     (pooled - own).abs() <= AGREEMENT_SIGMAS * spread * own.max(pooled)
 }

@@ -281,8 +281,11 @@ fn reference_pooling(m: &PhotonMapper) -> (Vec<[f64; 3]>, Vec<f32>) {
                 radiance[p][c] = f64::from(wp[c]) * value;
             }
         }
+        // A pooled value more than three of the slot's own standard errors (1/√N of the larger
+        // sum of channels) from its own estimate is refused.
         let spread = 1.0 / s.photon_count()[p].max(1.0).sqrt();
-        if !super::pool::agrees(own[p], radiance[p], spread) {
+        let (mine, pooled) = (own[p].iter().sum::<f64>(), radiance[p].iter().sum::<f64>());
+        if (pooled - mine).abs() > 3.0 * spread * mine.max(pooled) {
             radiance[p] = own[p];
             widths[p] = 0.0;
         }
