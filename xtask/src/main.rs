@@ -14,6 +14,7 @@ mod converge;
 mod docs_image;
 mod farm;
 mod fuzz;
+mod luxcore;
 mod peers;
 #[cfg(test)]
 mod peers_tests;

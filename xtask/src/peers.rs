@@ -22,7 +22,7 @@ pub(crate) const HELP: &str = "\
 cargo xtask peers [--scenes a,b,...] [--seconds 60] [--film WxH] [--threads 2]
                   [--methods freq-sppm,sppm,freq,ppm] [--peers path,ptracer]
                   [--reference-seconds 1200] [--out DIR] [--fppm-args \"...\"] [--paths N]
-                  [--fppm FILE]
+                  [--fppm FILE] [--reference mitsuba|luxcore]
 
 Renders every scene of scenes/peers/ (or those named: a name of scenes/peers/, `veach-mis` for
 ../shared/scenes/pbrt-v4/veach-mis/veach-mis.pbrt, or the path of any scene file fppm reads,
@@ -46,7 +46,14 @@ with --methods light --peers ptracer to compare the two light tracers' variance.
 
 --fppm FILE runs that fppm binary instead of building this checkout's: another build scored
 against the same references (copy DIR/SCENE/ of the first run into the second's --out to reuse
-them).";
+them).
+
+--reference luxcore renders the reference's halves with LuxCore's path tracer and its PhotonGI
+caustic cache (pip install pyluxcore into the venv on first use) as DIR/SCENE/lux-a.exr and
+lux-b.exr: the reference of caustics seen in a mirror or through water, which Mitsuba's `path`
+does not resolve. `--peers luxcore` adds the same LuxCore renderer as an equal-time peer. The LuxCore export
+(xtask/src/luxcore.rs) carries diffuse, mirror and dielectric materials and emissive surfaces,
+and refuses anything else by name.";
 
 /// The scenes of the comparison, in `scenes/peers/`.
 const SCENES: [&str; 4] = [
@@ -70,6 +77,19 @@ struct Flags {
     paths: Option<u64>,
     /// Another fppm binary to run instead of this checkout's.
     fppm: Option<PathBuf>,
+    /// Who renders the reference: Mitsuba's `path` (or `volpath`), or LuxCore.
+    reference: Reference,
+}
+
+/// The renderer of a comparison's reference.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Reference {
+    /// Mitsuba 3 `path` (`volpath` with media), halves `ref-a.exr` and `ref-b.exr`.
+    Mitsuba,
+    /// LuxCore's path tracer with its caustic cache (`crate::luxcore`), halves `lux-a.exr`
+    /// and `lux-b.exr`: the reference of caustics seen through specular surfaces, which
+    /// Mitsuba's path tracer does not resolve.
+    Luxcore,
 }
 
 impl Flags {
@@ -88,6 +108,7 @@ impl Flags {
             fppm_args: Vec::new(),
             paths: None,
             fppm: None,
+            reference: Reference::Mitsuba,
         };
         let mut it = args.iter();
         while let Some(flag) = it.next() {
@@ -120,6 +141,13 @@ impl Flags {
                 }
                 "--paths" => flags.paths = Some(parse_count(&value()?)?),
                 "--fppm" => flags.fppm = Some(PathBuf::from(value()?)),
+                "--reference" => {
+                    flags.reference = match value()?.as_str() {
+                        "mitsuba" => Reference::Mitsuba,
+                        "luxcore" => Reference::Luxcore,
+                        other => bail!("--reference {other}: mitsuba or luxcore"),
+                    }
+                }
                 other => bail!("unknown flag {other} (see cargo xtask peers --help)"),
             }
         }
@@ -220,6 +248,17 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         let (width, height) = (description.film.width, description.film.height);
         let dir = out.join(name);
         let xml = write_mitsuba(&description, &dir.join("mitsuba"))?;
+        // LuxCore's scene, where it renders the reference or is a peer.
+        let luxcore = (flags.reference == Reference::Luxcore
+            || flags.peers.iter().any(|p| p == LUXCORE_PEER))
+        .then(|| crate::luxcore::write_luxcore(&description, &dir.join("luxcore")))
+        .transpose()
+        .with_context(|| format!("exporting {name} to LuxCore"))?;
+        let luxcore_script = root.join("xtask/peers/render_luxcore.py");
+        if luxcore.is_some() {
+            ensure_luxcore(&python)?;
+        }
+
         // Mitsuba's `path` and `ptracer` ignore media: a scene with media is scored against
         // `volpath` and only `volpath` is a fair peer.
         let reference_integrator = reference_integrator(&description);
@@ -239,9 +278,34 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
         };
 
         // The reference: two independent halves.
-        let halves = ["ref-a", "ref-b"].map(|h| dir.join(format!("{h}.exr")));
+        let stems = match flags.reference {
+            Reference::Mitsuba => ["ref-a", "ref-b"],
+            Reference::Luxcore => ["lux-a", "lux-b"],
+        };
+        let halves = stems.map(|h| dir.join(format!("{h}.exr")));
         for (seed, half) in halves.iter().enumerate() {
-            if !half.exists() {
+            if half.exists() {
+                continue;
+            }
+            if let Some(scn) = luxcore
+                .as_ref()
+                .filter(|_| flags.reference == Reference::Luxcore)
+            {
+                eprintln!(
+                    "{name}: LuxCore path + caustic cache reference half {} ({} s)",
+                    seed + 1,
+                    flags.reference_seconds / 2.0
+                );
+                run_luxcore(
+                    &python,
+                    &luxcore_script,
+                    scn,
+                    flags.reference_seconds / 2.0,
+                    half,
+                    flags.threads,
+                    1000 + seed as u32,
+                )?;
+            } else {
                 eprintln!(
                     "{name}: Mitsuba {reference_integrator} reference half {} ({} s)",
                     seed + 1,
@@ -328,6 +392,37 @@ pub(crate) fn run(root: &Path, args: &[String]) -> Result<bool> {
             )?);
         }
         for integrator in &flags.peers {
+            if let Some(scn) = luxcore.as_ref().filter(|_| integrator == LUXCORE_PEER) {
+                let file = dir.join("luxcore.exr");
+                eprintln!(
+                    "{name}: LuxCore path + caustic cache for {} s",
+                    flags.seconds
+                );
+                if flags.paths.is_some() {
+                    bail!("--paths: LuxCore renders for a time only");
+                }
+                let clock = Instant::now();
+                let report = run_luxcore(
+                    &python,
+                    &luxcore_script,
+                    scn,
+                    flags.seconds,
+                    &file,
+                    flags.threads,
+                    7,
+                )?;
+                let seconds = clock.elapsed().as_secs_f64();
+                rows.push(score(
+                    name,
+                    "LuxCore path + caustic cache",
+                    seconds,
+                    &file,
+                    &reference,
+                    masks,
+                    &report,
+                )?);
+                continue;
+            }
             let file = dir.join(format!("mitsuba-{integrator}.exr"));
             eprintln!("{name}: Mitsuba {integrator} for {} s", flags.seconds);
             let clock = Instant::now();
@@ -474,6 +569,61 @@ fn ensure_venv(root: &Path) -> Result<PathBuf> {
         bail!("installing mitsuba into {} failed", venv.display());
     }
     Ok(python)
+}
+
+/// The `--peers` name of LuxCore (its path tracer with the caustic cache).
+const LUXCORE_PEER: &str = "luxcore";
+
+/// Installs LuxCore's Python module into the peers' venv if it is not there.
+fn ensure_luxcore(python: &Path) -> Result<()> {
+    let has = Command::new(python)
+        .args(["-c", "import pyluxcore"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if has {
+        return Ok(());
+    }
+    eprintln!("pip install pyluxcore");
+    let status = Command::new(python)
+        .args(["-m", "pip", "install", "--quiet", "pyluxcore"])
+        .status()
+        .context("running pip")?;
+    if !status.success() {
+        bail!("installing pyluxcore failed");
+    }
+    Ok(())
+}
+
+/// Runs the LuxCore driver script for `seconds`; returns its report line.
+fn run_luxcore(
+    python: &Path,
+    script: &Path,
+    scn: &Path,
+    seconds: f64,
+    out: &Path,
+    threads: u32,
+    seed: u32,
+) -> Result<String> {
+    let output = Command::new(python)
+        .arg(script)
+        .arg(scn)
+        .arg(seconds.to_string())
+        .arg(out)
+        .arg(threads.to_string())
+        .arg(seed.to_string())
+        .output()
+        .context("running LuxCore")?;
+    if !output.status.success() {
+        bail!(
+            "LuxCore on {} failed: {}",
+            scn.display(),
+            String::from_utf8_lossy(&output.stderr)
+                .lines()
+                .last()
+                .unwrap_or("")
+        );
+    }
+    Ok(String::from_utf8_lossy(&output.stdout).trim().to_owned())
 }
 
 /// Builds the release `fppm` binary and returns its path.
@@ -1020,7 +1170,7 @@ fn environment_emitter(env: &scene::Environment) -> String {
 
 /// An open cylinder's kept arc as an ASCII PLY of `segments` quads with exact outward normals,
 /// counter-clockwise seen from outside (the front, as fppm's analytic cylinder).
-fn cylinder_ply(c: &scene::Cylinder, segments: usize) -> String {
+pub(crate) fn cylinder_ply(c: &scene::Cylinder, segments: usize) -> String {
     let side = c.axis.cross(c.facing);
     let mut ply = String::new();
     let n_vertices = 2 * (segments + 1);
