@@ -604,26 +604,49 @@ fn run_luxcore(
     threads: u32,
     seed: u32,
 ) -> Result<String> {
+    let args = [
+        scn.as_os_str().to_owned(),
+        seconds.to_string().into(),
+        out.as_os_str().to_owned(),
+        threads.to_string().into(),
+        seed.to_string().into(),
+    ];
+    run_driver(
+        python,
+        script,
+        &args,
+        &format!("LuxCore on {}", scn.display()),
+    )
+}
+
+/// Runs a peer's Python driver script with `args`; returns the last line it printed (its
+/// report), or an error naming `what` with the last line of its errors.
+fn run_driver(
+    python: &Path,
+    script: &Path,
+    args: &[std::ffi::OsString],
+    what: &str,
+) -> Result<String> {
     let output = Command::new(python)
         .arg(script)
-        .arg(scn)
-        .arg(seconds.to_string())
-        .arg(out)
-        .arg(threads.to_string())
-        .arg(seed.to_string())
+        .args(args)
         .output()
-        .context("running LuxCore")?;
+        .with_context(|| format!("running {what}"))?;
     if !output.status.success() {
         bail!(
-            "LuxCore on {} failed: {}",
-            scn.display(),
+            "{what} failed: {}",
             String::from_utf8_lossy(&output.stderr)
                 .lines()
                 .last()
                 .unwrap_or("")
         );
     }
-    Ok(String::from_utf8_lossy(&output.stdout).trim().to_owned())
+    Ok(String::from_utf8_lossy(&output.stdout)
+        .lines()
+        .last()
+        .unwrap_or("")
+        .trim()
+        .to_owned())
 }
 
 /// Builds the release `fppm` binary and returns its path.
@@ -652,27 +675,20 @@ fn run_mitsuba(
     threads: u32,
     seed: u32,
 ) -> Result<String> {
-    let output = Command::new(python)
-        .arg(script)
-        .arg(xml)
-        .arg(integrator)
-        .arg(budget)
-        .arg(out)
-        .arg(threads.to_string())
-        .arg(seed.to_string())
-        .output()
-        .context("running Mitsuba")?;
-    if !output.status.success() {
-        bail!(
-            "Mitsuba {integrator} on {} failed: {}",
-            xml.display(),
-            String::from_utf8_lossy(&output.stderr)
-                .lines()
-                .last()
-                .unwrap_or("")
-        );
-    }
-    Ok(String::from_utf8_lossy(&output.stdout).trim().to_owned())
+    let args = [
+        xml.as_os_str().to_owned(),
+        integrator.into(),
+        budget.into(),
+        out.as_os_str().to_owned(),
+        threads.to_string().into(),
+        seed.to_string().into(),
+    ];
+    run_driver(
+        python,
+        script,
+        &args,
+        &format!("Mitsuba {integrator} on {}", xml.display()),
+    )
 }
 
 /// Writes `description` as a Mitsuba 3 scene (`scene.xml` and one PLY per material group) in
