@@ -15,6 +15,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
 
+use crate::meshes::{cylinder_ply, sphere_ply};
+
 /// The segments of a sphere's tessellation around its axis (and half as many from pole to
 /// pole): at 512 the facets of a sphere 30 pixels wide are a tenth of a pixel, and their vertex
 /// normals are exact, so the shading normal is the sphere's within 10⁻⁵.
@@ -139,7 +141,7 @@ pub(crate) fn write_luxcore(description: &scene::SceneDescription, dir: &Path) -
         object(
             &mut scn,
             format!("cylinder{index}"),
-            crate::peers::cylinder_ply(cylinder, CYLINDER_SEGMENTS),
+            cylinder_ply(cylinder, CYLINDER_SEGMENTS),
             cylinder.material,
         )?;
     }
@@ -221,51 +223,14 @@ fn triangles_ply(triangles: &[&scene::Triangle]) -> String {
     ply
 }
 
-/// A sphere as an ASCII PLY of `segments` × `segments / 2` latitude–longitude quads with exact
-/// outward normals, counter-clockwise seen from outside (its front, as fppm's sphere).
-pub(crate) fn sphere_ply(s: &scene::Sphere, segments: usize) -> String {
-    let rings = (segments / 2).max(2);
-    let mut ply = String::new();
-    let _ = writeln!(
-        ply,
-        "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nelement face {}\nproperty list uchar int vertex_indices\nend_header",
-        (rings + 1) * (segments + 1),
-        2 * rings * segments
-    );
-    for i in 0..=rings {
-        let theta = std::f32::consts::PI * i as f32 / rings as f32;
-        for j in 0..=segments {
-            let phi = std::f32::consts::TAU * j as f32 / segments as f32;
-            let n = Vec3::new(
-                theta.sin() * phi.cos(),
-                theta.cos(),
-                theta.sin() * phi.sin(),
-            );
-            let p = s.center + s.radius * n;
-            let _ = writeln!(ply, "{} {} {} {} {} {}", p.x, p.y, p.z, n.x, n.y, n.z);
-        }
-    }
-    let row = segments + 1;
-    for i in 0..rings {
-        for j in 0..segments {
-            let (a, b) = (i * row + j, i * row + j + 1);
-            let (c, d) = (a + row, b + row);
-            // From the north pole (+y) down, φ turning from +x towards +z: (a, b, d) and
-            // (a, d, c) turn counter-clockwise seen from outside.
-            let _ = writeln!(ply, "3 {a} {b} {d}");
-            let _ = writeln!(ply, "3 {a} {d} {c}");
-        }
-    }
-    ply
-}
-
 #[cfg(test)]
 mod tests {
     use std::path::Path;
 
     use glam::Vec3;
 
-    use super::{sphere_ply, write_luxcore};
+    use super::write_luxcore;
+    use crate::meshes::sphere_ply;
 
     /// The vertices and faces of an ASCII PLY with `x y z nx ny nz` vertices.
     fn read_ply(ply: &str) -> (Vec<[Vec3; 2]>, Vec<[usize; 3]>) {

@@ -15,6 +15,7 @@ mod docs_image;
 mod farm;
 mod fuzz;
 mod luxcore;
+mod meshes;
 mod peers;
 #[cfg(test)]
 mod peers_tests;

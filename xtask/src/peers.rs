@@ -1015,7 +1015,7 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
     for (index, cylinder) in description.cylinders.iter().enumerate() {
         let (bsdf, emitter) = &bsdfs[cylinder.material as usize];
         let file = format!("cylinder-{index}.ply");
-        std::fs::write(dir.join(&file), cylinder_ply(cylinder, 512))?;
+        std::fs::write(dir.join(&file), crate::meshes::cylinder_ply(cylinder, 512))?;
         writeln!(
             xml,
             "  <shape type=\"ply\"><string name=\"filename\" value=\"{file}\"/>{bsdf}{}</shape>",
@@ -1182,34 +1182,6 @@ fn environment_emitter(env: &scene::Environment) -> String {
             )
         }
     }
-}
-
-/// An open cylinder's kept arc as an ASCII PLY of `segments` quads with exact outward normals,
-/// counter-clockwise seen from outside (the front, as fppm's analytic cylinder).
-pub(crate) fn cylinder_ply(c: &scene::Cylinder, segments: usize) -> String {
-    let side = c.axis.cross(c.facing);
-    let mut ply = String::new();
-    let n_vertices = 2 * (segments + 1);
-    let _ = writeln!(
-        ply,
-        "ply\nformat ascii 1.0\nelement vertex {n_vertices}\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nelement face {}\nproperty list uchar int vertex_indices\nend_header",
-        2 * segments
-    );
-    for i in 0..=segments {
-        let phi = c.arc * (i as f32 / segments as f32 - 0.5);
-        let n = phi.cos() * c.facing + phi.sin() * side;
-        for s in [0.0, c.height] {
-            let p = c.center + s * c.axis + c.radius * n;
-            let _ = writeln!(ply, "{} {} {} {} {} {}", p.x, p.y, p.z, n.x, n.y, n.z);
-        }
-    }
-    for i in 0..segments {
-        let (a, b, c2, d) = (2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1);
-        // Seen from outside, going around counter-clockwise about the axis, then up.
-        let _ = writeln!(ply, "3 {a} {b} {c2}");
-        let _ = writeln!(ply, "3 {a} {c2} {d}");
-    }
-    ply
 }
 
 /// A Mitsuba `bitmap` texture parameter reading `texture`'s image file: colour textures as
