@@ -39,7 +39,13 @@ const NORMAL_COS: f32 = 0.5;
 /// hitpoint at `position` with unit geometric normal `normal` (facing the camera side) lies on
 /// a surface that accepts photons; [`LEVELS`] if even the smallest candidate does not. Levels
 /// fit a byte of the slot's state; [`level_radius`] turns one into a radius.
-pub(crate) fn clear_level(scene: &Scene, position: Vec3, normal: Vec3, r0: f32) -> u8 {
+///
+/// A drop probe at distance r falls from r/2 and must land within r/2 of the tangent plane, but
+/// never further than `depth`: a ladder that starts far above the largest kernel (the blocks'
+/// shared probe, eight times it) would otherwise take a surface a step below for the same one
+/// (the ground around a pool for the water 7 cm under it) and call a disc that hangs over the
+/// step clear. `depth` = r0/2 is the plain rule.
+pub(crate) fn clear_level(scene: &Scene, position: Vec3, normal: Vec3, r0: f32, depth: f32) -> u8 {
     const NONE: u8 = LEVELS as u8;
     if !(r0 > 0.0 && r0.is_finite() && position.is_finite() && normal.is_finite()) {
         return NONE;
@@ -64,7 +70,7 @@ pub(crate) fn clear_level(scene: &Scene, position: Vec3, normal: Vec3, r0: f32) 
         if r <= wall
             && directions
                 .iter()
-                .all(|&d| lands(scene, position, normal, d, r, lift))
+                .all(|&d| lands(scene, position, normal, d, r, depth.min(0.5 * r), lift))
         {
             return level;
         }
@@ -82,9 +88,18 @@ pub(crate) fn level_radius(level: u8, r0: f64) -> f64 {
     }
 }
 
-/// Whether the drop probe at tangent distance `r` along `d` meets the hitpoint's surface.
-fn lands(scene: &Scene, position: Vec3, normal: Vec3, d: Vec3, r: f32, lift: f32) -> bool {
-    let height = 0.5 * r + lift;
+/// Whether the drop probe at tangent distance `r` along `d` meets the hitpoint's surface within
+/// `depth` of its tangent plane.
+fn lands(
+    scene: &Scene,
+    position: Vec3,
+    normal: Vec3,
+    d: Vec3,
+    r: f32,
+    depth: f32,
+    lift: f32,
+) -> bool {
+    let height = depth + lift;
     let origin = position + d * r + normal * height;
     let ray = Ray::new(origin, -normal, 2.0 * height);
     scene
@@ -143,7 +158,65 @@ intensity = [1.0, 1.0, 1.0]
     }
 
     fn clear_radius(scene: &Scene, position: Vec3, normal: Vec3, r0: f32) -> f64 {
-        level_radius(clear_level(scene, position, normal, r0), f64::from(r0))
+        level_radius(
+            clear_level(scene, position, normal, r0, 0.5 * r0),
+            f64::from(r0),
+        )
+    }
+
+    /// A step: a platform (y = 0.1) over x ≤ 0 above a floor (y = 0), both 8 wide, as the
+    /// ground around a pool stands above its water.
+    const STEP: &str = r#"
+format = 1
+[camera]
+position = [0.0, 3.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 40.0
+[film]
+width = 8
+height = 8
+[materials.white]
+type = "diffuse"
+albedo = [0.8, 0.8, 0.8]
+[[shapes]]
+type = "quad"
+corner = [-4.0, 0.0, 4.0]
+edge1 = [8.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, -8.0]
+material = "white"
+[[shapes]]
+type = "quad"
+corner = [-4.0, 0.1, 4.0]
+edge1 = [4.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, -8.0]
+material = "white"
+[[lights]]
+type = "point"
+position = [0.0, 2.0, 0.0]
+intensity = [1.0, 1.0, 1.0]
+"#;
+
+    /// The blocks' shared ladder starts at eight times the largest kernel (0.1 here): with
+    /// drop probes as deep as r/2 its large levels land on the floor a step below and call a
+    /// disc 0.02 from the platform's edge clear at 0.8; held to the kernel's r/2 = 0.05 they
+    /// find the edge, and the disc is clear only at 0.0125 (the level within 0.02).
+    #[test]
+    fn a_step_below_an_edge_is_not_the_same_surface_at_any_level() {
+        let description = import::load_toml_str(STEP, Path::new("step-test.toml"))
+            .expect("the step scene parses");
+        let scene = Scene::new(description).expect("the step scene builds");
+        let at = Vec3::new(-0.02, 0.1, 0.0);
+        let wide = 0.8f32;
+        let loose = level_radius(
+            clear_level(&scene, at, Vec3::Y, wide, 0.5 * wide),
+            f64::from(wide),
+        );
+        assert_eq!(loose, f64::from(wide));
+        let held = level_radius(
+            clear_level(&scene, at, Vec3::Y, wide, 0.05),
+            f64::from(wide),
+        );
+        assert_eq!(held, f64::from(wide) / 64.0);
     }
 
     #[test]

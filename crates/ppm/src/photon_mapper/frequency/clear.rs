@@ -72,6 +72,7 @@ impl PhotonMapper {
                 slots.position()[slot],
                 slots.geometric_normal()[slot],
                 r0 as f32,
+                0.5 * r0 as f32,
             )
         };
         let probed: Vec<(usize, u8)> = if !share {
@@ -102,7 +103,13 @@ impl PhotonMapper {
                     block_slots(block).find_map(|slot| setup.visible_surface(slot as u32, epoch));
                 let (centre, normal, clear) = match visible {
                     Some((centre, normal)) => {
-                        let level = crate::disc::clear_level(scene, centre, normal, wide as f32);
+                        let level = crate::disc::clear_level(
+                            scene,
+                            centre,
+                            normal,
+                            wide as f32,
+                            0.5 * r_top as f32,
+                        );
                         (centre, normal, crate::disc::level_radius(level, wide))
                     }
                     None => (Vec3::ZERO, Vec3::ZERO, 0.0),
