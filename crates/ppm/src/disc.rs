@@ -113,9 +113,8 @@ mod tests {
 
     use super::*;
 
-    /// A floor (y = 0, |x|, |z| ≤ 1), a wall standing on it at x = 0.5 and a platform
-    /// (y = 0.3) over x ∈ [−1, −0.5].
-    const SCENE: &str = r#"
+    /// The camera, film and material of the test scenes, and their point light.
+    const HEADER: &str = r#"
 format = 1
 [camera]
 position = [0.0, 3.0, 3.0]
@@ -127,6 +126,15 @@ height = 8
 [materials.white]
 type = "diffuse"
 albedo = [0.8, 0.8, 0.8]
+[[lights]]
+type = "point"
+position = [0.0, 2.0, 0.0]
+intensity = [1.0, 1.0, 1.0]
+"#;
+
+    /// A floor (y = 0, |x|, |z| ≤ 1), a wall standing on it at x = 0.5 and a platform
+    /// (y = 0.3) over x ∈ [−1, −0.5].
+    const SHAPES: &str = r#"
 [[shapes]]
 type = "quad"
 corner = [-1.0, 0.0, 1.0]
@@ -145,39 +153,11 @@ corner = [-1.0, 0.3, 1.0]
 edge1 = [0.5, 0.0, 0.0]
 edge2 = [0.0, 0.0, -2.0]
 material = "white"
-[[lights]]
-type = "point"
-position = [0.0, 2.0, 0.0]
-intensity = [1.0, 1.0, 1.0]
 "#;
-
-    fn scene() -> Scene {
-        let description = import::load_toml_str(SCENE, Path::new("disc-test.toml"))
-            .expect("the test scene parses");
-        Scene::new(description).expect("the test scene builds")
-    }
-
-    fn clear_radius(scene: &Scene, position: Vec3, normal: Vec3, r0: f32) -> f64 {
-        level_radius(
-            clear_level(scene, position, normal, r0, 0.5 * r0),
-            f64::from(r0),
-        )
-    }
 
     /// A step: a platform (y = 0.1) over x ≤ 0 above a floor (y = 0), both 8 wide, as the
     /// ground around a pool stands above its water.
     const STEP: &str = r#"
-format = 1
-[camera]
-position = [0.0, 3.0, 3.0]
-look_at = [0.0, 0.0, 0.0]
-fov_y = 40.0
-[film]
-width = 8
-height = 8
-[materials.white]
-type = "diffuse"
-albedo = [0.8, 0.8, 0.8]
 [[shapes]]
 type = "quad"
 corner = [-4.0, 0.0, 4.0]
@@ -190,11 +170,25 @@ corner = [-4.0, 0.1, 4.0]
 edge1 = [4.0, 0.0, 0.0]
 edge2 = [0.0, 0.0, -8.0]
 material = "white"
-[[lights]]
-type = "point"
-position = [0.0, 2.0, 0.0]
-intensity = [1.0, 1.0, 1.0]
 "#;
+
+    fn build(shapes: &str) -> Scene {
+        let text = format!("{HEADER}{shapes}");
+        let description = import::load_toml_str(&text, Path::new("disc-test.toml"))
+            .expect("the test scene parses");
+        Scene::new(description).expect("the test scene builds")
+    }
+
+    fn scene() -> Scene {
+        build(SHAPES)
+    }
+
+    fn clear_radius(scene: &Scene, position: Vec3, normal: Vec3, r0: f32) -> f64 {
+        level_radius(
+            clear_level(scene, position, normal, r0, 0.5 * r0),
+            f64::from(r0),
+        )
+    }
 
     /// The blocks' shared ladder starts at eight times the largest kernel (0.1 here): with
     /// drop probes as deep as r/2 its large levels land on the floor a step below and call a
@@ -202,9 +196,7 @@ intensity = [1.0, 1.0, 1.0]
     /// find the edge, and the disc is clear only at 0.0125 (the level within 0.02).
     #[test]
     fn a_step_below_an_edge_is_not_the_same_surface_at_any_level() {
-        let description = import::load_toml_str(STEP, Path::new("step-test.toml"))
-            .expect("the step scene parses");
-        let scene = Scene::new(description).expect("the step scene builds");
+        let scene = build(STEP);
         let at = Vec3::new(-0.02, 0.1, 0.0);
         let wide = 0.8f32;
         let loose = level_radius(
