@@ -110,6 +110,44 @@ fn block_discs_recomputed_mid_epoch_are_those_of_the_epoch_start() {
     assert!(same, "the image differs");
 }
 
+/// A slot that the 2 × 2 blocks' shared disc calls clear at the largest kernel is clear there by
+/// its own probes too: on `scenes/peers/pool-caustic.toml`, whose ground stands 7 cm above the
+/// water, the shared ladder (from 8·R_max) once took the water for the ground and called the
+/// discs along the pool's edge clear.
+#[test]
+fn a_block_calls_a_slot_clear_only_where_its_own_probes_do() {
+    let scene = scene_at("../../scenes/peers/pool-caustic.toml", 96, 96);
+    let mut params = RenderParams::preview();
+    params.method = Method::FreqSppm;
+    params.budget.photons_per_pass = 20_000;
+    params.budget.photons_auto = false;
+    let mut mapper = PhotonMapper::new(Arc::clone(&scene), params).unwrap();
+    for _ in 0..3 {
+        mapper.iterate();
+    }
+    let r_top = mapper.setup.kernel_max() as f32;
+    let slots = &mapper.slots;
+    let mut shared_clear = 0;
+    for slot in 0..slots.len() {
+        if !mapper.is_valid(slot) || slots.freq()[slot].clear_level() != 0 {
+            continue;
+        }
+        shared_clear += 1;
+        let own = crate::disc::clear_level(
+            &scene,
+            slots.position()[slot],
+            slots.geometric_normal()[slot],
+            r_top,
+            0.5 * r_top,
+        );
+        assert_eq!(own, 0, "slot {slot} at {:?}", slots.position()[slot]);
+    }
+    assert!(
+        shared_clear > 1000,
+        "only {shared_clear} slots clear at R_max"
+    );
+}
+
 /// The vectorised pooling (eight pixels a time, bands of rows, f32 sums) gives what a plain
 /// per-pixel loop of the same rule gives: on a film whose width is not a multiple of eight, with
 /// two samples per pixel and a window that reaches over band edges.
