@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
 
-use crate::meshes::{cylinder_ply, sphere_ply};
+use crate::meshes::{cylinder_ply, sphere_ply, triangles_ply};
 
 /// The segments of a sphere's tessellation around its axis (and half as many from pole to
 /// pole): at 512 the facets of a sphere 30 pixels wide are a tenth of a pixel, and their vertex
@@ -159,68 +159,27 @@ pub(crate) fn write_luxcore(description: &scene::SceneDescription, dir: &Path) -
     Ok(scene_file)
 }
 
-/// The diagonal of the box around every shape.
+/// The diagonal of the box around every shape (1 for a scene without shapes).
 fn scene_diagonal(description: &scene::SceneDescription) -> f32 {
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    let mut add = |p: Vec3| {
-        lo = lo.min(p);
-        hi = hi.max(p);
-    };
+    let mut bounds = scene::Aabb::EMPTY;
     for t in &description.triangles {
-        t.positions.iter().for_each(|&p| add(p));
+        bounds = t.positions.iter().fold(bounds, |b, &p| b.include(p));
     }
     for s in &description.spheres {
-        add(s.center - s.radius);
-        add(s.center + s.radius);
+        bounds = bounds
+            .include(s.center - s.radius)
+            .include(s.center + s.radius);
     }
     for c in &description.cylinders {
         for end in [c.center, c.center + c.height * c.axis] {
-            add(end - c.radius);
-            add(end + c.radius);
+            bounds = bounds.include(end - c.radius).include(end + c.radius);
         }
     }
-    if lo.cmple(hi).all() {
-        (hi - lo).length()
-    } else {
+    if bounds.is_empty() {
         1.0
+    } else {
+        2.0 * bounds.bounding_radius()
     }
-}
-
-/// Triangles as an ASCII PLY, three vertices each, with their shading normals where every
-/// triangle has them (else LuxCore shades them flat, as fppm does).
-fn triangles_ply(triangles: &[&scene::Triangle]) -> String {
-    let normals = triangles.iter().all(|t| t.normals.is_some());
-    let mut ply = String::new();
-    let _ = writeln!(
-        ply,
-        "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z",
-        3 * triangles.len()
-    );
-    if normals {
-        let _ = writeln!(
-            ply,
-            "property float nx\nproperty float ny\nproperty float nz"
-        );
-    }
-    let _ = writeln!(
-        ply,
-        "element face {}\nproperty list uchar int vertex_indices\nend_header",
-        triangles.len()
-    );
-    for t in triangles {
-        for k in 0..3 {
-            let p = t.positions[k];
-            let _ = write!(ply, "{} {} {}", p.x, p.y, p.z);
-            if let Some(n) = t.normals.filter(|_| normals) {
-                let _ = write!(ply, " {} {} {}", n[k].x, n[k].y, n[k].z);
-            }
-            let _ = writeln!(ply);
-        }
-    }
-    for i in 0..triangles.len() {
-        let _ = writeln!(ply, "3 {} {} {}", 3 * i, 3 * i + 1, 3 * i + 2);
-    }
-    ply
 }
 
 #[cfg(test)]

@@ -1,9 +1,49 @@
-//! Curved shapes as tessellated ASCII PLY meshes, for the peers' exports (Mitsuba and LuxCore
-//! read them where they have no such analytic shape).
+//! Shapes as ASCII PLY meshes for the peers' exports (Mitsuba and LuxCore): triangles as they
+//! are, and curved shapes tessellated where a peer has no such analytic shape.
 
 use std::fmt::Write as _;
 
 use glam::Vec3;
+
+/// Triangles as an ASCII PLY, three vertices each, with their shading normals and texture
+/// coordinates where every triangle has them (else flat, as fppm shades them). Texture
+/// coordinates are as they are: Mitsuba's bitmap, like fppm, puts v = 0 at the image's top row.
+pub(crate) fn triangles_ply(triangles: &[&scene::Triangle]) -> String {
+    let normals = triangles.iter().all(|t| t.normals.is_some());
+    let uvs = triangles.iter().all(|t| t.uv.is_some());
+    let mut ply = String::new();
+    let _ = writeln!(ply, "ply\nformat ascii 1.0");
+    let _ = writeln!(ply, "element vertex {}", 3 * triangles.len());
+    let _ = writeln!(ply, "property float x\nproperty float y\nproperty float z");
+    if normals {
+        let _ = writeln!(
+            ply,
+            "property float nx\nproperty float ny\nproperty float nz"
+        );
+    }
+    if uvs {
+        let _ = writeln!(ply, "property float u\nproperty float v");
+    }
+    let _ = writeln!(ply, "element face {}", triangles.len());
+    let _ = writeln!(ply, "property list uchar int vertex_indices\nend_header");
+    for t in triangles {
+        for k in 0..3 {
+            let p = t.positions[k];
+            let _ = write!(ply, "{} {} {}", p.x, p.y, p.z);
+            if let Some(n) = t.normals.filter(|_| normals) {
+                let _ = write!(ply, " {} {} {}", n[k].x, n[k].y, n[k].z);
+            }
+            if let Some(uv) = t.uv.filter(|_| uvs) {
+                let _ = write!(ply, " {} {}", uv[k].x, uv[k].y);
+            }
+            let _ = writeln!(ply);
+        }
+    }
+    for i in 0..triangles.len() {
+        let _ = writeln!(ply, "3 {} {} {}", 3 * i, 3 * i + 1, 3 * i + 2);
+    }
+    ply
+}
 
 /// An open cylinder's kept arc as an ASCII PLY of `segments` quads with exact outward normals,
 /// counter-clockwise seen from outside (the front, as fppm's analytic cylinder).

@@ -958,41 +958,7 @@ pub(crate) fn write_mitsuba(description: &scene::SceneDescription, dir: &Path) -
             None => format!("material-{index}.ply"),
             Some(entry) => format!("material-{index}-media-{entry}.ply"),
         };
-        let mut ply = String::new();
-        let normals = triangles.iter().all(|t| t.normals.is_some());
-        // Texture coordinates as they are: Mitsuba's bitmap, like fppm, puts v = 0 at the
-        // image's top row.
-        let uvs = triangles.iter().all(|t| t.uv.is_some());
-        writeln!(ply, "ply\nformat ascii 1.0")?;
-        writeln!(ply, "element vertex {}", 3 * triangles.len())?;
-        writeln!(ply, "property float x\nproperty float y\nproperty float z")?;
-        if normals {
-            writeln!(
-                ply,
-                "property float nx\nproperty float ny\nproperty float nz"
-            )?;
-        }
-        if uvs {
-            writeln!(ply, "property float u\nproperty float v")?;
-        }
-        writeln!(ply, "element face {}", triangles.len())?;
-        writeln!(ply, "property list uchar int vertex_indices\nend_header")?;
-        for t in &triangles {
-            for k in 0..3 {
-                let p = t.positions[k];
-                write!(ply, "{} {} {}", p.x, p.y, p.z)?;
-                if let Some(n) = t.normals.filter(|_| normals) {
-                    write!(ply, " {} {} {}", n[k].x, n[k].y, n[k].z)?;
-                }
-                if let Some(uv) = t.uv.filter(|_| uvs) {
-                    write!(ply, " {} {}", uv[k].x, uv[k].y)?;
-                }
-                writeln!(ply)?;
-            }
-        }
-        for i in 0..triangles.len() {
-            writeln!(ply, "3 {} {} {}", 3 * i, 3 * i + 1, 3 * i + 2)?;
-        }
+        let ply = crate::meshes::triangles_ply(&triangles);
         std::fs::write(dir.join(&file), ply)?;
         writeln!(
             xml,
