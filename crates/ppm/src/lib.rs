@@ -61,8 +61,8 @@ pub use crate::checkpoint::surgery as checkpoint_surgery;
 pub use crate::checkpoint::{STATE_VERSION, StateError, StateHeader};
 pub use crate::independent::{Part, PartError, PassSums};
 pub use crate::params::{
-    Budget, Connections, FilmSampling, FrequencyParams, Kernel, Method, PARAMS, Param, ParamError,
-    ParamKind, PoolMode, Pooling, RenderParams, param,
+    Budget, CameraSequence, Connections, FilmSampling, FrequencyParams, Kernel, Method, PARAMS,
+    Param, ParamError, ParamKind, PoolMode, Pooling, RenderParams, param,
 };
 pub use crate::photon_mapper::{auto_initial_radius, bytes_per_hitpoint};
 pub use crate::pointwise::{pointwise_reference, pointwise_reference_paths};

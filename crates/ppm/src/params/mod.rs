@@ -173,6 +173,35 @@ pub struct FilmSampling {
     /// Hitpoint slots per pixel (jittered; ≥ 1); for the path tracer and the bidirectional
     /// methods, camera paths per pixel per pass.
     pub samples_per_pixel: u32,
+    /// Where the photon mappers' camera paths sample the pixel, the lens and their first
+    /// specular choice, pass after pass.
+    pub sequence: CameraSequence,
+}
+
+/// How the photon mappers draw a slot's camera samples over the passes: the sub-pixel
+/// position, the lens position and the first specular vertex's lobe (reflect or refract) and
+/// direction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CameraSequence {
+    /// Independent random numbers in every pass.
+    Independent,
+    /// The passes of a pixel walk an Owen-scrambled Sobol sequence (Burley 2020), seeded per
+    /// pixel: any 2^k successive passes stratify those dimensions, so a pixel's average over
+    /// its footprint, its lens and the split of a glass surface's reflection and refraction
+    /// converges faster than at random; each pass's sample is still uniform, so the estimate
+    /// stays unbiased.
+    Sobol,
+}
+
+impl CameraSequence {
+    /// The name in parameters and metadata.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            CameraSequence::Independent => "independent",
+            CameraSequence::Sobol => "sobol",
+        }
+    }
 }
 
 /// The progressive gather radius of the photon mappers.
@@ -468,6 +497,7 @@ impl RenderParams {
             },
             film: FilmSampling {
                 samples_per_pixel: 1,
+                sequence: CameraSequence::Sobol,
             },
             kernel: Kernel {
                 alpha: 0.7,

@@ -7,7 +7,7 @@
 
 use spectrum::{K_POSTER, K_STRICT, MergePolicy};
 
-use super::{Method, ParamError, PoolMode, RenderParams};
+use super::{CameraSequence, Method, ParamError, PoolMode, RenderParams};
 use crate::update::FrequencyFloor;
 
 /// One render parameter.
@@ -480,6 +480,30 @@ pub const PARAMS: &[Param] = &[
         get: |p| p.film.samples_per_pixel.to_string(),
         set: |p, v| {
             p.film.samples_per_pixel = parse_small(v)?;
+            Ok(())
+        },
+    },
+    Param {
+        name: "camera_samples",
+        flag: "camera-samples",
+        help: "Photon mappers: how a pixel's camera samples (sub-pixel and lens position, first glass or mirror choice) follow one another over the passes [default: sobol]",
+        kind: ParamKind::Value {
+            value_name: "SEQUENCE",
+            choices: &[
+                (
+                    "sobol",
+                    "An Owen-scrambled Sobol sequence per pixel: the passes stratify the pixel, the lens and the first specular choice",
+                ),
+                ("independent", "Independent random numbers every pass"),
+            ],
+        },
+        get: |p| p.film.sequence.name().to_owned(),
+        set: |p, v| {
+            p.film.sequence = match v {
+                "sobol" => CameraSequence::Sobol,
+                "independent" => CameraSequence::Independent,
+                _ => return Err("is not one of sobol, independent".to_owned()),
+            };
             Ok(())
         },
     },

@@ -11,8 +11,9 @@ use super::frequency::SlotFrequency;
 use super::pool::{SurfacePoint, same_surface};
 use super::volume::{Segment, stretch_transmittance};
 use super::{NO_VISIBLE_POINT, PhotonMapper, SLOT_CHUNK, Setup};
+use crate::params::CameraSequence;
 use crate::path::{MAX_CROSSINGS, bsdf_emission_weight, next_event, sample_and_roulette};
-use crate::rng::{CAMERA_STREAM, Sampler};
+use crate::rng::{CAMERA_STREAM, PassSequence, Sampler};
 
 /// Where a camera path records its stretches through media and their ratio-tracking walks.
 type Stretches<'a> = (&'a mut Vec<Segment>, &'a mut Vec<(f32, Rgb)>);
@@ -322,8 +323,29 @@ impl Setup {
         let pixel = slot / spp;
         let (x, y) = (pixel % self.width, pixel / self.width);
         let mut sampler = Sampler::new(self.params.seed, pass, CAMERA_STREAM | u64::from(slot));
-        let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-        let mut ray = self.scene.camera().generate_ray(film, sampler.next_2d());
+        // The sub-pixel and lens positions, and the lobe and direction of the first specular
+        // vertex: from the pixel's sequence over the passes (the film position and the lobe
+        // stratified jointly; the lens only where there is one, the direction only where a
+        // specular vertex needs it, since each set costs a few tens of nanoseconds), or
+        // independent.
+        let pinhole = self.scene.camera().aperture_radius() == 0.0;
+        let (film, lens, mut first_specular) = match self.params.film.sequence {
+            CameraSequence::Sobol => {
+                let sample = u64::from(pass) * u64::from(spp) + u64::from(slot % spp);
+                let sequence = PassSequence::new(self.params.seed, u64::from(pixel), sample);
+                let [fx, fy, lobe] = sequence.get(0);
+                let lens = if pinhole {
+                    Vec2::splat(0.5)
+                } else {
+                    let [lx, ly, _] = sequence.get(1);
+                    Vec2::new(lx, ly)
+                };
+                (Vec2::new(fx, fy), lens, Some((lobe, sequence)))
+            }
+            CameraSequence::Independent => (sampler.next_2d(), sampler.next_2d(), None),
+        };
+        let film = Vec2::new(x as f32, y as f32) + film;
+        let mut ray = self.scene.camera().generate_ray(film, lens);
         let mut throughput = Rgb::ONE;
         let mut direct = Rgb::ZERO;
         let max_depth = self.params.budget.max_depth;
@@ -334,7 +356,6 @@ impl Setup {
             None
         };
         let mut crossings = 0;
-        let pinhole = self.scene.camera().aperture_radius() == 0.0;
         // The geometric normal of the surface the current ray left (zero: the camera).
         let mut left = Vec3::ZERO;
         // `bounces`: scattering events of the camera path before this hit. Emission seen here
@@ -438,8 +459,13 @@ impl Setup {
                 continue;
             }
             if bsdf.is_specular() {
-                let u_lobe = sampler.next_f32();
-                let u = sampler.next_2d();
+                let (u_lobe, u) = match first_specular.take() {
+                    Some((lobe, sequence)) => {
+                        let [ux, uy, _] = sequence.get(2);
+                        (lobe, Vec2::new(ux, uy))
+                    }
+                    None => (sampler.next_f32(), sampler.next_2d()),
+                };
                 let Some(sample) = bsdf.sample(outgoing, u_lobe, u, TransportMode::Radiance) else {
                     break;
                 };
