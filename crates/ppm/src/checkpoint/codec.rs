@@ -9,7 +9,7 @@ use crate::params::ParamError;
 
 /// Version of the checkpoint layout; bump it whenever the layout or the meaning of a field
 /// changes, so that old checkpoints are refused rather than misread.
-pub const STATE_VERSION: u32 = 12;
+pub const STATE_VERSION: u32 = 13;
 
 /// Why a checkpoint could not be restored.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

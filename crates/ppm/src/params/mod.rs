@@ -176,6 +176,10 @@ pub struct FilmSampling {
     /// Where the photon mappers' camera paths sample the pixel, the lens and their first
     /// specular choice, pass after pass.
     pub sequence: CameraSequence,
+    /// Whether a photon mapper's camera path, where glass makes it choose between reflection
+    /// and refraction (outside media), also traces the branch it did not take one segment for
+    /// the emission seen there, weighting each branch's emission by its Fresnel share.
+    pub glass_split: bool,
 }
 
 /// How the photon mappers draw a slot's camera samples over the passes: the sub-pixel
@@ -498,6 +502,7 @@ impl RenderParams {
             film: FilmSampling {
                 samples_per_pixel: 1,
                 sequence: CameraSequence::Sobol,
+                glass_split: true,
             },
             kernel: Kernel {
                 alpha: 0.7,

@@ -508,6 +508,17 @@ pub const PARAMS: &[Param] = &[
         },
     },
     Param {
+        name: "glass_split",
+        flag: "no-glass-split",
+        help: "Photon mappers: where a camera path meets glass, follow only the branch (reflection or refraction) chosen by Fresnel; by default the other branch is traced one segment for the emission it sees",
+        kind: ParamKind::Switch { sets: false },
+        get: |p| on_off(p.film.glass_split),
+        set: |p, v| {
+            p.film.glass_split = parse_switch(v)?;
+            Ok(())
+        },
+    },
+    Param {
         name: "seed",
         flag: "seed",
         help: "Seed of every random number [default: scene, else 0]",

@@ -366,6 +366,11 @@ impl Setup {
         // BSDF sample it went on with: emission found next shares the light with the light
         // sample taken there (`bsdf_emission_weight`).
         let mut glossy: Option<(Hit, BsdfSample)> = None;
+        // The share of the emission found next that the path counts: 1, or after a glass
+        // vertex whose other branch was traced for its emission, the chosen lobe's probability.
+        let mut split_share = 1.0_f32;
+        // Not in a scene with media: the branch not taken would need its transmittance.
+        let split_glass = self.params.film.glass_split && !has_media;
         loop {
             let hit = self.scene.intersect(&ray);
             if let Some(m) = medium.and_then(|m| self.scene.media().list.get(m as usize)) {
@@ -404,7 +409,7 @@ impl Setup {
             // or a specular bounce, the MIS share after a glossy vertex.
             let emission_weight = |next: Option<&Hit>| match &glossy {
                 Some((at, sample)) => bsdf_emission_weight(&self.scene, at, sample, next, &ray),
-                None => 1.0,
+                None => split_share,
             };
             let Some(hit) = hit else {
                 // An escaped camera path sees the environment (zero without one).
@@ -428,6 +433,7 @@ impl Setup {
             if emitted != Rgb::ZERO {
                 direct += throughput * emitted * emission_weight(Some(&hit));
             }
+            split_share = 1.0;
             if bounces == max_depth {
                 break;
             }
@@ -469,6 +475,34 @@ impl Setup {
                 let Some(sample) = bsdf.sample(outgoing, u_lobe, u, TransportMode::Radiance) else {
                     break;
                 };
+                // Glass chooses reflection or refraction by Fresnel: the emission one segment
+                // along the branch not taken is traced here and counted with its lobe's
+                // probability, and the branch taken counts the emission it finds next with
+                // its own, so that a lamp seen in glass is not left to the choice.
+                if split_glass && sample.is_specular && sample.pdf > 0.0 && sample.pdf < 1.0 {
+                    let other_lobe = if sample.is_transmission {
+                        0.0
+                    } else {
+                        1.0 - f32::EPSILON
+                    };
+                    if let Some(other) =
+                        bsdf.sample(outgoing, other_lobe, u, TransportMode::Radiance)
+                        && other.is_transmission != sample.is_transmission
+                    {
+                        let other_ray = hit.spawn_ray(other.incoming);
+                        let emitted = match self.scene.intersect(&other_ray) {
+                            Some(next) => self.scene.emitted(&next),
+                            None => self
+                                .scene
+                                .lights()
+                                .environment_radiance(other_ray.direction),
+                        };
+                        if emitted != Rgb::ZERO {
+                            direct += throughput * other.weight * (other.pdf * emitted);
+                        }
+                        split_share = sample.pdf;
+                    }
+                }
                 throughput *= sample.weight;
                 if throughput == Rgb::ZERO {
                     break;
