@@ -184,8 +184,19 @@ material = "white"
     }
 
     fn clear_radius(scene: &Scene, position: Vec3, normal: Vec3, r0: f32) -> f64 {
+        clear_radius_within(scene, position, normal, r0, 0.5 * r0)
+    }
+
+    /// The clear radius with drop probes no deeper than `depth`.
+    fn clear_radius_within(
+        scene: &Scene,
+        position: Vec3,
+        normal: Vec3,
+        r0: f32,
+        depth: f32,
+    ) -> f64 {
         level_radius(
-            clear_level(scene, position, normal, r0, 0.5 * r0),
+            clear_level(scene, position, normal, r0, depth),
             f64::from(r0),
         )
     }
@@ -199,15 +210,9 @@ material = "white"
         let scene = build(STEP);
         let at = Vec3::new(-0.02, 0.1, 0.0);
         let wide = 0.8f32;
-        let loose = level_radius(
-            clear_level(&scene, at, Vec3::Y, wide, 0.5 * wide),
-            f64::from(wide),
-        );
+        let loose = clear_radius(&scene, at, Vec3::Y, wide);
         assert_eq!(loose, f64::from(wide));
-        let held = level_radius(
-            clear_level(&scene, at, Vec3::Y, wide, 0.05),
-            f64::from(wide),
-        );
+        let held = clear_radius_within(&scene, at, Vec3::Y, wide, 0.05);
         assert_eq!(held, f64::from(wide) / 64.0);
     }
 

@@ -406,7 +406,8 @@ impl Setup {
                 throughput *= tr;
             }
             // How much of the emission found next the path counts: all of it after the camera
-            // or a specular bounce, the MIS share after a glossy vertex.
+            // or a specular bounce (the chosen lobe's probability after a split glass vertex),
+            // the MIS share after a glossy vertex.
             let emission_weight = |next: Option<&Hit>| match &glossy {
                 Some((at, sample)) => bsdf_emission_weight(&self.scene, at, sample, next, &ray),
                 None => split_share,
